@@ -1,0 +1,32 @@
+#include "cli.hpp"
+
+#include <exception>
+#include <iostream>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/version.hpp>
+
+namespace dicestack::cli {
+
+int run(int argc, char** argv) {
+  CLI::App app{"dicestack: imitation learning for dynamic dice stacking", "dicestack"};
+  app.set_version_flag("--version", "dicestack " DICESTACK_VERSION);
+  app.require_subcommand(1);
+  add_bench_command(app);
+  add_config_command(app);
+  add_rollout_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const Error& e) {
+    std::cerr << "dicestack: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "dicestack: internal error: " << e.what() << '\n';
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace dicestack::cli

@@ -1,0 +1,16 @@
+#pragma once
+// The dicestack command line: one file per subcommand, one catch in run() (STYLE 8).
+#include <CLI/CLI.hpp>
+
+namespace dicestack::cli {
+
+/// Parses argv, runs the chosen subcommand and returns the process exit status: 0 on success,
+/// 1 for a dicestack::Error (message on stderr), CLI11's codes for usage errors.
+int run(int argc, char** argv);
+
+// Each subcommand file registers itself on the top-level app.
+void add_bench_command(CLI::App& app);
+void add_config_command(CLI::App& app);
+void add_rollout_command(CLI::App& app);
+
+}  // namespace dicestack::cli

@@ -1,0 +1,19 @@
+#pragma once
+// The paper's state distance and goal cost (eq. 6), used by the optimisers and as the
+// environment's reward.
+#include <span>
+
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// Scaled L2 distance between two states: sqrt(sum_j ((a_j - b_j) / sigma_j)^2) over the dice
+/// and the cup's velocity (indices 3-23), as the original implementation compared states; the
+/// cup's pose is free. Die angles compare modulo 90 degrees (a turned die is the same die).
+double state_distance(const State& a, const State& b, const CostConfig& cost);
+
+/// Eq. 6 for one trajectory s_1..s_T: sum_j gamma^(T - j) d(s_j, goal).
+double discounted_cost(std::span<const State> trajectory, const State& goal, const CostConfig& cost);
+
+}  // namespace dicestack

@@ -1,0 +1,84 @@
+#pragma once
+// The dice-stacking task as a Gym-style environment: reset(seed) gives the first observation,
+// step(action) gives observation, reward, terminated, truncated and info.
+#include <cstdint>
+
+#include <dicestack/core/judge.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/core/world.hpp>
+
+namespace dicestack {
+
+/// Per-step details beside the reward.
+struct StepInfo {
+  int t = 0;                       ///< control steps taken in this episode
+  double distance = 0.0;           ///< scaled L2 distance to the goal (cost.hpp)
+  bool wall_contact_step = false;  ///< a side wall or the ceiling was touched in this step
+  Outcome outcome;                 ///< the judge's running outcome
+};
+
+struct StepResult {
+  State observation{};
+  double reward = 0.0;     ///< -gamma^(T - t) * distance: summed over T steps, minus eq. 6
+  bool terminated = false; ///< realistic success held for judge.success_hold_steps steps
+  bool truncated = false;  ///< the time limit episode.max_steps was reached
+  StepInfo info;
+};
+
+/// Lower and upper bounds of an observation or an action.
+template <std::size_t N>
+struct Box {
+  std::array<double, N> low{};
+  std::array<double, N> high{};
+};
+
+/// An exact copy of an environment: world snapshot, step count, outcome and noise stream.
+struct EnvSnapshot {
+  WorldSnapshot world;
+  Outcome outcome;
+  Rng noise{0};
+};
+
+/// One episode at a time of the dice-stacking task. Not thread-safe; use one per thread.
+class DiceEnv {
+ public:
+  /// Throws ConfigError if `config` is invalid.
+  explicit DiceEnv(const WorldConfig& config = {});
+
+  /// Starts an episode from random_start_state(config, seed); the noise stream (if any)
+  /// is seeded from `seed` too. Returns the first observation.
+  State reset(std::uint64_t seed);
+
+  /// Starts an episode from a bare state (e.g. a recorded one); `seed` seeds the noise.
+  State reset_to(const State& state, std::uint64_t seed = 0);
+
+  /// Applies `action` (clipped to config.action.limit, plus noise if configured) and advances
+  /// one control step. Throws InputError if the action is not finite.
+  StepResult step(const Action& action);
+
+  State get_state() const { return world_.state(); }
+  EnvSnapshot snapshot() const;
+  /// Continues bit-for-bit from `snapshot`.
+  void restore(const EnvSnapshot& snapshot);
+
+  const Outcome& outcome() const { return outcome_; }
+  int t() const { return outcome_.steps; }
+  const WorldConfig& config() const { return world_.config(); }
+  const World& world() const { return world_; }
+
+  /// Observation bounds: positions inside the walls, velocities below Box2D's speed cap,
+  /// angles unbounded.
+  Box<kStateDim> observation_space() const;
+  /// Action bounds: +-config.action.limit.
+  Box<kActionDim> action_space() const;
+
+ private:
+  StepResult finish_step(bool wall);
+
+  World world_;
+  State goal_;
+  Outcome outcome_;
+  Rng noise_{0};
+};
+
+}  // namespace dicestack

@@ -1,0 +1,33 @@
+#pragma once
+// The outcome judge (DESIGN "Outcome judge", paper III-B/C): how many dice the cup holds,
+// whether the dice stand stacked, and whether anything touched a wall.
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// Dice whose centre lies inside the cup while the cup's mouth points up (within 90 degrees of
+/// upright) and the die is off the table. A cup held mouth-down over the dice holds none.
+int count_dice_in_cup(const State& state, const WorldConfig& config);
+
+/// True when the three dice form one vertical column at rest on the table: in any order, at
+/// any x, each rotated by a multiple of 90 degrees (within config.judge's tolerances). Dice
+/// side by side, a leaning or offset column, or a moving one are not stacked.
+bool is_stacked(const State& state, const WorldConfig& config);
+
+/// What happened in an episode so far.
+struct Outcome {
+  int steps = 0;             ///< control steps taken
+  int dice_in_cup = 0;       ///< most dice held in the cup at once during the episode (0-3)
+  int dice_in_cup_now = 0;   ///< dice in the cup in the latest state
+  bool stacked = false;      ///< the latest state is stacked
+  bool wall_contact = false; ///< the cup or a die touched a side wall or the ceiling at any time
+  int stacked_steps = 0;     ///< consecutive steps the dice have been stacked, up to the latest
+  /// Stacked without ever touching a wall: the paper's realistic success (III-C).
+  bool realistic_success() const { return stacked && !wall_contact; }
+};
+
+/// Updates an Outcome with one more state; `wall_contact_step` is what World::step returned.
+void observe(Outcome& outcome, const State& state, bool wall_contact_step, const WorldConfig& config);
+
+}  // namespace dicestack

@@ -1,0 +1,18 @@
+#pragma once
+// Parallel loops whose results do not depend on the thread count: work item i writes only to
+// slot i, and callers reduce the slots in index order afterwards (STYLE 15).
+#include <cstddef>
+#include <functional>
+
+namespace dicestack {
+
+/// Number of threads `threads` stands for: itself if > 0, else the hardware's core count.
+int resolve_threads(int threads);
+
+/// Calls fn(i, worker) for every i in [0, n), on up to `threads` threads (0 = all cores).
+/// `worker` is in [0, resolve_threads(threads)) and no two calls with the same worker run at
+/// once, so it can index per-thread scratch state (one World per thread). The first exception
+/// thrown by fn is rethrown here after the loop stops.
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t i, int worker)>& fn);
+
+}  // namespace dicestack

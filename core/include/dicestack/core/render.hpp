@@ -1,0 +1,40 @@
+#pragma once
+// Drawing a state to an image a person can read: walls, cup, dice (numbered by their pips),
+// time and the judge's outcome. OpenCV stays behind this header.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/judge.hpp>
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// An 8-bit BGR image, rows top to bottom.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> bgr;  ///< width * height * 3 bytes
+};
+
+struct RenderOptions {
+  double pixels_per_metre = 100.0;  ///< 100 reproduces the original 900 x 700 window
+  bool show_hud = true;             ///< time, step and outcome text
+};
+
+/// The heads-up text drawn over a frame.
+struct Hud {
+  int step = 0;
+  Outcome outcome;
+  std::string title;  ///< e.g. the policy's name; empty for none
+};
+
+/// Renders `state` of a world built from `config`.
+Image render_state(const State& state, const WorldConfig& config, const Hud& hud, const RenderOptions& options = {});
+
+/// Writes a PNG atomically. Throws InputError if it cannot be written.
+void write_png(const Image& image, const std::filesystem::path& path);
+
+}  // namespace dicestack

@@ -1,0 +1,89 @@
+#include <dicestack/core/env.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <dicestack/core/cost.hpp>
+#include <dicestack/core/initial_state.hpp>
+
+namespace dicestack {
+
+DiceEnv::DiceEnv(const WorldConfig& config) : world_(config), goal_(goal_state(config)) {}
+
+State DiceEnv::reset(std::uint64_t seed) {
+  return reset_to(random_start_state(config(), seed), derive_seed(seed, 1));
+}
+
+State DiceEnv::reset_to(const State& state, std::uint64_t seed) {
+  world_.set_state(state);
+  outcome_ = Outcome{};
+  noise_ = Rng(seed);
+  return world_.state();
+}
+
+StepResult DiceEnv::step(const Action& action) {
+  require_finite(action, "action");
+  const auto& c = config();
+  Action a = action;
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    if (c.physics.action_noise > 0.0) a[k] += c.physics.action_noise * c.action.scale[k] * noise_.normal();
+    a[k] = std::clamp(a[k], -c.action.limit[k], c.action.limit[k]);
+  }
+  return finish_step(world_.step(a));
+}
+
+StepResult DiceEnv::finish_step(bool wall) {
+  const auto& c = config();
+  StepResult r;
+  r.observation = world_.state();
+  observe(outcome_, r.observation, wall, c);
+  r.info.t = outcome_.steps;
+  r.info.distance = state_distance(r.observation, goal_, c.cost);
+  r.info.wall_contact_step = wall;
+  r.info.outcome = outcome_;
+  const int remaining = std::max(0, c.episode.max_steps - outcome_.steps);
+  r.reward = -std::pow(c.cost.gamma, remaining) * r.info.distance;
+  r.terminated = outcome_.realistic_success() && outcome_.stacked_steps >= c.judge.success_hold_steps;
+  r.truncated = !r.terminated && outcome_.steps >= c.episode.max_steps;
+  return r;
+}
+
+EnvSnapshot DiceEnv::snapshot() const { return {world_.snapshot(), outcome_, noise_}; }
+
+void DiceEnv::restore(const EnvSnapshot& snapshot) {
+  world_.restore(snapshot.world);
+  outcome_ = snapshot.outcome;
+  noise_ = snapshot.noise;
+}
+
+Box<kStateDim> DiceEnv::observation_space() const {
+  const auto& c = config();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double speed = 2.0 * c.physics.substeps / c.physics.control_dt / c.physics.units_per_metre;
+  Box<kStateDim> box;
+  const double x_lo = c.walls.left_x + c.walls.radius, x_hi = c.walls.right_x - c.walls.radius;
+  const double y_lo = c.walls.floor_y + c.walls.radius, y_hi = c.walls.ceiling_y - c.walls.radius;
+  auto body = [&](std::size_t at, std::size_t vat) {
+    box.low[at] = x_lo, box.high[at] = x_hi;
+    box.low[at + 1] = y_lo, box.high[at + 1] = y_hi;
+    box.low[at + 2] = -inf, box.high[at + 2] = inf;
+    box.low[vat] = box.low[vat + 1] = -speed;
+    box.high[vat] = box.high[vat + 1] = speed;
+    box.low[vat + 2] = -inf, box.high[vat + 2] = inf;
+  };
+  body(state_index::kCupX, state_index::kCupVx);
+  for (std::size_t i = 0; i < kDiceCount; ++i) body(state_index::die(i), state_index::die(i) + 3);
+  return box;
+}
+
+Box<kActionDim> DiceEnv::action_space() const {
+  Box<kActionDim> box;
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    box.high[k] = config().action.limit[k];
+    box.low[k] = -box.high[k];
+  }
+  return box;
+}
+
+}  // namespace dicestack

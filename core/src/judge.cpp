@@ -1,0 +1,71 @@
+#include <dicestack/core/judge.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <dicestack/core/geometry.hpp>
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+
+// Distance from `angle` to the nearest multiple of 90 degrees.
+double off_quarter_turn(double angle) {
+  const double q = std::numbers::pi / 2.0;
+  return std::abs(angle - q * std::round(angle / q));
+}
+
+}  // namespace
+
+int count_dice_in_cup(const State& s, const WorldConfig& config) {
+  const double angle = s[si::kCupAngle];
+  if (std::cos(angle) <= 0.0) return 0;  // mouth down or sideways
+  const CupGeometry cup = cup_geometry(config.cup);
+  const double on_table = table_height(config.walls) + config.dice.half_size + config.judge.gap_tolerance;
+  const Vec2 com{s[si::kCupX], s[si::kCupY]};
+  const double h = config.cup.wall_height, w = config.cup.base_width, f = config.cup.flare;
+  int count = 0;
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    const std::size_t d = si::die(i);
+    if (s[d + 1] <= on_table) continue;
+    const Vec2 local = to_local(com, angle, {s[d], s[d + 1]});
+    // Back to the anchor frame, where the base runs from (0, 0) to (w, 0).
+    const double x = local.x + cup.com_from_anchor.x, y = local.y + cup.com_from_anchor.y;
+    if (y <= 0.0 || y >= h) continue;
+    const double left = -f * y / h, right = w + f * y / h;
+    if (x > left && x < right) ++count;
+  }
+  return count;
+}
+
+bool is_stacked(const State& s, const WorldConfig& config) {
+  const auto& j = config.judge;
+  std::array<std::size_t, kDiceCount> order{0, 1, 2};
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return s[si::die(a) + 1] < s[si::die(b) + 1]; });
+  const double side = 2.0 * config.dice.half_size;
+  const double bottom = table_height(config.walls) + config.dice.half_size;
+  for (std::size_t k = 0; k < kDiceCount; ++k) {
+    const std::size_t d = si::die(order[k]);
+    const double expected_y = bottom + side * static_cast<double>(k);
+    if (std::abs(s[d + 1] - expected_y) > j.gap_tolerance * static_cast<double>(k + 1)) return false;
+    if (std::abs(s[d] - s[si::die(order[0])]) > j.column_tolerance) return false;
+    if (off_quarter_turn(s[d + 2]) > j.angle_tolerance) return false;
+    if (std::hypot(s[d + 3], s[d + 4]) > j.rest_speed) return false;
+    if (std::abs(s[d + 5]) > j.rest_angular_speed) return false;
+  }
+  return true;
+}
+
+void observe(Outcome& o, const State& s, bool wall_contact_step, const WorldConfig& config) {
+  ++o.steps;
+  o.dice_in_cup_now = count_dice_in_cup(s, config);
+  o.dice_in_cup = std::max(o.dice_in_cup, o.dice_in_cup_now);
+  o.stacked = is_stacked(s, config);
+  o.stacked_steps = o.stacked ? o.stacked_steps + 1 : 0;
+  o.wall_contact = o.wall_contact || wall_contact_step;
+}
+
+}  // namespace dicestack

@@ -1,0 +1,32 @@
+#include <dicestack/core/parallel.hpp>
+
+#include <thread>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace dicestack {
+
+int resolve_threads(int threads) {
+  if (threads > 0) return threads;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : static_cast<int>(hw);
+}
+
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t, int)>& fn) {
+  const int t = resolve_threads(threads);
+  if (t == 1 || n <= 1) {
+    for (std::size_t i = 0; i < n; ++i) fn(i, 0);
+    return;
+  }
+  tbb::task_arena arena(t);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      const int worker = tbb::this_task_arena::current_thread_index();
+      for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i, worker);
+    });
+  });
+}
+
+}  // namespace dicestack

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages dicestack builds and tests with. Idempotent: when every
+# package is already installed it changes nothing and does not touch the network.
+set -euo pipefail
+
+packages=(
+  cmake g++ make pkg-config
+  libbox2d-dev            # physics (Box2D 2.4)
+  libeigen3-dev           # linear algebra
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libopencv-ml-dev        # SVR, MLP, random forest
+  libxgboost-dev          # gradient-boosted trees
+  libnanoflann-dev        # k-NN
+  libpagmo-dev            # differential evolution, basin hopping
+  libnlopt-cxx-dev        # L-BFGS
+  libcli11-dev            # command line
+  nlohmann-json3-dev      # JSON
+  libtbb-dev              # threads
+  libsdl2-dev             # the interactive player
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update
+$sudo apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The README's quick start. On a fresh Debian 12 machine:
+#   bash scripts/quickstart.sh        installs dependencies, builds (Release), runs the main job
+#   bash scripts/quickstart.sh test   installs dependencies, builds (Release), runs every test
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mode="${1:-run}"
+
+bash scripts/install-deps.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DDICESTACK_WERROR=ON
+cmake --build build -j 2
+
+case "$mode" in
+  run)
+    mkdir -p out
+    ./build/apps/dicestack rollout --start paper --seed 1 --png out/rollout.png
+    ./build/apps/dicestack bench sim --episodes 100 --repeats 3
+    ;;
+  test)
+    ctest --test-dir build --output-on-failure -j 2
+    ;;
+  *)
+    echo "usage: bash scripts/quickstart.sh [run|test]" >&2
+    exit 2
+    ;;
+esac

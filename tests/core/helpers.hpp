@@ -1,0 +1,35 @@
+#pragma once
+// Small helpers shared by the core tests.
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/rng.hpp>
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack::test {
+
+inline bool bit_equal(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
+
+/// `n` actions uniform in the optimisers' scale, from `seed`.
+inline std::vector<Action> random_actions(const WorldConfig& c, std::uint64_t seed, int n) {
+  Rng rng(seed);
+  std::vector<Action> out(static_cast<std::size_t>(n));
+  for (auto& a : out)
+    for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng.uniform(-1.0, 1.0) * c.action.scale[k];
+  return out;
+}
+
+/// What a callable throws, as text; empty if it does not throw.
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return {};
+}
+
+}  // namespace dicestack::test

@@ -1,0 +1,114 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <dicestack/core/judge.hpp>
+
+#include "helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+constexpr double kPi = std::numbers::pi;
+
+// A state with the cup upright at rest far to the right and the dice in a column at x, in
+// the given order (bottom first) and quarter turns.
+State column(double x, std::array<std::size_t, 3> order = {0, 1, 2}, std::array<int, 3> turns = {0, 0, 0}) {
+  State s{};
+  s[si::kCupX] = 7.5;
+  s[si::kCupY] = 1.0 + 0.05 + 2.2 / 3.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::size_t d = si::die(order[k]);
+    s[d] = x;
+    s[d + 1] = 1.2 + 0.4 * static_cast<double>(k);
+    s[d + 2] = turns[k] * kPi / 2.0;
+  }
+  return s;
+}
+
+TEST(Judge, ColumnIsStackedAtAnyXOrderAndQuarterTurn) {
+  const WorldConfig c;
+  EXPECT_TRUE(is_stacked(column(4.51), c));
+  EXPECT_TRUE(is_stacked(column(2.0), c));
+  EXPECT_TRUE(is_stacked(column(6.3, {2, 0, 1}), c));
+  EXPECT_TRUE(is_stacked(column(3.0, {1, 2, 0}, {1, -2, 7}), c));
+  State s = column(4.0);
+  s[si::die(1)] += 0.03;  // slightly offset, within tolerance
+  s[si::die(2) + 2] += 0.05;
+  EXPECT_TRUE(is_stacked(s, c));
+}
+
+TEST(Judge, SideBySideLeaningMovingOrFloatingIsNotStacked) {
+  const WorldConfig c;
+  State side = column(4.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    side[si::die(i)] = 3.0 + 0.45 * static_cast<double>(i);
+    side[si::die(i) + 1] = 1.2;
+  }
+  EXPECT_FALSE(is_stacked(side, c));
+
+  State leaning = column(4.0);
+  leaning[si::die(1)] += 0.12;
+  leaning[si::die(2)] += 0.24;
+  EXPECT_FALSE(is_stacked(leaning, c));
+
+  State tilted = column(4.0);
+  tilted[si::die(2) + 2] = 0.4;
+  EXPECT_FALSE(is_stacked(tilted, c));
+
+  State moving = column(4.0);
+  moving[si::die(2) + 3] = 0.3;
+  EXPECT_FALSE(is_stacked(moving, c));
+  State spinning = column(4.0);
+  spinning[si::die(0) + 5] = 1.0;
+  EXPECT_FALSE(is_stacked(spinning, c));
+
+  State floating = column(4.0);
+  for (std::size_t i = 0; i < 3; ++i) floating[si::die(i) + 1] += 0.5;
+  EXPECT_FALSE(is_stacked(floating, c));
+
+  State two_high = column(4.0);
+  two_high[si::die(2)] = 6.0;
+  two_high[si::die(2) + 1] = 1.2;
+  EXPECT_FALSE(is_stacked(two_high, c));
+}
+
+TEST(Judge, DiceInCupCountsOnlyHeldDice) {
+  const WorldConfig c;
+  State s = column(2.0);
+  // Cup upright in the air at x = 5, dice 0 and 1 inside above its base, die 2 on the table.
+  s[si::kCupX] = 5.0;
+  s[si::kCupY] = 3.0;
+  s[si::kCupAngle] = 0.1;
+  s[si::die(0)] = 5.0;
+  s[si::die(0) + 1] = 3.0 - 2.2 / 3.0 + 0.3;
+  s[si::die(1)] = 5.1;
+  s[si::die(1) + 1] = 3.0;
+  EXPECT_EQ(count_dice_in_cup(s, c), 2);
+  s[si::kCupAngle] = kPi;  // mouth down: holds nothing
+  EXPECT_EQ(count_dice_in_cup(s, c), 0);
+  EXPECT_EQ(count_dice_in_cup(column(4.0), c), 0);
+}
+
+TEST(Judge, OutcomeTracksMaximaAndWallContact) {
+  const WorldConfig c;
+  Outcome o;
+  observe(o, column(4.0), false, c);
+  EXPECT_TRUE(o.realistic_success());
+  EXPECT_EQ(o.stacked_steps, 1);
+  observe(o, column(4.0), true, c);
+  EXPECT_TRUE(o.stacked);
+  EXPECT_TRUE(o.wall_contact);
+  EXPECT_FALSE(o.realistic_success());
+  State side = column(4.0);
+  side[si::die(2)] = 6.0;
+  observe(o, side, false, c);
+  EXPECT_EQ(o.stacked_steps, 0);
+  EXPECT_TRUE(o.wall_contact) << "wall contact is sticky for the episode";
+  EXPECT_EQ(o.steps, 3);
+}
+
+}  // namespace
+}  // namespace dicestack

@@ -1,0 +1,183 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/world.hpp>
+
+#include "helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+using ::testing::HasSubstr;
+
+double dice_kinetic_energy(const State& s, const WorldConfig& c) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    const std::size_t d = si::die(i);
+    e += 0.5 * c.dice.mass * (s[d + 3] * s[d + 3] + s[d + 4] * s[d + 4]);
+  }
+  return e;
+}
+
+TEST(World, StartStateIsThePapers) {
+  const WorldConfig c;
+  const State s = World(c).state();
+  EXPECT_NEAR(s[si::kCupX], 4.5, 1e-6);
+  EXPECT_NEAR(s[si::kCupY], 1.9 + 2.2 / 3.0, 1e-6);
+  EXPECT_NEAR(s[si::kCupAngle], std::numbers::pi, 1e-6);
+  EXPECT_NEAR(s[si::die(0)], 4.08, 1e-6);
+  EXPECT_NEAR(s[si::die(2)], 4.93, 1e-6);
+  EXPECT_NEAR(s[si::die(1) + 1], 1.25, 1e-6);
+}
+
+TEST(World, DieFallsWithGravityUntilContact) {
+  const WorldConfig c;
+  State s = paper_start_state(c);
+  s[si::die(0)] = 2.0;  // away from the cup
+  s[si::die(0) + 1] = 4.0;
+  World w(c, s);
+  const double dt = c.physics.control_dt, h = dt / c.physics.substeps;
+  double y = 4.0, v = 0.0;
+  for (int t = 1; t <= 20; ++t) {
+    w.step({0.0, 0.0, 0.0});
+    for (int k = 0; k < c.physics.substeps; ++k) {  // Box2D's semi-implicit Euler
+      v += -4.0 * h;
+      y += v * h;
+    }
+    const State now = w.state();
+    ASSERT_NEAR(now[si::die(0) + 4], -4.0 * dt * t, 1e-4) << "step " << t;
+    ASSERT_NEAR(now[si::die(0) + 1], y, 1e-4) << "step " << t;
+  }
+}
+
+TEST(World, DiceSettleOnTheTableWithoutJitter) {
+  const WorldConfig c;
+  World w(c);
+  for (int t = 0; t < 30; ++t) w.step({0.0, 0.0, 0.0});  // one second
+  State s = w.state();
+  EXPECT_LT(dice_kinetic_energy(s, c), 1e-3);
+  for (int t = 0; t < 30; ++t) w.step({0.0, 0.0, 0.0});
+  s = w.state();
+  EXPECT_LT(dice_kinetic_energy(s, c), 1e-9);
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    // Resting on the table: centre at table + half size, within Box2D's 0.5 mm slop and the
+    // cup wall leaning on die 2.
+    EXPECT_NEAR(s[si::die(i) + 1], 1.2, 2e-3) << "die " << i;
+  }
+}
+
+TEST(World, CupWithoutActionFallsAndRestsOnTheTable) {
+  const WorldConfig c;
+  World w(c);
+  const double y0 = w.state()[si::kCupY];
+  for (int t = 0; t < 90; ++t) w.step({0.0, 0.0, 0.0});
+  const State s = w.state();
+  // The mouth-down rim starts 0.1167 m above the table (rim centre line 1.1667 minus radius).
+  const double rim_gap = (c.cup.start_anchor.y + 2.0 * (2.2 / 3.0) - 2.2 - c.cup.radius) - 1.0;  // 0.1167 m
+  EXPECT_NEAR(s[si::kCupY], y0 - rim_gap, 1e-3);
+  EXPECT_NEAR(s[si::kCupVy], 0.0, 1e-6);
+  EXPECT_NEAR(s[si::kCupVx], 0.0, 1e-6);
+}
+
+TEST(World, ActionChangesCupVelocityByExactlyItsValue) {
+  const WorldConfig c;
+  State s = paper_start_state(c);
+  s[si::kCupY] = 5.0;  // in free flight, far from everything
+  s[si::kCupVx] = 0.37;
+  World w(c, s);
+  const State before = w.state();
+  w.step({1.0, 0.0, 0.0});
+  State after = w.state();
+  EXPECT_NEAR(after[si::kCupVx] - before[si::kCupVx], 1.0, 1e-6);
+  EXPECT_NEAR(after[si::kCupVy] - before[si::kCupVy], -4.0 * c.physics.control_dt, 1e-6);
+  w.step({0.0, 0.5, -0.25});
+  const State third = w.state();
+  EXPECT_NEAR(third[si::kCupVy] - after[si::kCupVy], 0.5 - 4.0 * c.physics.control_dt, 1e-6);
+  EXPECT_NEAR(third[si::kCupW] - after[si::kCupW], -0.25, 1e-6);
+}
+
+TEST(World, StateRoundTripsExactly) {
+  const WorldConfig c;
+  World w(c, random_start_state(c, 3));
+  for (const auto& a : test::random_actions(c, 4, 40)) w.step(a);
+  const State s = w.state();
+  World copy(c, s);
+  EXPECT_TRUE(test::bit_equal(copy.state(), s));
+  copy.set_state(s);
+  EXPECT_TRUE(test::bit_equal(copy.state(), s));
+}
+
+TEST(World, SameSeedAndActionsGiveBitIdenticalStates) {
+  const WorldConfig c;
+  const auto actions = test::random_actions(c, 11, 300);
+  std::uint64_t hashes[2];
+  for (auto& h : hashes) {
+    World w(c, random_start_state(c, 5));
+    h = hash_state(w.state());
+    for (const auto& a : actions) {
+      w.step(a);
+      h = hash_state(w.state(), h);
+    }
+  }
+  EXPECT_EQ(hashes[0], hashes[1]);
+  World other(c, random_start_state(c, 6));
+  std::uint64_t h = hash_state(other.state());
+  for (const auto& a : actions) {
+    other.step(a);
+    h = hash_state(other.state(), h);
+  }
+  EXPECT_NE(h, hashes[0]);
+}
+
+TEST(World, PushingIntoSideWallsAndCeilingIsReported) {
+  const WorldConfig c;
+  World w(c);
+  bool touched = false;
+  for (int t = 0; t < 60 && !touched; ++t) touched = w.step({t == 0 ? -3.0 : 0.0, 0.1, 0.0});
+  EXPECT_TRUE(touched) << "cup pushed left never touched the left wall";
+  World up(c);
+  touched = false;
+  for (int t = 0; t < 90 && !touched; ++t) touched = up.step({0.0, t == 0 ? 6.0 : 0.134, 0.0});
+  EXPECT_TRUE(touched) << "cup pushed up never touched the ceiling";
+  World still(c);
+  for (int t = 0; t < 60; ++t) EXPECT_FALSE(still.step({0.0, 0.0, 0.0}));
+}
+
+TEST(World, RejectsNonFiniteStatesAndActions) {
+  const WorldConfig c;
+  World w(c);
+  Action bad{0.0, std::nan(""), 0.0};
+  EXPECT_THAT(test::error_of([&] { w.step(bad); }), HasSubstr("action: element 1 is NaN"));
+  State s = w.state();
+  s[7] = INFINITY;
+  EXPECT_THAT(test::error_of([&] { w.set_state(s); }), HasSubstr("world state: element 7 is infinite"));
+  EXPECT_THROW(w.set_state(s), InputError);
+}
+
+TEST(World, WrongSizedVectorsAreRejected) {
+  const std::vector<double> five(5, 0.0);
+  EXPECT_THAT(test::error_of([&] { to_state(five, "row 3"); }), HasSubstr("row 3: a state needs 24 values, got 5"));
+  EXPECT_THAT(test::error_of([&] { to_action(five, "policy output"); }),
+              HasSubstr("policy output: an action needs 3 values, got 5"));
+  const std::vector<double> ok{0.1, 0.2, 0.3};
+  EXPECT_EQ(to_action(ok, "x")[2], 0.3);
+}
+
+TEST(World, RandomStartsDifferAndDoNotOverlap) {
+  const WorldConfig c;
+  const State a = random_start_state(c, 1), b = random_start_state(c, 2);
+  EXPECT_FALSE(test::bit_equal(a, b));
+  EXPECT_TRUE(test::bit_equal(a, random_start_state(c, 1)));
+  for (std::uint64_t seed = 0; seed < 50; ++seed) EXPECT_FALSE(World(c, random_start_state(c, seed)).has_overlaps());
+  WorldConfig none = c;
+  none.randomization = {0.0, 0.0, 0.0, 0.0, false};
+  EXPECT_TRUE(test::bit_equal(random_start_state(none, 9), paper_start_state(none)));
+}
+
+}  // namespace
+}  // namespace dicestack

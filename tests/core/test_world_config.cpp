@@ -1,0 +1,112 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/world_config.hpp>
+
+#include "helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+using test::error_of;
+
+nlohmann::json default_json() { return nlohmann::json::parse(to_json(WorldConfig{})); }
+
+std::string error_for(const nlohmann::json& j) {
+  return error_of([&] { world_config_from_json(j.dump(), "w.json"); });
+}
+
+TEST(WorldConfig, DefaultsAreThePapersAndValid) {
+  const WorldConfig c;
+  EXPECT_NO_THROW(validate(c));
+  EXPECT_DOUBLE_EQ(c.physics.gravity.y, -4.0);
+  EXPECT_EQ(c.physics.substeps, 5);
+  EXPECT_EQ(c.physics.velocity_iterations, 10);
+  EXPECT_DOUBLE_EQ(c.physics.control_dt, 1.0 / 30.0);
+  EXPECT_DOUBLE_EQ(c.dice.friction, 0.6);
+  EXPECT_DOUBLE_EQ(c.cup.friction, 0.4);
+  EXPECT_DOUBLE_EQ(c.walls.friction, 1.0);
+  EXPECT_DOUBLE_EQ(c.walls.floor_y + c.walls.radius, 1.0);
+}
+
+TEST(WorldConfig, JsonRoundTripKeepsEveryField) {
+  WorldConfig c;
+  c.physics.substeps = 7;
+  c.cup.start_anchor = {3.5, 2.0};
+  c.dice.start_x = {4.0, 4.5, 5.0};
+  c.randomization.die_quarter_turns = false;
+  c.cost.sigma[5] = 0.25;
+  const WorldConfig back = world_config_from_json(to_json(c));
+  EXPECT_EQ(to_json(back), to_json(c));
+  EXPECT_EQ(back.physics.substeps, 7);
+  EXPECT_DOUBLE_EQ(back.cost.sigma[5], 0.25);
+}
+
+TEST(WorldConfig, MissingFieldIsNamed) {
+  auto j = default_json();
+  j["physics"].erase("substeps");
+  EXPECT_THAT(error_for(j), HasSubstr("w.json: field \"physics.substeps\" is missing"));
+}
+
+TEST(WorldConfig, MistypedFieldIsNamed) {
+  auto j = default_json();
+  j["dice"]["mass"] = "heavy";
+  EXPECT_THAT(error_for(j), HasSubstr("field \"dice.mass\" must be a number, got \"heavy\""));
+  j = default_json();
+  j["physics"]["substeps"] = 2.5;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"physics.substeps\" must be an integer, got 2.5"));
+  j = default_json();
+  j["cost"]["sigma"] = {1.0, 2.0};
+  EXPECT_THAT(error_for(j), HasSubstr("field \"cost.sigma\" must be an array of 24 numbers"));
+}
+
+TEST(WorldConfig, NonFiniteFieldIsNamed) {
+  std::string text = default_json().dump();
+  const std::string key = "\"half_size\":0.2";
+  const auto at = text.find(key);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, key.size(), "\"half_size\":1e999");
+  const std::string msg = error_of([&] { world_config_from_json(text, "w.json"); });
+  EXPECT_THAT(msg, HasSubstr("w.json: field \"half_size\" value 1e999"));
+  EXPECT_THAT(msg, HasSubstr("finite"));
+}
+
+TEST(WorldConfig, OutOfRangeFieldIsNamedWithValue) {
+  auto j = default_json();
+  j["physics"]["substeps"] = 0;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"physics.substeps\" must be in [1, 1000], got 0"));
+  j = default_json();
+  j["cup"]["radius"] = -0.05;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"cup.radius\" must be > 0, got -0.05"));
+  j = default_json();
+  j["dice"]["corner_cut"] = 0.3;
+  EXPECT_THAT(error_for(j), HasSubstr("dice.corner_cut"));
+}
+
+TEST(WorldConfig, UnknownFieldIsRejected) {
+  auto j = default_json();
+  j["physics"]["gravty"] = -9.8;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"physics.gravty\" is not a world config field"));
+}
+
+TEST(WorldConfig, BrokenJsonIsRejected) {
+  EXPECT_THAT(error_of([] { world_config_from_json("{\"walls\": ", "w.json"); }),
+              HasSubstr("w.json: not valid JSON"));
+  EXPECT_THROW(world_config_from_json("{\"walls\": ", "w.json"), ConfigError);
+}
+
+TEST(WorldConfig, ValidateRejectsBadStructs) {
+  WorldConfig c;
+  c.walls.left_x = 10.0;
+  EXPECT_THAT(error_of([&] { validate(c); }), HasSubstr("walls.right_x"));
+  c = WorldConfig{};
+  c.judge.success_hold_steps = 0;
+  EXPECT_THROW(validate(c), ConfigError);
+}
+
+}  // namespace
+}  // namespace dicestack
