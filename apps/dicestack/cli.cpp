@@ -14,6 +14,7 @@ int run(int argc, char** argv) {
   app.require_subcommand(1);
   add_bench_command(app);
   add_config_command(app);
+  add_dataset_commands(app);
   add_rollout_command(app);
   try {
     app.parse(argc, argv);

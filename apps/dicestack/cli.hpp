@@ -11,6 +11,7 @@ int run(int argc, char** argv);
 // Each subcommand file registers itself on the top-level app.
 void add_bench_command(CLI::App& app);
 void add_config_command(CLI::App& app);
+void add_dataset_commands(CLI::App& app);  // import, dataset
 void add_rollout_command(CLI::App& app);
 
 }  // namespace dicestack::cli

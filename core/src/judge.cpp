@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <dicestack/core/geometry.hpp>
+#include <dicestack/core/world.hpp>
 
 namespace dicestack {
 namespace {
@@ -21,7 +22,6 @@ double off_quarter_turn(double angle) {
 
 int count_dice_in_cup(const State& s, const WorldConfig& config) {
   const double angle = s[si::kCupAngle];
-  if (std::cos(angle) <= 0.0) return 0;  // mouth down or sideways
   const CupGeometry cup = cup_geometry(config.cup);
   const double on_table = table_height(config.walls) + config.dice.half_size + config.judge.gap_tolerance;
   const Vec2 com{s[si::kCupX], s[si::kCupY]};
@@ -51,12 +51,26 @@ bool is_stacked(const State& s, const WorldConfig& config) {
     const std::size_t d = si::die(order[k]);
     const double expected_y = bottom + side * static_cast<double>(k);
     if (std::abs(s[d + 1] - expected_y) > j.gap_tolerance * static_cast<double>(k + 1)) return false;
-    if (std::abs(s[d] - s[si::die(order[0])]) > j.column_tolerance) return false;
+    if (k > 0 && std::abs(s[d] - s[si::die(order[k - 1])]) > j.column_tolerance) return false;
     if (off_quarter_turn(s[d + 2]) > j.angle_tolerance) return false;
     if (std::hypot(s[d + 3], s[d + 4]) > j.rest_speed) return false;
     if (std::abs(s[d + 5]) > j.rest_angular_speed) return false;
   }
   return true;
+}
+
+Settled settle(const State& state, const WorldConfig& config, int max_steps) {
+  World world(config, state);
+  Settled r;
+  for (r.steps = 0; r.steps < max_steps; ++r.steps) {
+    const State s = world.state();
+    if (is_stacked(s, config)) {
+      r.stacked = true;
+      break;
+    }
+    r.wall_contact = world.step({-s[si::kCupVx], -s[si::kCupVy], -s[si::kCupW]}) || r.wall_contact;
+  }
+  return r;
 }
 
 void observe(Outcome& o, const State& s, bool wall_contact_step, const WorldConfig& config) {

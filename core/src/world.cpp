@@ -459,6 +459,11 @@ std::vector<ShapeOutline> World::outlines() const {
   return out;
 }
 
+bool World::touching_walls() {
+  impl_->scene->world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
+  return impl_->touches_wall();
+}
+
 bool World::has_overlaps(double tolerance) {
   Scene& sc = *impl_->scene;
   sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing

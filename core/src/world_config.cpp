@@ -229,11 +229,11 @@ void validate_relations(const WorldConfig& c, std::string_view source) {
 
 CostConfig WorldConfig::default_cost() {
   CostConfig cost;
-  // Population std per state column over the 68 human recordings (18,081 frames), in SI, with the
-  // cup at its centre of mass: see docs/world.md, "Cost".
-  cost.sigma = {1.2712, 0.7920, 0.4469, 1.2695, 0.6331, 1.8701, 4.8735, 1.0347,
-                2.2378, 1.2145, 0.5318, 1.9616, 4.6458, 0.9868, 2.1715, 1.2344,
-                0.6158, 2.5378, 4.6774, 1.0269, 2.4287, 4.9517, 1.1062, 1.7148};
+  // Population std per state column over the 68 human recordings as imported (18,016 frames,
+  // SI, cup at its centre of mass): see docs/world.md, "Cost and reward".
+  cost.sigma = {1.2734, 0.7895, 0.4477, 1.2717, 0.6337, 1.8692, 4.8822, 1.0365,
+                2.2418, 1.2166, 0.5323, 1.9605, 4.6541, 0.9885, 2.1754, 1.2364,
+                0.6161, 2.5361, 4.6858, 1.0288, 2.4331, 4.9580, 1.1083, 1.7183};
   return cost;
 }
 

@@ -35,7 +35,7 @@ TEST(Judge, ColumnIsStackedAtAnyXOrderAndQuarterTurn) {
   EXPECT_TRUE(is_stacked(column(6.3, {2, 0, 1}), c));
   EXPECT_TRUE(is_stacked(column(3.0, {1, 2, 0}, {1, -2, 7}), c));
   State s = column(4.0);
-  s[si::die(1)] += 0.03;  // slightly offset, within tolerance
+  s[si::die(1)] += 0.09;  // offset like the paper's imitate_2 stack, within tolerance
   s[si::die(2) + 2] += 0.05;
   EXPECT_TRUE(is_stacked(s, c));
 }
@@ -87,8 +87,23 @@ TEST(Judge, DiceInCupCountsOnlyHeldDice) {
   s[si::die(1)] = 5.1;
   s[si::die(1) + 1] = 3.0;
   EXPECT_EQ(count_dice_in_cup(s, c), 2);
-  s[si::kCupAngle] = kPi;  // mouth down: holds nothing
-  EXPECT_EQ(count_dice_in_cup(s, c), 0);
+  // Mouth down, swinging: the dice pressed against the base (now above them) still count.
+  State flipped = s;
+  flipped[si::kCupAngle] = kPi;
+  flipped[si::die(0) + 1] = 3.0 + 2.2 / 3.0 - 0.3;
+  flipped[si::die(1) + 1] = 3.0;
+  flipped[si::die(1)] = 4.9;
+  EXPECT_EQ(count_dice_in_cup(flipped, c), 2);
+  // Dice lying on the table under the mouth-down cup at the start are not held.
+  State start = column(4.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    start[si::die(i)] = 4.1 + 0.4 * static_cast<double>(i);
+    start[si::die(i) + 1] = 1.2;
+  }
+  start[si::kCupX] = 4.5;
+  start[si::kCupY] = 2.5;
+  start[si::kCupAngle] = kPi;
+  EXPECT_EQ(count_dice_in_cup(start, c), 0);
   EXPECT_EQ(count_dice_in_cup(column(4.0), c), 0);
 }
 

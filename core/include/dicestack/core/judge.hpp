@@ -6,8 +6,10 @@
 
 namespace dicestack {
 
-/// Dice whose centre lies inside the cup while the cup's mouth points up (within 90 degrees of
-/// upright) and the die is off the table. A cup held mouth-down over the dice holds none.
+/// Dice whose centre lies inside the cup (between its walls, between base and rim) while the
+/// die is off the table, whatever the cup's angle: the human technique swings the cup
+/// mouth-down and holds the dice against its base by centripetal acceleration. Dice lying on
+/// the table under the cup do not count.
 int count_dice_in_cup(const State& state, const WorldConfig& config);
 
 /// True when the three dice form one vertical column at rest on the table: in any order, at
@@ -26,6 +28,15 @@ struct Outcome {
   /// Stacked without ever touching a wall: the paper's realistic success (III-C).
   bool realistic_success() const { return stacked && !wall_contact; }
 };
+
+/// What happens when a recording ends while a finished stack still wobbles: from `state`, the
+/// cup is held still (its velocity cancelled every step) for up to `max_steps` control steps.
+struct Settled {
+  bool stacked = false;       ///< the dice came to rest stacked
+  bool wall_contact = false;  ///< something touched a side wall or the ceiling meanwhile
+  int steps = 0;              ///< steps simulated
+};
+Settled settle(const State& state, const WorldConfig& config, int max_steps = 60);
 
 /// Updates an Outcome with one more state; `wall_contact_step` is what World::step returned.
 void observe(Outcome& outcome, const State& state, bool wall_contact_step, const WorldConfig& config);

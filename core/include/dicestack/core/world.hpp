@@ -88,6 +88,10 @@ class World {
   /// anything, which a run that continues from here would do in its first step anyway.
   bool has_overlaps(double tolerance = 0.005);
 
+  /// True if the cup or a die is within judge.wall_contact_distance of a side wall or the
+  /// ceiling now. Like has_overlaps, for probe worlds (e.g. judging recorded states).
+  bool touching_walls();
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

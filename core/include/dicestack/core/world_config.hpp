@@ -82,7 +82,7 @@ struct RandomizationConfig {
 
 /// Tolerances of the outcome judge (DESIGN "Outcome judge").
 struct JudgeConfig {
-  double column_tolerance = 0.08;  ///< max |x_i - x_j| between dice of one column, m
+  double column_tolerance = 0.10;  ///< max |x| offset between a die and the one below it, m
   double gap_tolerance = 0.04;     ///< max deviation of centre spacing from one die side, m
   double angle_tolerance = 0.15;   ///< max deviation of a die from a multiple of 90 degrees, rad
   double rest_speed = 0.05;        ///< max die speed at rest, m/s

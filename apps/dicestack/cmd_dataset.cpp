@@ -1,0 +1,140 @@
+// `dicestack import cupdice` and `dicestack dataset info|validate`: getting demonstrations in,
+// and looking at them.
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/cupdice_import.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct ImportOptions {
+  WorldOption world;
+  std::filesystem::path src, out;
+};
+
+struct DatasetOptions {
+  std::filesystem::path dir;
+  bool json = false;
+};
+
+int run_import(const ImportOptions& opt) {
+  const DemoSet set = import_cupdice(opt.src, opt.world.load());
+  write_demo_set(set, opt.out);
+  std::size_t frames = 0, stacked = 0, success = 0;
+  for (const auto& e : set.episodes) {
+    frames += e.size();
+    stacked += e.outcome.stacked;
+    success += e.outcome.realistic_success();
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "imported %zu recordings (%zu frames) into %s: %zu stacked, %zu realistic successes",
+                set.episodes.size(), frames, opt.out.string().c_str(), stacked, success);
+  print_line(line);
+  return 0;
+}
+
+int run_info(const DatasetOptions& opt) {
+  const DemoSet set = read_demo_set(opt.dir);
+  const Dataset all = make_dataset(set.episodes);
+  std::map<std::string, std::size_t> sources;
+  std::size_t stacked = 0, success = 0, walls = 0, in_cup = 0, shortest = SIZE_MAX, longest = 0;
+  for (const auto& e : set.episodes) {
+    stacked += e.outcome.stacked;
+    success += e.outcome.realistic_success();
+    walls += e.outcome.wall_contact;
+    in_cup += static_cast<std::size_t>(e.outcome.dice_in_cup);
+    shortest = std::min(shortest, e.size());
+    longest = std::max(longest, e.size());
+    for (auto s : e.sources) ++sources[std::string(to_string(s))];
+  }
+  const double n = static_cast<double>(set.episodes.size());
+  if (opt.json) {
+    nlohmann::json columns = nlohmann::json::object();
+    const auto names = episode_csv_columns();
+    for (Eigen::Index j = 0; j < all.x.cols(); ++j)
+      columns[names[static_cast<std::size_t>(j) + 1]] = {{"min", all.x.col(j).minCoeff()}, {"max", all.x.col(j).maxCoeff()}};
+    for (Eigen::Index j = 0; j < all.y.cols(); ++j)
+      columns[names[kStateDim + 1 + static_cast<std::size_t>(j)]] = {{"min", all.y.col(j).minCoeff()},
+                                                                     {"max", all.y.col(j).maxCoeff()}};
+    print_line(nlohmann::json{{"episodes", set.episodes.size()},
+                              {"frames", all.rows()},
+                              {"stacked", stacked},
+                              {"realistic_success", success},
+                              {"wall_contact", walls},
+                              {"dice_in_cup_mean", in_cup / n},
+                              {"sources", sources},
+                              {"columns", columns},
+                              {"description", set.description}}
+                   .dump());
+    return 0;
+  }
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%s\n  %s\n  episodes %zu, frames %zu (%zu to %zu per episode, %.1f s to %.1f s)\n"
+                "  outcomes: stacked %zu, realistic success %zu, wall contact %zu, dice in cup (most) mean %.2f",
+                opt.dir.string().c_str(), set.description.c_str(), set.episodes.size(), all.rows(), shortest, longest,
+                shortest * set.world.physics.control_dt, longest * set.world.physics.control_dt, stacked, success, walls,
+                in_cup / n);
+  print_line(line);
+  std::string src = "  sources:";
+  for (const auto& [name, count] : sources) src += " " + name + " " + std::to_string(count);
+  print_line(src);
+  print_line("  column            min          max");
+  const auto names = episode_csv_columns();
+  for (Eigen::Index j = 0; j < all.x.cols() + all.y.cols(); ++j) {
+    const bool is_x = j < all.x.cols();
+    const auto col = is_x ? all.x.col(j) : all.y.col(j - all.x.cols());
+    std::snprintf(line, sizeof line, "  %-12s %12.4f %12.4f", names[static_cast<std::size_t>(j) + 1].c_str(),
+                  col.minCoeff(), col.maxCoeff());
+    print_line(line);
+  }
+  return 0;
+}
+
+int run_validate(const DatasetOptions& opt) {
+  const DemoSet set = read_demo_set(opt.dir);
+  std::size_t frames = 0;
+  for (const auto& e : set.episodes) frames += e.size();
+  print_line(opt.dir.string() + ": valid (" + std::to_string(set.episodes.size()) + " episodes, " +
+             std::to_string(frames) + " frames)");
+  return 0;
+}
+
+}  // namespace
+
+void add_dataset_commands(CLI::App& app) {
+  CLI::App* import = app.add_subcommand("import", "Convert recordings from other tools into dicestack's format");
+  import->require_subcommand(1);
+  auto imp = std::make_shared<ImportOptions>();
+  CLI::App* cupdice = import->add_subcommand("cupdice", "The paper's original recordings (both layouts)");
+  cupdice->add_option("src", imp->src, "Folder of imitate_*.csv files (searched recursively)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cupdice->add_option("--out", imp->out, "Folder to write the demonstration set to (replaced whole)")->required();
+  imp->world.add_to(*cupdice);
+  cupdice->callback([imp] { run_import(*imp); });
+
+  CLI::App* dataset = app.add_subcommand("dataset", "Inspect and check demonstration sets");
+  dataset->require_subcommand(1);
+  auto info = std::make_shared<DatasetOptions>();
+  CLI::App* cmd = dataset->add_subcommand("info", "Summary: episodes, frames, outcomes, per-column ranges");
+  cmd->add_option("dir", info->dir, "Demonstration folder")->required();
+  cmd->add_flag("--json", info->json, "Print one JSON object");
+  cmd->callback([info] { run_info(*info); });
+  auto check = std::make_shared<DatasetOptions>();
+  cmd = dataset->add_subcommand("validate", "Check every file of a set; exit 1 with the first problem");
+  cmd->add_option("dir", check->dir, "Demonstration folder")->required();
+  cmd->callback([check] { run_validate(*check); });
+}
+
+}  // namespace dicestack::cli

@@ -1,0 +1,50 @@
+#pragma once
+// Demonstrations as matrices a regressor can fit: X (N x 24 states), Y (N x 3 actions), with
+// episode boundaries, and the train/test splits of DESIGN.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include <dicestack/datasets/episode.hpp>
+
+namespace dicestack {
+
+/// Row-major so that one row is a contiguous span (predict_row's input).
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Stacked (state, action) pairs of some episodes.
+struct Dataset {
+  Matrix x;                              ///< N x 24
+  Matrix y;                              ///< N x 3
+  std::vector<std::size_t> episode_begin;  ///< first row of each episode, ascending
+  std::vector<std::string> episode_names;
+
+  std::size_t rows() const { return static_cast<std::size_t>(x.rows()); }
+  std::size_t episodes() const { return episode_begin.size(); }
+};
+
+/// Stacks the episodes in the given order. Throws InputError if an episode is malformed.
+Dataset make_dataset(const std::vector<Episode>& episodes);
+
+/// A train/test partition and how it was made (for reports).
+struct Split {
+  Dataset train;
+  Dataset test;
+  std::string description;  ///< e.g. "episodes: i % 5 == 4 is test (14 of 68)"
+};
+
+/// DESIGN's default: episode i (in file-name order) is a test episode when i % 5 == 4.
+/// Throws InputError if that leaves no training episode.
+Split split_by_episode(const std::vector<Episode>& episodes);
+
+/// The paper's Table I protocol: a random `test_fraction` of rows is test, drawn as
+/// scikit-learn's train_test_split(random_state=seed) draws it (numpy's legacy Mersenne
+/// Twister permutation), so neighbouring frames of one episode can sit on both sides.
+Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction = 0.25, std::uint32_t seed = 42);
+
+/// numpy.random.RandomState(seed).permutation(n), reproduced exactly.
+std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t seed);
+
+}  // namespace dicestack

@@ -1,0 +1,46 @@
+#pragma once
+// The on-disk demonstration format: a folder with one CSV per episode (header naming every
+// column: t, the 24 state names, dvx, dvy, dw, source) and a versioned meta.json (format,
+// units, world config, provenance, per-episode outcomes). Opens in any spreadsheet or pandas.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/world_config.hpp>
+#include <dicestack/datasets/episode.hpp>
+
+namespace dicestack {
+
+inline constexpr const char* kDemoFormat = "dicestack-demos";
+inline constexpr int kDemoFormatVersion = 1;
+
+/// A folder of episodes and what meta.json says about them.
+struct DemoSet {
+  WorldConfig world;        ///< the world the episodes were recorded in
+  std::string description;  ///< one line for people
+  std::string provenance;   ///< how the set was made (command, source files, seeds)
+  std::vector<Episode> episodes;  ///< in file-name order
+};
+
+/// The header row of an episode CSV.
+std::vector<std::string> episode_csv_columns();
+
+/// Reads a whole set, checking everything: meta.json's format and version, that its episode
+/// list matches the CSV files exactly, every header, row and value (finite numbers, known
+/// sources, consecutive t). Throws InputError with "path:line:" and the column at fault;
+/// never returns a partial set.
+DemoSet read_demo_set(const std::filesystem::path& dir);
+
+/// Reads one episode CSV (name = the file stem). Throws InputError as read_demo_set does.
+Episode read_episode_csv(const std::filesystem::path& file);
+
+/// Writes a set into `dir` (created, or replaced whole): files go to a temporary folder that
+/// is renamed into place, so a failure never leaves half a set. Throws InputError.
+void write_demo_set(const DemoSet& set, const std::filesystem::path& dir);
+
+/// Appends episodes to the set in `dir` (created if missing) and rewrites its meta.json
+/// atomically; new episodes get the next free names. Returns the names given.
+std::vector<std::string> append_to_demo_set(const std::filesystem::path& dir, std::vector<Episode> episodes,
+                                            const WorldConfig& world, const std::string& description);
+
+}  // namespace dicestack

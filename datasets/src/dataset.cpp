@@ -1,0 +1,97 @@
+#include <dicestack/datasets/dataset.hpp>
+
+#include <cmath>
+#include <random>
+
+#include <dicestack/core/error.hpp>
+
+namespace dicestack {
+namespace {
+
+Dataset stack(const std::vector<const Episode*>& episodes) {
+  std::size_t n = 0;
+  for (const Episode* e : episodes) n += e->size();
+  Dataset d;
+  d.x.resize(static_cast<Eigen::Index>(n), kStateDim);
+  d.y.resize(static_cast<Eigen::Index>(n), kActionDim);
+  Eigen::Index row = 0;
+  for (const Episode* e : episodes) {
+    check_episode(*e);
+    d.episode_begin.push_back(static_cast<std::size_t>(row));
+    d.episode_names.push_back(e->name);
+    for (std::size_t t = 0; t < e->size(); ++t, ++row) {
+      for (std::size_t j = 0; j < kStateDim; ++j) d.x(row, static_cast<Eigen::Index>(j)) = e->states[t][j];
+      for (std::size_t j = 0; j < kActionDim; ++j) d.y(row, static_cast<Eigen::Index>(j)) = e->actions[t][j];
+    }
+  }
+  return d;
+}
+
+Dataset take_rows(const Dataset& all, const std::vector<std::size_t>& rows) {
+  Dataset d;
+  d.x.resize(static_cast<Eigen::Index>(rows.size()), kStateDim);
+  d.y.resize(static_cast<Eigen::Index>(rows.size()), kActionDim);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    d.x.row(static_cast<Eigen::Index>(i)) = all.x.row(static_cast<Eigen::Index>(rows[i]));
+    d.y.row(static_cast<Eigen::Index>(i)) = all.y.row(static_cast<Eigen::Index>(rows[i]));
+  }
+  return d;  // rows from many episodes: no episode boundaries
+}
+
+}  // namespace
+
+Dataset make_dataset(const std::vector<Episode>& episodes) {
+  std::vector<const Episode*> all;
+  for (const auto& e : episodes) all.push_back(&e);
+  return stack(all);
+}
+
+Split split_by_episode(const std::vector<Episode>& episodes) {
+  std::vector<const Episode*> train, test;
+  for (std::size_t i = 0; i < episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(&episodes[i]);
+  if (train.empty()) throw InputError("episode split: no training episode among " + std::to_string(episodes.size()));
+  Split s{stack(train), stack(test),
+          "episodes: i % 5 == 4 is test (" + std::to_string(test.size()) + " of " + std::to_string(episodes.size()) +
+              " episodes)"};
+  return s;
+}
+
+std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t seed) {
+  // RandomState(seed) seeds MT19937 with init_genrand(seed), as std::mt19937(seed) does;
+  // shuffle swaps i with a j drawn by masked rejection from 32-bit outputs, for i = n-1..1.
+  std::mt19937 mt(seed);
+  std::vector<std::size_t> perm(n);
+  for (std::size_t i = 0; i < n; ++i) perm[i] = i;
+  for (std::size_t i = n; i-- > 1;) {
+    std::uint32_t mask = static_cast<std::uint32_t>(i);
+    mask |= mask >> 1;
+    mask |= mask >> 2;
+    mask |= mask >> 4;
+    mask |= mask >> 8;
+    mask |= mask >> 16;
+    std::uint32_t j;
+    do j = static_cast<std::uint32_t>(mt()) & mask;
+    while (j > i);
+    std::swap(perm[i], perm[j]);
+  }
+  return perm;
+}
+
+Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction, std::uint32_t seed) {
+  if (!(test_fraction > 0.0 && test_fraction < 1.0))
+    throw ConfigError("row split: test fraction must be in (0, 1), got " + std::to_string(test_fraction));
+  const Dataset all = make_dataset(episodes);
+  const std::size_t n = all.rows();
+  // scikit-learn: n_test = ceil(fraction * n), test = perm[:n_test], train = perm[n_test:].
+  const auto n_test = static_cast<std::size_t>(std::ceil(test_fraction * static_cast<double>(n)));
+  if (n_test == 0 || n_test >= n) throw InputError("row split: " + std::to_string(n) + " rows are too few to split");
+  const auto perm = numpy_legacy_permutation(n, seed);
+  const std::vector<std::size_t> test(perm.begin(), perm.begin() + static_cast<std::ptrdiff_t>(n_test));
+  const std::vector<std::size_t> train(perm.begin() + static_cast<std::ptrdiff_t>(n_test), perm.end());
+  char text[160];
+  std::snprintf(text, sizeof text, "rows: random %.0f%% of %zu rows is test (numpy permutation, seed %u)",
+                100.0 * test_fraction, n, seed);
+  return {take_rows(all, train), take_rows(all, test), text};
+}
+
+}  // namespace dicestack

@@ -1,0 +1,346 @@
+#include <dicestack/datasets/demo_set.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/version.hpp>
+
+namespace dicestack {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr std::size_t kColumns = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string episode_file_name(std::size_t index) {
+  std::string digits = std::to_string(index);
+  if (digits.size() < 4) digits.insert(0, 4 - digits.size(), '0');
+  return "episode_" + digits + ".csv";
+}
+
+// Splits one CSV line on commas (no quoting: none of our fields contain commas).
+void split_fields(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    out.push_back(line.substr(start, comma == std::string_view::npos ? comma : comma - start));
+    if (comma == std::string_view::npos) return;
+    start = comma + 1;
+  }
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+json outcome_json(const Outcome& o) {
+  return {{"steps", o.steps},
+          {"dice_in_cup", o.dice_in_cup},
+          {"stacked", o.stacked},
+          {"wall_contact", o.wall_contact},
+          {"realistic_success", o.realistic_success()}};
+}
+
+std::string number_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
+  return std::string(buf, r.ptr);
+}
+
+void write_episode_csv(const Episode& e, const fs::path& path) {
+  AtomicFile file(path);
+  auto& out = file.stream();
+  const auto columns = episode_csv_columns();
+  for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
+  out << '\n';
+  for (std::size_t t = 0; t < e.states.size(); ++t) {
+    out << t;
+    for (double v : e.states[t]) out << ',' << number_text(v);
+    for (double v : e.actions[t]) out << ',' << number_text(v);
+    out << ',' << to_string(e.sources[t]) << '\n';
+  }
+  file.commit();
+}
+
+json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
+  json episodes = json::array();
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) {
+    const Episode& e = set.episodes[i];
+    std::set<std::string_view> sources;
+    for (auto s : e.sources) sources.insert(to_string(s));
+    episodes.push_back({{"file", files[i]},
+                        {"seed", e.seed},
+                        {"steps", e.size()},
+                        {"origin", e.origin},
+                        {"sources", std::vector<std::string>(sources.begin(), sources.end())},
+                        {"outcome", outcome_json(e.outcome)}});
+  }
+  return {{"format", kDemoFormat},
+          {"version", kDemoFormatVersion},
+          {"dicestack_version", DICESTACK_VERSION},
+          {"description", set.description},
+          {"provenance", set.provenance},
+          {"units",
+           {{"length", "m"},
+            {"angle", "rad"},
+            {"time", "s"},
+            {"control_dt", set.world.physics.control_dt},
+            {"state", "before the step's action; cup x, y at its centre of mass"},
+            {"action", "velocity change of the cup applied at the start of the step: dvx, dvy (m/s), dw (rad/s)"}}},
+          {"world", json::parse(to_json(set.world))},
+          {"episodes", episodes}};
+}
+
+[[noreturn]] void meta_error(const fs::path& meta, const std::string& what) { throw InputError(meta.string() + ": " + what); }
+
+template <class T>
+T meta_field(const json& j, const char* key, const fs::path& meta, const char* expected) {
+  if (!j.contains(key)) meta_error(meta, std::string("missing \"") + key + "\"");
+  try {
+    return j.at(key).get<T>();
+  } catch (const json::exception&) {
+    meta_error(meta, std::string("\"") + key + "\" must be " + expected + ", got " + j.at(key).dump());
+  }
+}
+
+Outcome outcome_from(const json& j, const fs::path& meta, const std::string& file) {
+  Outcome o;
+  try {
+    o.steps = j.at("steps").get<int>();
+    o.dice_in_cup = j.at("dice_in_cup").get<int>();
+    o.stacked = j.at("stacked").get<bool>();
+    o.wall_contact = j.at("wall_contact").get<bool>();
+  } catch (const json::exception& e) {
+    meta_error(meta, "outcome of " + file + " is malformed: " + e.what());
+  }
+  o.stacked_steps = o.stacked ? 1 : 0;
+  o.dice_in_cup_now = o.dice_in_cup;
+  return o;
+}
+
+// Writes the folder next to its destination, then swaps it in whole.
+void replace_folder(const fs::path& dir, const std::function<void(const fs::path&)>& fill) {
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  const std::string stem = dir.filename().string();
+  std::random_device rd;  // only names a scratch folder; never affects results
+  const fs::path tmp = parent / ("." + stem + ".tmp-" + std::to_string(rd()));
+  const fs::path old = parent / ("." + stem + ".old-" + std::to_string(rd()));
+  fs::create_directory(tmp);
+  try {
+    fill(tmp);
+    if (fs::exists(dir)) fs::rename(dir, old);
+    fs::rename(tmp, dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::remove_all(old, ec);
+}
+
+}  // namespace
+
+std::vector<std::string> episode_csv_columns() {
+  std::vector<std::string> cols{"t"};
+  for (auto n : state_names()) cols.emplace_back(n);
+  for (auto n : action_names()) cols.emplace_back(n);
+  cols.emplace_back("source");
+  return cols;
+}
+
+Episode read_episode_csv(const fs::path& file) {
+  const std::string text = read_file(file);
+  const std::string where = file.string();
+  const auto columns = episode_csv_columns();
+  Episode e;
+  e.name = file.stem().string();
+  std::vector<std::string_view> fields;
+  std::size_t line_no = 0, pos = 0;
+  while (pos < text.size()) {
+    const auto nl = text.find('\n', pos);
+    const std::string_view line(text.data() + pos, (nl == std::string::npos ? text.size() : nl) - pos);
+    pos = nl == std::string::npos ? text.size() : nl + 1;
+    ++line_no;
+    const std::string prefix = where + ":" + std::to_string(line_no) + ": ";
+    if (trim(line).empty()) {
+      if (pos >= text.size()) break;  // trailing blank line
+      throw InputError(prefix + "empty line inside the file");
+    }
+    split_fields(line, fields);
+    if (line_no == 1) {
+      if (fields.size() != kColumns)
+        throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
+                         std::to_string(kColumns) + " (t, 24 state names, dvx, dvy, dw, source)");
+      for (std::size_t c = 0; c < kColumns; ++c)
+        if (trim(fields[c]) != columns[c])
+          throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c])) +
+                           "\", expected \"" + columns[c] + "\"");
+      continue;
+    }
+    if (fields.size() != kColumns)
+      throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
+                       std::to_string(kColumns) + (nl == std::string::npos ? " (truncated last line?)" : ""));
+    std::array<double, kColumns - 1> values{};
+    for (std::size_t c = 0; c + 1 < kColumns; ++c) {
+      const std::string_view f = trim(fields[c]);
+      double v = 0.0;
+      const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+      if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
+        throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f) + "\" is not a number");
+      if (!std::isfinite(v))
+        throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
+                         "; demonstrations must be finite");
+      values[c] = v;
+    }
+    const double expected_t = static_cast<double>(e.states.size());
+    if (values[0] != expected_t)
+      throw InputError(prefix + "column \"t\" is " + number_text(values[0]) + ", expected " + number_text(expected_t) +
+                       " (rows are consecutive steps from 0)");
+    State s;
+    std::copy(values.begin() + 1, values.begin() + 1 + kStateDim, s.begin());
+    Action a;
+    std::copy(values.begin() + 1 + kStateDim, values.end(), a.begin());
+    e.states.push_back(s);
+    e.actions.push_back(a);
+    try {
+      e.sources.push_back(step_source_from(trim(fields[kColumns - 1])));
+    } catch (const InputError& err) {
+      throw InputError(prefix + "column \"source\": " + err.what());
+    }
+  }
+  if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
+  if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");
+  return e;
+}
+
+DemoSet read_demo_set(const fs::path& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder of demonstrations");
+  const fs::path meta_path = dir / "meta.json";
+  if (!fs::exists(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
+  json meta;
+  try {
+    meta = json::parse(read_file(meta_path));
+  } catch (const json::exception& e) {
+    meta_error(meta_path, std::string("not valid JSON: ") + e.what());
+  }
+  if (!meta.is_object()) meta_error(meta_path, "must be a JSON object");
+  const auto format = meta_field<std::string>(meta, "format", meta_path, "a string");
+  if (format != kDemoFormat) meta_error(meta_path, "format \"" + format + "\" is not " + kDemoFormat);
+  const int version = meta_field<int>(meta, "version", meta_path, "an integer");
+  if (version > kDemoFormatVersion)
+    meta_error(meta_path, "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
+                              std::to_string(kDemoFormatVersion) + "); upgrade dicestack");
+  if (version < 1) meta_error(meta_path, "format version " + std::to_string(version) + " is not valid");
+  if (!meta.contains("world")) meta_error(meta_path, "missing \"world\"");
+
+  DemoSet set;
+  set.world = world_config_from_json(meta["world"].dump(), meta_path.string() + " \"world\"");
+  set.description = meta.value("description", "");
+  set.provenance = meta.value("provenance", "");
+  if (!meta.contains("episodes") || !meta["episodes"].is_array()) meta_error(meta_path, "\"episodes\" must be a list");
+
+  std::set<std::string> listed;
+  for (const auto& entry : meta["episodes"]) {
+    const auto file = meta_field<std::string>(entry, "file", meta_path, "a string");
+    if (!listed.insert(file).second) meta_error(meta_path, "lists " + file + " twice");
+    const fs::path path = dir / file;
+    if (!fs::exists(path)) meta_error(meta_path, "lists " + file + ", which does not exist");
+    Episode e = read_episode_csv(path);
+    e.seed = meta_field<std::uint64_t>(entry, "seed", meta_path, "an unsigned integer");
+    e.origin = entry.value("origin", "");
+    const auto steps = meta_field<std::size_t>(entry, "steps", meta_path, "an unsigned integer");
+    if (steps != e.size())
+      meta_error(meta_path, "says " + file + " has " + std::to_string(steps) + " steps; the file has " +
+                                std::to_string(e.size()));
+    if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + file);
+    e.outcome = outcome_from(entry["outcome"], meta_path, file);
+    for (std::size_t t = 0; t < e.size(); ++t)
+      for (std::size_t k = 0; k < kActionDim; ++k)
+        if (std::abs(e.actions[t][k]) > set.world.action.limit[k])
+          throw InputError(path.string() + ":" + std::to_string(t + 2) + ": column \"" +
+                           std::string(action_names()[k]) + "\" = " + number_text(e.actions[t][k]) + " is outside [-" +
+                           number_text(set.world.action.limit[k]) + ", " + number_text(set.world.action.limit[k]) +
+                           "] (the world's action.limit)");
+    set.episodes.push_back(std::move(e));
+  }
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const auto name = entry.path().filename().string();
+    if (entry.path().extension() == ".csv" && !listed.contains(name))
+      throw InputError(entry.path().string() + ": not listed in meta.json");
+  }
+  std::sort(set.episodes.begin(), set.episodes.end(), [](const Episode& a, const Episode& b) { return a.name < b.name; });
+  return set;
+}
+
+void write_demo_set(const DemoSet& set, const fs::path& dir) {
+  validate(set.world);
+  std::vector<std::string> files;
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) {
+    check_episode(set.episodes[i]);
+    files.push_back(episode_file_name(i));
+  }
+  replace_folder(dir, [&](const fs::path& tmp) {
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) write_episode_csv(set.episodes[i], tmp / files[i]);
+    AtomicFile meta(tmp / "meta.json");
+    meta.stream() << meta_json(set, files).dump(2) << '\n';
+    meta.commit();
+  });
+}
+
+std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Episode> episodes,
+                                            const WorldConfig& world, const std::string& description) {
+  DemoSet set;
+  if (fs::exists(dir / "meta.json")) {
+    set = read_demo_set(dir);
+  } else {
+    set.world = world;
+    set.description = description;
+    fs::create_directories(dir);
+  }
+  std::vector<std::string> files, added;
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) files.push_back(set.episodes[i].name + ".csv");
+  std::size_t next = set.episodes.size();
+  for (auto& e : episodes) {
+    check_episode(e);
+    std::string file;
+    do file = episode_file_name(next++);
+    while (fs::exists(dir / file));
+    write_episode_csv(e, dir / file);
+    e.name = fs::path(file).stem().string();
+    added.push_back(e.name);
+    files.push_back(file);
+    set.episodes.push_back(std::move(e));
+  }
+  AtomicFile meta(dir / "meta.json");
+  meta.stream() << meta_json(set, files).dump(2) << '\n';
+  meta.commit();
+  return added;
+}
+
+}  // namespace dicestack

@@ -1,0 +1,35 @@
+#include <dicestack/datasets/episode.hpp>
+
+#include <dicestack/core/error.hpp>
+
+namespace dicestack {
+
+std::string_view to_string(StepSource source) {
+  switch (source) {
+    case StepSource::human: return "human";
+    case StepSource::expert: return "expert";
+    case StepSource::policy: return "policy";
+    case StepSource::correction: return "correction";
+  }
+  return "unknown";
+}
+
+StepSource step_source_from(std::string_view text) {
+  for (auto s : {StepSource::human, StepSource::expert, StepSource::policy, StepSource::correction})
+    if (to_string(s) == text) return s;
+  throw InputError("\"" + std::string(text) + "\" is not one of human, expert, policy, correction");
+}
+
+void check_episode(const Episode& e) {
+  const std::string who = "episode " + (e.name.empty() ? std::string("(unnamed)") : e.name);
+  if (e.states.empty()) throw InputError(who + ": has no steps");
+  if (e.actions.size() != e.states.size() || e.sources.size() != e.states.size())
+    throw InputError(who + ": " + std::to_string(e.states.size()) + " states, " + std::to_string(e.actions.size()) +
+                     " actions and " + std::to_string(e.sources.size()) + " sources; they must be equal");
+  for (std::size_t t = 0; t < e.states.size(); ++t) {
+    require_finite(e.states[t], who + " state " + std::to_string(t));
+    require_finite(e.actions[t], who + " action " + std::to_string(t));
+  }
+}
+
+}  // namespace dicestack

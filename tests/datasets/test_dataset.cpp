@@ -1,0 +1,108 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/datasets/standardizer.hpp>
+
+namespace dicestack {
+namespace {
+
+Episode tiny(const std::string& name, std::size_t n, double offset) {
+  Episode e;
+  e.name = name;
+  for (std::size_t t = 0; t < n; ++t) {
+    State s{};
+    s.fill(offset + static_cast<double>(t));
+    e.states.push_back(s);
+    e.actions.push_back({offset, static_cast<double>(t), -1.0});
+    e.sources.push_back(StepSource::expert);
+  }
+  return e;
+}
+
+std::vector<Episode> episodes(std::size_t count) {
+  std::vector<Episode> out;
+  for (std::size_t i = 0; i < count; ++i) {
+    std::string name(1, 'e');
+    name += std::to_string(i);  // (GCC 12 warns falsely on "e" + to_string)
+    out.push_back(tiny(name, 2 + i % 3, 10.0 * static_cast<double>(i)));
+  }
+  return out;
+}
+
+TEST(Dataset, StacksEpisodesWithBoundaries) {
+  const auto eps = episodes(3);
+  const Dataset d = make_dataset(eps);
+  EXPECT_EQ(d.rows(), 2u + 3u + 4u);
+  EXPECT_EQ(d.x.cols(), 24);
+  EXPECT_EQ(d.y.cols(), 3);
+  EXPECT_EQ(d.episode_begin, (std::vector<std::size_t>{0, 2, 5}));
+  EXPECT_EQ(d.x(5, 0), 20.0);
+  EXPECT_EQ(d.y(6, 1), 1.0);
+}
+
+TEST(Dataset, EpisodeSplitPutsEveryFifthEpisodeInTest) {
+  const auto eps = episodes(10);
+  const Split s = split_by_episode(eps);
+  EXPECT_EQ(s.test.episode_names, (std::vector<std::string>{"e4", "e9"}));
+  EXPECT_EQ(s.train.episodes(), 8u);
+  EXPECT_THAT(s.description, ::testing::HasSubstr("i % 5 == 4"));
+  EXPECT_THROW(split_by_episode({}), InputError);
+}
+
+TEST(Dataset, NumpyPermutationMatchesNumpy) {
+  // numpy.random.RandomState(42).permutation(10)
+  EXPECT_EQ(numpy_legacy_permutation(10, 42), (std::vector<std::size_t>{8, 1, 5, 0, 7, 2, 9, 4, 3, 6}));
+}
+
+TEST(Dataset, RowSplitTakesAQuarterOfRowsDeterministically) {
+  const auto eps = episodes(10);  // 29 rows
+  const Split a = split_by_rows(eps), b = split_by_rows(eps);
+  EXPECT_EQ(a.test.rows(), 8u);  // ceil(0.25 * 29)
+  EXPECT_EQ(a.train.rows(), 21u);
+  EXPECT_EQ(a.test.x, b.test.x);
+  EXPECT_NE(split_by_rows(eps, 0.25, 7).test.x, a.test.x);
+}
+
+TEST(Standardizer, MeanAndPopulationSigmaByHand) {
+  Matrix m(3, 2);
+  m << 1.0, 5.0, 2.0, 5.0, 3.0, 5.0;
+  std::vector<std::string> warnings;
+  const std::vector<std::string> names{"a", "b"};
+  const Standardizer s = Standardizer::fit(m, &warnings, &names);
+  EXPECT_DOUBLE_EQ(s.mean[0], 2.0);
+  EXPECT_DOUBLE_EQ(s.sigma[0], std::sqrt(2.0 / 3.0));  // ddof 0
+  EXPECT_DOUBLE_EQ(s.sigma[1], 1.0);                     // constant column
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_THAT(warnings[0], ::testing::HasSubstr("b is constant"));
+  const Matrix z = s.apply(m);
+  EXPECT_DOUBLE_EQ(z(0, 0), -1.0 / std::sqrt(2.0 / 3.0));
+  EXPECT_DOUBLE_EQ(z(2, 1), 0.0);
+  double back[2];
+  s.invert_row({z.row(2).data(), 2}, back);
+  EXPECT_DOUBLE_EQ(back[0], 3.0);
+  EXPECT_THROW(s.apply(Matrix(2, 3)), InputError);
+  EXPECT_THROW(Standardizer::fit(Matrix(0, 2)), InputError);
+}
+
+TEST(Metrics, ScaledL1ByHand) {
+  Matrix y(3, 2), yhat(3, 2);
+  y << 1, 2, 3, 4, 5, 6;
+  yhat << 1, 3, 1, 4, 5, 2;
+  const std::vector<double> sigma{2.0, 4.0};
+  // Row errors: 0 + 1/4, 2/2 + 0, 0 + 4/4  -> (0.25 + 1 + 1) / 3
+  EXPECT_DOUBLE_EQ(scaled_l1_error(y, yhat, sigma), 2.25 / 3.0);
+  EXPECT_THROW(scaled_l1_error(y, Matrix(2, 2), sigma), InputError);
+  EXPECT_THROW(scaled_l1_error(y, yhat, std::vector<double>{1.0, 0.0}), InputError);
+  const auto cs = column_sigma(y);
+  EXPECT_DOUBLE_EQ(cs[0], std::sqrt(8.0 / 3.0));
+}
+
+}  // namespace
+}  // namespace dicestack
