@@ -18,6 +18,7 @@ packages=(
   libtbb-dev              # threads
   libsdl2-dev             # the interactive player
   libgtest-dev libgmock-dev libbenchmark-dev
+  xvfb xdotool            # the headless test of `dicestack play`
 )
 
 missing=()

@@ -15,6 +15,7 @@ int run(int argc, char** argv) {
   add_bench_command(app);
   add_config_command(app);
   add_dataset_commands(app);
+  add_play_command(app);
   add_rollout_command(app);
   try {
     app.parse(argc, argv);

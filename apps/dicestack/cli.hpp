@@ -12,6 +12,7 @@ int run(int argc, char** argv);
 void add_bench_command(CLI::App& app);
 void add_config_command(CLI::App& app);
 void add_dataset_commands(CLI::App& app);  // import, dataset
+void add_play_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 
 }  // namespace dicestack::cli

@@ -23,7 +23,9 @@ double off_quarter_turn(double angle) {
 int count_dice_in_cup(const State& s, const WorldConfig& config) {
   const double angle = s[si::kCupAngle];
   const CupGeometry cup = cup_geometry(config.cup);
-  const double on_table = table_height(config.walls) + config.dice.half_size + config.judge.gap_tolerance;
+  // Off the table: at least two gap tolerances (8 cm) above a resting die, so the dice falling
+  // the 5 cm of the start do not count.
+  const double on_table = table_height(config.walls) + config.dice.half_size + 2.0 * config.judge.gap_tolerance;
   const Vec2 com{s[si::kCupX], s[si::kCupY]};
   const double h = config.cup.wall_height, w = config.cup.base_width, f = config.cup.flare;
   int count = 0;

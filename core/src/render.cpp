@@ -55,19 +55,31 @@ void draw_text(cv::Mat& img, cv::Point origin, const std::string& text, int row,
 }  // namespace
 
 Image render_state(const State& s, const WorldConfig& config, const Hud& hud, const RenderOptions& options) {
+  Image out;
+  render_state_into(out, s, config, hud, options);
+  return out;
+}
+
+void render_state_into(Image& out, const State& s, const WorldConfig& config, const Hud& hud,
+                       const RenderOptions& options) {
   const auto& w = config.walls;
   const double ppm = options.pixels_per_metre;
   const int width = static_cast<int>(std::lround((w.right_x + w.left_x) * ppm));
   // The original window: a margin of left_x on every side of the walls' centre lines.
   const int height = static_cast<int>(std::lround((w.ceiling_y + w.left_x) * ppm));
-  Canvas c{cv::Mat(height, width, CV_8UC3, kBackground), ppm};
+  out.width = width;
+  out.height = height;
+  out.bgr.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
+  Canvas c{cv::Mat(height, width, CV_8UC3, out.bgr.data()), ppm};
+  c.img.setTo(kBackground);
 
-  const std::array<std::array<Vec2, 2>, 4> walls{{{{{w.left_x, w.floor_y}, {w.right_x, w.floor_y}}},
-                                                  {{{w.left_x, w.floor_y}, {w.left_x, w.ceiling_y}}},
-                                                  {{{w.right_x, w.floor_y}, {w.right_x, w.ceiling_y}}},
-                                                  {{{w.left_x, w.ceiling_y}, {w.right_x, w.ceiling_y}}}}};
-  for (const auto& seg : walls)
-    cv::line(c.img, c.px(seg[0]), c.px(seg[1]), kWall, 2 * c.len(w.radius), cv::LINE_AA, Canvas::kShift);
+  // Walls: axis-aligned bands (the inner faces of the rounded segments), drawn as rectangles.
+  const double r = w.radius;
+  const std::array<std::array<Vec2, 2>, 4> walls{{{{{w.left_x - r, w.floor_y - r}, {w.right_x + r, w.floor_y + r}}},
+                                                  {{{w.left_x - r, w.floor_y - r}, {w.left_x + r, w.ceiling_y + r}}},
+                                                  {{{w.right_x - r, w.floor_y - r}, {w.right_x + r, w.ceiling_y + r}}},
+                                                  {{{w.left_x - r, w.ceiling_y - r}, {w.right_x + r, w.ceiling_y + r}}}}};
+  for (const auto& box : walls) cv::rectangle(c.img, c.px(box[0]), c.px(box[1]), kWall, cv::FILLED, cv::LINE_8, Canvas::kShift);
 
   const CupGeometry cup = cup_geometry(config.cup);
   const Vec2 com{s[si::kCupX], s[si::kCupY]};
@@ -93,11 +105,6 @@ Image render_state(const State& s, const WorldConfig& config, const Hud& hud, co
               o.wall_contact ? cv::Scalar(30, 30, 200) : kInk);
     if (o.realistic_success()) draw_text(c.img, at, "REALISTIC SUCCESS", row++, cv::Scalar(40, 150, 40));
   }
-  Image out;
-  out.width = c.img.cols;
-  out.height = c.img.rows;
-  out.bgr.assign(c.img.data, c.img.data + c.img.total() * c.img.elemSize());
-  return out;
 }
 
 void write_png(const Image& image, const std::filesystem::path& path) {

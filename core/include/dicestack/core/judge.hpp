@@ -7,7 +7,7 @@
 namespace dicestack {
 
 /// Dice whose centre lies inside the cup (between its walls, between base and rim) while the
-/// die is off the table, whatever the cup's angle: the human technique swings the cup
+/// die is off the table (centre 2 x judge.gap_tolerance above a resting die's), whatever the cup's angle: the human technique swings the cup
 /// mouth-down and holds the dice against its base by centripetal acceleration. Dice lying on
 /// the table under the cup do not count.
 int count_dice_in_cup(const State& state, const WorldConfig& config);

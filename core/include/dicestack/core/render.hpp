@@ -34,6 +34,10 @@ struct Hud {
 /// Renders `state` of a world built from `config`.
 Image render_state(const State& state, const WorldConfig& config, const Hud& hud, const RenderOptions& options = {});
 
+/// Same, into `image`, reusing its memory (no allocation once sized): for per-frame drawing.
+void render_state_into(Image& image, const State& state, const WorldConfig& config, const Hud& hud,
+                       const RenderOptions& options = {});
+
 /// Writes a PNG atomically. Throws InputError if it cannot be written.
 void write_png(const Image& image, const std::filesystem::path& path);
 
