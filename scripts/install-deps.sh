@@ -10,6 +10,7 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-ml-dev        # SVR, MLP, random forest
   libxgboost-dev          # gradient-boosted trees
+  xgboost                 # (libxgboost-dev's CMake config checks for its /usr/bin/xgboost)
   libnanoflann-dev        # k-NN
   libpagmo-dev            # differential evolution, basin hopping
   libnlopt-cxx-dev        # L-BFGS

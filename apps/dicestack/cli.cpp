@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/regressors/registry.hpp>
 #include <dicestack/version.hpp>
 
 namespace dicestack::cli {
@@ -12,12 +13,17 @@ int run(int argc, char** argv) {
   CLI::App app{"dicestack: imitation learning for dynamic dice stacking", "dicestack"};
   app.set_version_flag("--version", "dicestack " DICESTACK_VERSION);
   app.require_subcommand(1);
+  app.fallthrough();  // --plugin may follow any subcommand
+  app.add_option("--plugin", "Load a regressor plugin (shared library); repeatable, on any subcommand")
+      ->each([](const std::string& lib) { RegressorRegistry::global().load_plugin(lib); });
   add_bench_command(app);
   add_config_command(app);
   add_dataset_commands(app);
   add_play_command(app);
+  add_regressors_command(app);
   add_rollout_command(app);
   try {
+    RegressorRegistry::global().load_plugins_from_environment();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);

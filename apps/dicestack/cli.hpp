@@ -13,6 +13,8 @@ void add_bench_command(CLI::App& app);
 void add_config_command(CLI::App& app);
 void add_dataset_commands(CLI::App& app);  // import, dataset
 void add_play_command(CLI::App& app);
+void add_regressors_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
+void add_bench_regressors_command(CLI::App& bench);  // under `bench`
 
 }  // namespace dicestack::cli

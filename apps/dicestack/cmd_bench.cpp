@@ -247,6 +247,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--seed", snap->seed, "Seed")->capture_default_str();
   cmd->add_flag("--json", snap->json, "Print one JSON object");
   cmd->callback([snap] { run_snapshot(*snap); });
+
+  add_bench_regressors_command(*bench);
 }
 
 }  // namespace dicestack::cli

@@ -1,0 +1,157 @@
+// `dicestack regressors`: what the registry holds, with every parameter (STYLE 5), and
+// `dicestack bench regressors`: fit time, predict_row latency, throughput and eq. 9 errors.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/regressors/model.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct ListOptions {
+  bool json = false;
+};
+
+int run_list(const ListOptions& opt) {
+  const auto& reg = RegressorRegistry::global();
+  if (opt.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& name : reg.names()) {
+      const auto& i = reg.info(name);
+      nlohmann::json params = nlohmann::json::array();
+      for (const auto& p : i.params)
+        params.push_back({{"name", p.name}, {"type", to_string(p.type)}, {"default", p.default_value}, {"help", p.help}});
+      out.push_back({{"name", name}, {"description", i.description}, {"source", i.source}, {"params", params}});
+    }
+    print_line(out.dump());
+    return 0;
+  }
+  for (const auto& name : reg.names()) {
+    const auto& i = reg.info(name);
+    print_line(name + "  (" + i.source + ")\n    " + i.description);
+    for (const auto& p : i.params) {
+      std::string range;
+      if (p.type == ParamType::choice) {
+        for (const auto& c : p.choices) range += (range.empty() ? "" : "|") + c;
+      } else if (p.type != ParamType::boolean) {
+        std::ostringstream os;
+        os << "[" << p.min << ", " << p.max << "]";
+        range = os.str();
+      }
+      char line[512];
+      std::snprintf(line, sizeof line, "    --set %-14s %-8s default %-8s %-18s %s", (p.name + "=").c_str(),
+                    std::string(to_string(p.type)).c_str(), p.default_value.c_str(), range.c_str(), p.help.c_str());
+      print_line(line);
+    }
+  }
+  return 0;
+}
+
+struct BenchOptions {
+  WorldOption world;
+  std::filesystem::path demos;
+  std::string split = "episodes";
+  std::vector<std::string> regressors;
+  std::vector<std::string> sets;
+  std::uint64_t seed = 1;
+  int calls = 2000;
+  bool json = false;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run_bench(const BenchOptions& opt) {
+  const WorldConfig world = opt.world.load();
+  const auto dir = opt.demos.empty() ? human_demo_set(world) : opt.demos;
+  const DemoSet set = read_demo_set(dir);
+  const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
+  const auto sigma = column_sigma(split.train.y);
+  auto& reg = RegressorRegistry::global();
+  const auto names = opt.regressors.empty() ? reg.names() : opt.regressors;
+  nlohmann::json rows = nlohmann::json::array();
+  if (!opt.json) {
+    print_line("bench regressors: " + dir.string() + ", split " + split.description + "; " +
+               std::to_string(split.train.rows()) + " training rows, " + std::to_string(split.test.rows()) + " test rows");
+    print_line("  regressor        fit s   predict_row us   batch rows/s   train error   test error");
+  }
+  for (const auto& name : names) {
+    auto t0 = std::chrono::steady_clock::now();
+    Model model = Model::train(reg.create(name, opt.sets), split.train.x, split.train.y, opt.seed);
+    const double fit_s = seconds_since(t0);
+    // predict_row: median over batches of 50 calls on test states (a timer read per call
+    // would dominate the fastest regressors).
+    const Matrix probe = model.x_scaler().apply(split.test.rows() > 0 ? split.test.x : split.train.x);
+    std::vector<double> per_call;
+    double out[kActionDim];
+    const auto n = static_cast<std::size_t>(probe.rows());
+    for (int b = 0; b < std::max(1, opt.calls / 50); ++b) {
+      t0 = std::chrono::steady_clock::now();
+      for (int k = 0; k < 50; ++k) {
+        const auto row = static_cast<Eigen::Index>((static_cast<std::size_t>(b) * 50 + static_cast<std::size_t>(k)) % n);
+        model.regressor().predict_row({probe.row(row).data(), kStateDim}, out);
+      }
+      per_call.push_back(seconds_since(t0) / 50.0);
+    }
+    std::sort(per_call.begin(), per_call.end());
+    const double row_us = 1e6 * per_call[per_call.size() / 2];
+    t0 = std::chrono::steady_clock::now();
+    const Matrix train_pred = model.predict(split.train.x);
+    const double batch_rate = static_cast<double>(split.train.rows()) / seconds_since(t0);
+    const double train_error = scaled_l1_error(split.train.y, train_pred, sigma);
+    const double test_error = split.test.rows() ? scaled_l1_error(split.test.y, model.predict(split.test.x), sigma) : 0.0;
+    rows.push_back({{"name", name},
+                    {"fit_s", fit_s},
+                    {"predict_row_us", row_us},
+                    {"batch_rows_per_s", batch_rate},
+                    {"train_error", train_error},
+                    {"test_error", test_error},
+                    {"split", opt.split}});
+    if (!opt.json) {
+      char line[256];
+      std::snprintf(line, sizeof line, "  %-14s %7.2f %16.2f %14.0f %13.3f %12.3f", name.c_str(), fit_s, row_us, batch_rate,
+                    train_error, test_error);
+      print_line(line);
+    }
+  }
+  if (opt.json) print_line(rows.dump());
+  return 0;
+}
+
+}  // namespace
+
+void add_regressors_command(CLI::App& app) {
+  auto list = std::make_shared<ListOptions>();
+  CLI::App* cmd = app.add_subcommand("regressors", "List the registered regressors and their parameters");
+  cmd->add_flag("--json", list->json, "Print JSON");
+  cmd->callback([list] { run_list(*list); });
+}
+
+void add_bench_regressors_command(CLI::App& bench) {
+  auto opt = std::make_shared<BenchOptions>();
+  CLI::App* cmd = bench.add_subcommand("regressors", "Fit time, predict_row latency and eq. 9 errors of each regressor");
+  opt->world.add_to(*cmd);
+  cmd->add_option("--demos", opt->demos, "Demonstration folder (default: the paper's 68 recordings, converted)");
+  cmd->add_option("--split", opt->split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25%)")
+      ->check(CLI::IsMember({"episodes", "rows"}))
+      ->capture_default_str();
+  cmd->add_option("--regressors", opt->regressors, "Only these (comma-separated)")->delimiter(',');
+  cmd->add_option("--set", opt->sets, "key=value parameter for the regressor(s); repeatable");
+  cmd->add_option("--seed", opt->seed, "Training seed")->capture_default_str();
+  cmd->add_option("--calls", opt->calls, "predict_row calls timed")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_flag("--json", opt->json, "Print a JSON list");
+  cmd->callback([opt] { run_bench(*opt); });
+}
+
+}  // namespace dicestack::cli

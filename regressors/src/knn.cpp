@@ -1,0 +1,109 @@
+#include <algorithm>
+#include <cstring>
+#include <variant>
+
+#include <nanoflann.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/regressors/registry.hpp>
+
+#include "payload.hpp"
+
+namespace dicestack {
+namespace {
+
+// nanoflann reads the training rows in place through this adaptor: nothing is copied.
+struct RowsAdaptor {
+  const Matrix* rows;
+  std::size_t kdtree_get_point_count() const { return static_cast<std::size_t>(rows->rows()); }
+  double kdtree_get_pt(std::size_t i, std::size_t d) const {
+    return (*rows)(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(d));
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const { return false; }
+};
+
+// A fixed dimension keeps nanoflann's per-query scratch on the stack (no allocation); 24 is
+// the state size, anything else uses the dynamic-size tree.
+template <class Metric, int Dim>
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<Metric, RowsAdaptor, Dim, std::size_t>;
+template <int Dim>
+using L2Tree = Tree<nanoflann::L2_Simple_Adaptor<double, RowsAdaptor, double, std::size_t>, Dim>;
+template <int Dim>
+using L1Tree = Tree<nanoflann::L1_Adaptor<double, RowsAdaptor, double, std::size_t>, Dim>;
+
+constexpr int kMaxK = 64;
+
+// k nearest neighbours over the standardised states; the prediction is the mean of the k
+// labels (uniform weights, as scikit-learn's KNeighborsRegressor by default).
+class Knn final : public Regressor {
+ public:
+  using Regressor::Regressor;
+
+  static std::vector<ParamSpec> schema() {
+    return {{"k", ParamType::integer, "3", 1, kMaxK, "neighbours averaged (paper VI-E2: 3)", {}},
+            {"metric", ParamType::choice, "l2", 0, 0, "distance on standardised states: l2 (Euclidean) or l1", {"l2", "l1"}},
+            {"leaf_size", ParamType::integer, "10", 1, 10000, "k-d tree leaf size (speed only)", {}}};
+  }
+
+ private:
+  void do_fit(const Matrix& x, const Matrix& y, std::uint64_t) override {
+    x_ = x;
+    y_ = y;
+    build();
+  }
+
+  void build() {
+    adaptor_ = {&x_};
+    const auto leaf = static_cast<std::size_t>(params().integer("leaf_size"));
+    const bool l1 = params().choice("metric") == "l1";
+    const auto dims = static_cast<std::size_t>(x_.cols());
+    const nanoflann::KDTreeSingleIndexAdaptorParams p(leaf);  // the constructors build the tree
+    if (dims == 24) {
+      if (l1) tree_.emplace<std::unique_ptr<L1Tree<24>>>(std::make_unique<L1Tree<24>>(dims, adaptor_, p));
+      else tree_.emplace<std::unique_ptr<L2Tree<24>>>(std::make_unique<L2Tree<24>>(dims, adaptor_, p));
+    } else {
+      if (l1) tree_.emplace<std::unique_ptr<L1Tree<-1>>>(std::make_unique<L1Tree<-1>>(dims, adaptor_, p));
+      else tree_.emplace<std::unique_ptr<L2Tree<-1>>>(std::make_unique<L2Tree<-1>>(dims, adaptor_, p));
+    }
+  }
+
+  void do_predict_row(std::span<const double> x, std::span<double> y) const override {
+    const auto k = std::min<std::size_t>(static_cast<std::size_t>(params().integer("k")), static_cast<std::size_t>(x_.rows()));
+    std::size_t idx[kMaxK];
+    double dist[kMaxK];
+    const std::size_t found = std::visit([&](const auto& t) { return t->knnSearch(x.data(), k, idx, dist); }, tree_);
+    std::fill(y.begin(), y.end(), 0.0);
+    for (std::size_t n = 0; n < found; ++n)
+      for (std::size_t j = 0; j < y.size(); ++j) y[j] += y_(static_cast<Eigen::Index>(idx[n]), static_cast<Eigen::Index>(j));
+    for (double& v : y) v /= static_cast<double>(found);
+  }
+
+  std::string do_save() const override { return payload::write_matrices({&x_, &y_}); }
+
+  void do_load(std::string_view text, std::size_t input_dim, std::size_t output_dim) override {
+    auto m = payload::read_matrices(text, 2, name());
+    if (static_cast<std::size_t>(m[0].cols()) != input_dim || static_cast<std::size_t>(m[1].cols()) != output_dim ||
+        m[0].rows() != m[1].rows() || m[0].rows() == 0)
+      throw InputError(name() + ": payload holds " + std::to_string(m[0].rows()) + " x " + std::to_string(m[0].cols()) +
+                       " inputs and " + std::to_string(m[1].rows()) + " x " + std::to_string(m[1].cols()) +
+                       " labels, not matching the header");
+    x_ = std::move(m[0]);
+    y_ = std::move(m[1]);
+    build();
+  }
+
+  Matrix x_, y_;
+  RowsAdaptor adaptor_{nullptr};
+  std::variant<std::unique_ptr<L2Tree<24>>, std::unique_ptr<L1Tree<24>>, std::unique_ptr<L2Tree<-1>>,
+               std::unique_ptr<L1Tree<-1>>>
+      tree_;
+};
+
+}  // namespace
+
+void register_knn(RegressorRegistry& r) {
+  r.add(regressor_info<Knn>("knn", "k nearest neighbours (nanoflann k-d tree) over standardised states; mean of the k labels"));
+}
+
+}  // namespace dicestack

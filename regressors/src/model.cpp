@@ -1,0 +1,160 @@
+#include <dicestack/regressors/model.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+
+namespace dicestack {
+namespace {
+
+using nlohmann::json;
+
+std::string fnv1a_hex(std::string_view bytes) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ULL;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+json scaler_json(const Standardizer& s) { return {{"mean", s.mean}, {"sigma", s.sigma}}; }
+
+}  // namespace
+
+Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y)
+    : regressor_(std::move(regressor)), x_(std::move(x)), y_(std::move(y)) {
+  if (!regressor_) throw std::logic_error("Model needs a regressor");
+}
+
+Model Model::train(std::unique_ptr<Regressor> regressor, const Matrix& x, const Matrix& y, std::uint64_t seed,
+                   std::vector<std::string>* warnings) {
+  if (x.cols() != static_cast<Eigen::Index>(kStateDim) || y.cols() != static_cast<Eigen::Index>(kActionDim))
+    throw InputError("training data is " + std::to_string(x.cols()) + " -> " + std::to_string(y.cols()) +
+                     " columns; a policy maps 24 state values to 3 action values");
+  std::vector<std::string> names;
+  for (auto n : state_names()) names.emplace_back(n);
+  Standardizer xs = Standardizer::fit(x, warnings, &names);
+  names.clear();
+  for (auto n : action_names()) names.emplace_back(n);
+  Standardizer ys = Standardizer::fit(y, warnings, &names);
+  regressor->fit(xs.apply(x), ys.apply(y), seed);
+  return Model(std::move(regressor), std::move(xs), std::move(ys));
+}
+
+Action Model::act(const State& state) const {
+  std::array<double, kStateDim> z;
+  x_.apply_row(state, z);
+  std::array<double, kActionDim> out;
+  regressor_->predict_row(z, out);
+  Action a;
+  y_.invert_row(out, a);
+  return a;
+}
+
+Matrix Model::predict(const Matrix& states) const {
+  const Matrix z = regressor_->predict(x_.apply(states));
+  Matrix out(z.rows(), z.cols());
+  for (Eigen::Index i = 0; i < z.rows(); ++i)
+    y_.invert_row({z.row(i).data(), static_cast<std::size_t>(z.cols())}, {out.row(i).data(), static_cast<std::size_t>(z.cols())});
+  return out;
+}
+
+void save_model(const Model& model, const std::filesystem::path& path) {
+  const Regressor& r = model.regressor();
+  const std::string payload = r.save_payload();
+  json params = json::object();
+  for (const auto& [k, v] : r.params().as_text()) params[k] = v;
+  const json header{{"format", kModelFormat},
+                    {"version", kModelFormatVersion},
+                    {"dicestack_version", DICESTACK_VERSION},
+                    {"regressor", r.name()},
+                    {"params", params},
+                    {"state_dim", r.input_dim()},
+                    {"action_dim", r.output_dim()},
+                    {"state_names", state_names()},
+                    {"action_names", action_names()},
+                    {"x_standardizer", scaler_json(model.x_scaler())},
+                    {"y_standardizer", scaler_json(model.y_scaler())},
+                    {"record", model.record},
+                    {"payload_bytes", payload.size()},
+                    {"payload_fnv1a", fnv1a_hex(payload)}};
+  AtomicFile file(path);
+  file.stream() << header.dump() << '\n' << payload;
+  file.commit();
+}
+
+Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry) {
+  const std::string where = path.string() + ": ";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(where + "cannot open model file");
+  std::string first;
+  if (!std::getline(in, first) || first.empty()) throw InputError(where + "empty file; not a dicestack model");
+  json h;
+  try {
+    h = json::parse(first);
+  } catch (const json::exception&) {
+    throw InputError(where + "the first line is not a JSON header; not a dicestack model");
+  }
+  try {
+    if (h.value("format", "") != kModelFormat) throw InputError(where + "format is not " + kModelFormat);
+    const int version = h.at("version").get<int>();
+    if (version > kModelFormatVersion)
+      throw InputError(where + "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
+                       std::to_string(kModelFormatVersion) + "); upgrade dicestack");
+    const auto state_dim = h.at("state_dim").get<std::size_t>();
+    const auto action_dim = h.at("action_dim").get<std::size_t>();
+    if (state_dim != kStateDim)
+      throw InputError(where + "trained on " + std::to_string(state_dim) + "-d states, this world produces " +
+                       std::to_string(kStateDim) + "-d");
+    if (action_dim != kActionDim)
+      throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, this world takes " +
+                       std::to_string(kActionDim) + "-d");
+    const std::string name = h.at("regressor").get<std::string>();
+    if (!registry.contains(name))
+      throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
+    std::vector<std::string> sets;
+    for (const auto& [k, v] : h.at("params").items()) sets.push_back(k + "=" + v.get<std::string>());
+    auto regressor = registry.create(name, sets);
+    auto scaler = [&](const char* key, std::size_t dim) {
+      Standardizer s;
+      s.mean = h.at(key).at("mean").get<std::vector<double>>();
+      s.sigma = h.at(key).at("sigma").get<std::vector<double>>();
+      if (s.mean.size() != dim || s.sigma.size() != dim)
+        throw InputError(where + key + " has " + std::to_string(s.mean.size()) + " columns, expected " +
+                         std::to_string(dim));
+      for (double v : s.sigma)
+        if (!(v > 0.0) || !std::isfinite(v)) throw InputError(where + key + " has a sigma that is not positive");
+      return s;
+    };
+    Standardizer xs = scaler("x_standardizer", state_dim), ys = scaler("y_standardizer", action_dim);
+    const auto bytes = h.at("payload_bytes").get<std::size_t>();
+    std::string payload(bytes, '\0');
+    in.read(payload.data(), static_cast<std::streamsize>(bytes));
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (got != bytes)
+      throw InputError(where + "truncated: the payload has " + std::to_string(got) + " of " + std::to_string(bytes) +
+                       " bytes");
+    if (in.peek() != std::char_traits<char>::eof()) throw InputError(where + "has bytes after the payload; corrupted");
+    if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
+      throw InputError(where + "corrupted: the payload's checksum does not match the header");
+    try {
+      regressor->load_payload(payload, state_dim, action_dim);
+    } catch (const Error& e) {
+      throw InputError(where + e.what());
+    }
+    Model model(std::move(regressor), std::move(xs), std::move(ys));
+    if (h.contains("record"))
+      for (const auto& [k, v] : h["record"].items()) model.record[k] = v.is_string() ? v.get<std::string>() : v.dump();
+    return model;
+  } catch (const json::exception& e) {
+    throw InputError(where + "malformed header: " + e.what());
+  }
+}
+
+}  // namespace dicestack

@@ -1,0 +1,82 @@
+#pragma once
+// Shared plumbing for the OpenCV ml regressors: one model per action dimension (OpenCV's SVR
+// and random forest take a single response column), cv::Exception turned into InputError at
+// this edge with the regressor's name, and models saved as OpenCV YAML inside one JSON payload.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/ml.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/regressors/regressor.hpp>
+
+namespace dicestack::opencv {
+
+/// Runs fn, rethrowing OpenCV's errors as InputError("<who>: OpenCV: ...").
+template <class F>
+auto guarded(const std::string& who, F&& fn) {
+  try {
+    return fn();
+  } catch (const cv::Exception& e) {
+    throw InputError(who + ": OpenCV: " + e.err + " (in " + e.func + ")");
+  }
+}
+
+inline cv::Mat to_float(const Matrix& m) {
+  cv::Mat out(static_cast<int>(m.rows()), static_cast<int>(m.cols()), CV_32F);
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out.at<float>(static_cast<int>(i), static_cast<int>(j)) = static_cast<float>(m(i, j));
+  return out;
+}
+
+inline std::string save_yaml(const cv::Ptr<cv::ml::StatModel>& model) {
+  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  model->write(fs);
+  return fs.releaseAndGetString();
+}
+
+/// Payload: {"models": [yaml, ...]}, one per output.
+template <class T>
+std::string save_all(const std::vector<cv::Ptr<T>>& models) {
+  nlohmann::json j;
+  for (const auto& m : models) j["models"].push_back(save_yaml(m));
+  return j.dump();
+}
+
+template <class T>
+std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, const std::string& who) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(payload);
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(who + ": model payload is not the expected JSON");
+  }
+  if (!j.contains("models") || !j["models"].is_array() || j["models"].size() != outputs)
+    throw InputError(who + ": model payload must hold " + std::to_string(outputs) + " models");
+  std::vector<cv::Ptr<T>> models;
+  for (const auto& text : j["models"]) {
+    if (!text.is_string()) throw InputError(who + ": model payload holds a non-text model");
+    models.push_back(guarded(who, [&] {
+      cv::FileStorage fs(text.get<std::string>(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+      cv::Ptr<T> m = T::create();
+      m->read(fs.root());
+      if (!m->isTrained()) throw InputError(who + ": a stored model is empty");
+      return m;
+    }));
+  }
+  return models;
+}
+
+/// predict_row for per-output models: doubles to a stack float row, one predict per model.
+template <class T>
+void predict_each(const std::vector<cv::Ptr<T>>& models, std::span<const double> x, std::span<double> y) {
+  float row[64];
+  for (std::size_t i = 0; i < x.size(); ++i) row[i] = static_cast<float>(x[i]);
+  const cv::Mat sample(1, static_cast<int>(x.size()), CV_32F, row);
+  for (std::size_t j = 0; j < y.size(); ++j) y[j] = models[j]->predict(sample);
+}
+
+}  // namespace dicestack::opencv
