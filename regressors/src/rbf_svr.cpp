@@ -39,15 +39,60 @@ class RbfSvr final : public Regressor {
         return svm;
       }));
     }
+    prepare();
   }
 
-  void do_predict_row(std::span<const double> x, std::span<double> y) const override { opencv::predict_each(models_, x, y); }
+  // OpenCV evaluates the kernel sample by sample; the same float sum over the support vectors
+  // as one vectorised matrix-vector product is faster on the hot path.
+  struct Kernel {
+    Eigen::MatrixXf sv;        // support vectors, one per row
+    Eigen::VectorXf sv_norm2;  // |sv|^2
+    Eigen::VectorXf alpha;
+    float rho = 0.0f;
+    float gamma = 0.0f;
+  };
+
+  void prepare() {
+    kernels_.clear();
+    for (const auto& m : models_) {
+      Kernel k;
+      const cv::Mat sv = m->getSupportVectors();
+      cv::Mat alpha, index;
+      k.rho = static_cast<float>(m->getDecisionFunction(0, alpha, index));
+      k.gamma = static_cast<float>(m->getGamma());
+      k.sv.resize(sv.rows, sv.cols);
+      for (int i = 0; i < sv.rows; ++i)
+        for (int j = 0; j < sv.cols; ++j) k.sv(i, j) = sv.at<float>(i, j);
+      k.alpha.resize(sv.rows);
+      alpha.convertTo(alpha, CV_32F);
+      for (int i = 0; i < sv.rows; ++i) k.alpha[i] = alpha.at<float>(0, index.empty() ? i : index.at<int>(0, i));
+      k.sv_norm2 = k.sv.rowwise().squaredNorm();
+      kernels_.push_back(std::move(k));
+    }
+  }
+
+  void do_predict_row(std::span<const double> x, std::span<double> y) const override {
+    thread_local Eigen::VectorXf scratch;  // grows once per thread, then reused
+    float row[64];
+    for (std::size_t i = 0; i < x.size(); ++i) row[i] = static_cast<float>(x[i]);
+    const Eigen::Map<const Eigen::VectorXf> v(row, static_cast<Eigen::Index>(x.size()));
+    const float norm2 = v.squaredNorm();
+    for (std::size_t j = 0; j < y.size(); ++j) {
+      const Kernel& k = kernels_[j];
+      scratch.resize(k.sv.rows());
+      scratch.noalias() = k.sv * v;
+      scratch = ((2.0f * scratch - k.sv_norm2).array() - norm2).matrix() * k.gamma;
+      y[j] = scratch.array().exp().matrix().dot(k.alpha) - k.rho;
+    }
+  }
   std::string do_save() const override { return opencv::save_all(models_); }
   void do_load(std::string_view payload, std::size_t, std::size_t outputs) override {
     models_ = opencv::load_all<cv::ml::SVM>(payload, outputs, name());
+    prepare();
   }
 
   std::vector<cv::Ptr<cv::ml::SVM>> models_;
+  std::vector<Kernel> kernels_;
 };
 
 }  // namespace
