@@ -13,8 +13,7 @@ cmake --build build -j 2
 case "$mode" in
   run)
     mkdir -p out
-    ./build/apps/dicestack rollout --start paper --seed 1 --png out/rollout.png
-    ./build/apps/dicestack bench sim --episodes 100 --repeats 3
+    ./build/apps/dicestack leaderboard --out out/leaderboard.md
     ;;
   test)
     ctest --test-dir build --output-on-failure -j 2

@@ -19,7 +19,10 @@ int run(int argc, char** argv) {
   add_bench_command(app);
   add_config_command(app);
   add_dataset_commands(app);
+  add_evaluate_command(app);
+  add_leaderboard_command(app);
   add_play_command(app);
+  add_train_command(app);
   add_regressors_command(app);
   add_rollout_command(app);
   try {

@@ -12,7 +12,10 @@ int run(int argc, char** argv);
 void add_bench_command(CLI::App& app);
 void add_config_command(CLI::App& app);
 void add_dataset_commands(CLI::App& app);  // import, dataset
+void add_evaluate_command(CLI::App& app);
+void add_leaderboard_command(CLI::App& app);
 void add_play_command(CLI::App& app);
+void add_train_command(CLI::App& app);
 void add_regressors_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`

@@ -1,6 +1,11 @@
 #include "options.hpp"
 
+#include <cstdio>
 #include <iostream>
+
+#include <unistd.h>
+
+#include <dicestack/datasets/builtin.hpp>
 
 namespace dicestack::cli {
 
@@ -12,5 +17,19 @@ void WorldOption::add_to(CLI::App& app) {
 WorldConfig WorldOption::load() const { return path.empty() ? WorldConfig{} : load_world_config(path); }
 
 void print_line(const std::string& text) { std::cout << text << '\n' << std::flush; }
+
+void print_progress(const std::string& text) {
+  static const bool tty = isatty(fileno(stderr));
+  if (tty) std::cerr << "\r\033[K" << text << std::flush;
+  else std::cerr << text << '\n';
+}
+
+void DemosOption::add_to(CLI::App& app) {
+  app.add_option("--demos", path, "Demonstration folder (default: the built-in set; see docs/datasets.md)");
+}
+
+std::filesystem::path DemosOption::resolve(const WorldConfig& world) const {
+  return path.empty() ? human_demo_set(world) : path;
+}
 
 }  // namespace dicestack::cli

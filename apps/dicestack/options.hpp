@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <dicestack/core/world_config.hpp>
+#include <dicestack/datasets/demo_set.hpp>
 
 namespace dicestack::cli {
 
@@ -19,5 +20,16 @@ struct WorldOption {
 
 /// Prints a JSON object or a human-readable text on stdout.
 void print_line(const std::string& text);
+
+/// Prints progress on stderr (overwriting the line when stderr is a terminal).
+void print_progress(const std::string& text);
+
+/// `--demos DIR`: a demonstration folder; without it, the built-in set.
+struct DemosOption {
+  std::filesystem::path path;
+  void add_to(CLI::App& app);
+  /// The folder to read (the built-in set is prepared on first use).
+  std::filesystem::path resolve(const WorldConfig& world) const;
+};
 
 }  // namespace dicestack::cli

@@ -11,7 +11,8 @@ std::vector<double> column_sigma(const Matrix& labels) {
   const auto n = static_cast<double>(labels.rows());
   for (Eigen::Index j = 0; j < labels.cols(); ++j) {
     const double mean = labels.col(j).sum() / n;
-    sigma.push_back(std::sqrt((labels.col(j).array() - mean).square().sum() / n));
+    const double sd = std::sqrt((labels.col(j).array() - mean).square().sum() / n);
+    sigma.push_back(sd > 0.0 ? sd : 1.0);
   }
   return sigma;
 }

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -23,9 +25,10 @@ struct Process {
   std::string output;  // stdout and stderr
 };
 
-Process run(const std::string& args) {
+// Runs dicestack with `args`; stderr joins stdout unless `keep_stderr` is false.
+Process run(const std::string& args, bool keep_stderr = true) {
   Process r;
-  const std::string cmd = std::string(DICESTACK_EXE) + " " + args + " 2>&1";
+  const std::string cmd = std::string(DICESTACK_EXE) + " " + args + (keep_stderr ? " 2>&1" : " 2>/dev/null");
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
   char buf[4096];
@@ -104,6 +107,72 @@ TEST(Cli, RolloutWritesAPng) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_GT(std::filesystem::file_size(png), 1000u);
   std::filesystem::remove(png);
+}
+
+}  // namespace
+}  // namespace dicestack
+
+namespace dicestack {
+namespace {
+
+const std::string kTinyDemos = std::string(DICESTACK_SOURCE_DIR) + "/tests/datasets/data/good";
+
+TEST(CliLearning, TrainThenEvaluateEndToEnd) {
+  const auto model = std::filesystem::temp_directory_path() / "dicestack_cli_knn.dsm";
+  const Process t = run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + model.string());
+  ASSERT_EQ(t.status, 0) << t.output;
+  const Process e = run("evaluate --model " + model.string() + " --episodes 3 --seed 2 --json --demos " + kTinyDemos);
+  ASSERT_EQ(e.status, 0) << e.output;
+  const auto j = nlohmann::json::parse(e.output);
+  // (The two-episode set has no test episode, so no test_error.)
+  for (const char* key : {"train_error", "episodes", "dice_in_cup_mean", "stacked_rate", "wall_contact_rate",
+                          "realistic_success_rate", "us_per_step"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["episodes"], 3);
+  std::filesystem::remove(model);
+}
+
+TEST(CliLearning, BadArgumentsGiveAClearMessage) {
+  Process p = run("train --demos " + kTinyDemos + " --regressor rbf-svr --out /tmp/x.dsm");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("unknown regressor \"rbf-svr\"; registered:"));
+  p = run("evaluate --model /nonexistent.dsm");
+  EXPECT_NE(p.status, 0);
+  p = run("leaderboard --demos /nonexistent-demos --regressors knn");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("not a folder of demonstrations"));
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners nope");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("unknown learner \"nope\""));
+}
+
+TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
+  const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn,linear_svr --episodes 2 --seed 4 ";
+  const Process a = run(args + "--format json", false), b = run(args + "--format json", false);
+  ASSERT_EQ(a.status, 0) << a.output;
+  const auto ja = nlohmann::json::parse(a.output), jb = nlohmann::json::parse(b.output);
+  ASSERT_EQ(ja["rows"].size(), 3u);  // two regressors under bc, and playback
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(ja["rows"][i]["train_error"], jb["rows"][i]["train_error"]);
+    EXPECT_EQ(ja["rows"][i]["wall_contact"], jb["rows"][i]["wall_contact"]);
+    EXPECT_EQ(ja["rows"][i]["dice_in_cup_mean"], jb["rows"][i]["dice_in_cup_mean"]);
+  }
+  const Process csv = run(args + "--format csv", false);
+  std::istringstream lines(csv.output);
+  std::string line;
+  std::size_t header_fields = 0, n = 0;
+  while (std::getline(lines, line)) {
+    const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+    if (n++ == 0) header_fields = fields;
+    EXPECT_EQ(fields, header_fields) << line;
+  }
+  EXPECT_EQ(n, 4u);
+  const Process md = run(args + "--format md", false);
+  EXPECT_THAT(md.output, HasSubstr("| knn | bc |"));
+  EXPECT_THAT(md.output, HasSubstr("split episodes: i % 5 == 4 is test"));
+  const Process tex = run(args + "--format latex", false);
+  EXPECT_THAT(tex.output, HasSubstr("\\begin{tabular}"));
+  EXPECT_THAT(tex.output, HasSubstr("\\end{tabular}"));
 }
 
 }  // namespace

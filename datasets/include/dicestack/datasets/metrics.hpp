@@ -7,7 +7,8 @@
 
 namespace dicestack {
 
-/// Population standard deviation (ddof 0) of each column of `labels`.
+/// Population standard deviation (ddof 0) of each column of `labels`; a constant column gets
+/// 1, as in the standardiser, so that eq. 9 stays defined.
 std::vector<double> column_sigma(const Matrix& labels);
 
 /// Mean over rows of sum_j |y_ij - yhat_ij| / sigma_j (paper eq. 9), sigma from the training

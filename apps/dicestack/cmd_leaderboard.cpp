@@ -1,0 +1,294 @@
+// `dicestack leaderboard`: the paper's Table I regenerated: every regressor under every
+// learner, with train and test error (eq. 9), rollout outcomes with 95% intervals, fit time and
+// time per step. Interrupted runs resume from <out>.partial.json.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/version.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+using nlohmann::json;
+
+struct LeaderboardOptions {
+  WorldOption world;
+  DemosOption demos;
+  std::vector<std::string> regressors, learners;
+  std::string profile = "quick", format = "md", split = "episodes";
+  int episodes = 0, seeds = 1, threads = 0;
+  std::uint64_t seed = 0;
+  std::filesystem::path out;
+};
+
+struct Row {
+  std::string regressor, learner;
+  double train_error = 0, test_error = 0, fit_s = 0, us_per_step = 0, dice_in_cup = 0;
+  int episodes = 0, stacked = 0, walls = 0, success = 0;
+};
+
+json row_json(const Row& r) {
+  const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
+  return {{"regressor", r.regressor},     {"learner", r.learner},          {"train_error", r.train_error},
+          {"test_error", r.test_error},   {"dice_in_cup_mean", r.dice_in_cup}, {"episodes", r.episodes},
+          {"stacked", r.stacked},         {"wall_contact", r.walls},       {"realistic_success", r.success},
+          {"stacked_rate", st.value},     {"stacked_ci95", {st.low, st.high}},
+          {"wall_contact_rate", wc.value}, {"wall_contact_ci95", {wc.low, wc.high}},
+          {"realistic_success_rate", rs.value}, {"realistic_success_ci95", {rs.low, rs.high}},
+          {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
+}
+
+Row row_from(const json& j) {
+  Row r;
+  r.regressor = j.at("regressor");
+  r.learner = j.at("learner");
+  r.train_error = j.at("train_error");
+  r.test_error = j.at("test_error");
+  r.dice_in_cup = j.at("dice_in_cup_mean");
+  r.episodes = j.at("episodes");
+  r.stacked = j.at("stacked");
+  r.walls = j.at("wall_contact");
+  r.success = j.at("realistic_success");
+  r.fit_s = j.at("fit_s");
+  r.us_per_step = j.at("us_per_step");
+  return r;
+}
+
+std::string pct(int k, int n) {
+  const Rate r = wilson(k, n);
+  char s[64];
+  std::snprintf(s, sizeof s, "%.0f%% [%.0f-%.0f]", 100 * r.value, 100 * r.low, 100 * r.high);
+  return s;
+}
+
+std::string fixed(double v, int digits) {
+  if (v < 0) return "-";
+  char s[32];
+  std::snprintf(s, sizeof s, "%.*f", digits, v);
+  return s;
+}
+
+std::string render(const std::vector<Row>& rows, const std::string& format, const std::string& header, const json& meta) {
+  std::ostringstream os;
+  const std::vector<std::string> cols{"regressor", "learner", "train error", "test error", "dice in cup",
+                                      "stacked", "wall contact", "realistic success", "fit s", "us/step"};
+  auto cells = [](const Row& r) {
+    return std::vector<std::string>{r.regressor, r.learner, fixed(r.train_error, 3), fixed(r.test_error, 3),
+                                    fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
+                                    pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
+  };
+  if (format == "json") {
+    json j = meta;
+    j["rows"] = json::array();
+    for (const auto& r : rows) j["rows"].push_back(row_json(r));
+    os << j.dump(2) << '\n';
+  } else if (format == "csv") {
+    os << "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
+          "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step\n";
+    for (const auto& r : rows) {
+      const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
+      os << r.regressor << ',' << r.learner << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
+         << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
+         << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
+    }
+  } else if (format == "latex") {
+    os << "% " << header << "\n\\begin{tabular}{llrrrrrrrr}\n\\hline\n";
+    for (std::size_t c = 0; c < cols.size(); ++c) os << cols[c] << (c + 1 < cols.size() ? " & " : " \\\\\n\\hline\n");
+    for (const auto& r : rows) {
+      const auto v = cells(r);
+      for (std::size_t c = 0; c < v.size(); ++c) {
+        std::string cell = v[c];
+        for (std::size_t p = 0; (p = cell.find_first_of("%_", p)) != std::string::npos; p += 2) cell.insert(p, "\\");
+        os << cell << (c + 1 < v.size() ? " & " : " \\\\\n");
+      }
+    }
+    os << "\\hline\n\\end{tabular}\n";
+  } else {
+    os << header << "\n\n|";
+    for (const auto& c : cols) os << ' ' << c << " |";
+    os << "\n|";
+    for (std::size_t c = 0; c < cols.size(); ++c) os << (c < 2 ? "---|" : "---:|");
+    os << '\n';
+    for (const auto& r : rows) {
+      os << '|';
+      for (const auto& v : cells(r)) os << ' ' << v << " |";
+      os << '\n';
+    }
+  }
+  return os.str();
+}
+
+int run_leaderboard(const LeaderboardOptions& opt) {
+  const WorldConfig world = opt.world.load();
+  const bool paper = opt.profile == "paper";
+  const int episodes = opt.episodes > 0 ? opt.episodes : (paper ? 100 : 20);
+  const auto dir = opt.demos.resolve(world);
+  const DemoSet set = read_demo_set(dir);
+  const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
+  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc"} : opt.learners;
+  for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
+  for (const auto& l : learners) LearnerRegistry::global().info(l);
+
+  std::vector<Episode> train, test;
+  if (opt.split == "rows") {
+    train = set.episodes;  // learners see whole episodes; errors use the row split below
+  } else {
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(set.episodes[i]);
+  }
+  const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
+  if (opt.split == "rows") {
+    // The paper's protocol fits on the training rows only.
+    train.clear();
+  }
+  const auto sigma = column_sigma(split.train.y);
+
+  std::size_t frames = 0;
+  for (const auto& e : set.episodes) frames += e.size();
+  std::ostringstream header;
+  header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << dir.string() << " (" << set.episodes.size()
+         << " episodes, " << frames << " frames); split " << split.description << "; profile " << opt.profile << "; "
+         << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
+         << " training seed(s); rates with 95% Wilson intervals";
+  const json meta{{"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
+                  {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
+                  {"training_seeds", opt.seeds}, {"seed", opt.seed}};
+
+  // Resume: rows already measured with the same settings are read back.
+  const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
+  json done = json::object();
+  if (!partial.empty() && std::filesystem::exists(partial)) {
+    try {
+      json p = json::parse(std::ifstream(partial));
+      if (p.value("meta", json()) == meta) done = p.value("rows", json::object());
+    } catch (const json::exception&) {
+    }
+  }
+
+  std::vector<Row> rows;
+  const std::size_t total = learners.size() * regressors.size();
+  std::size_t index = 0;
+  for (const auto& learner_name : learners) {
+    for (const auto& name : regressors) {
+      ++index;
+      const std::string key = learner_name + "/" + name;
+      if (done.contains(key)) {
+        rows.push_back(row_from(done[key]));
+        continue;
+      }
+      Row row{name, learner_name};
+      for (int s = 0; s < opt.seeds; ++s) {
+        const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(s);
+        print_progress("[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name +
+                       ": training (seed " + std::to_string(seed) + ")");
+        LearnContext c;
+        c.world = world;
+        c.regressor = name;
+        c.seed = seed;
+        c.threads = opt.threads;
+        if (opt.split == "rows") {
+          // Fit on the row split's training rows directly (one pseudo-episode).
+          Episode all;
+          all.name = "train-rows";
+          for (Eigen::Index i = 0; i < split.train.x.rows(); ++i) {
+            State st;
+            Action a;
+            for (std::size_t j = 0; j < kStateDim; ++j) st[j] = split.train.x(i, static_cast<Eigen::Index>(j));
+            for (std::size_t j = 0; j < kActionDim; ++j) a[j] = split.train.y(i, static_cast<Eigen::Index>(j));
+            all.states.push_back(st);
+            all.actions.push_back(a);
+            all.sources.push_back(StepSource::human);
+          }
+          c.demos = {all};
+        } else {
+          c.demos = train;
+        }
+        const auto t0 = std::chrono::steady_clock::now();
+        const LearnResult learned = LearnerRegistry::global().create(learner_name)->learn(c);
+        row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
+        row.train_error += scaled_l1_error(split.train.y, learned.model->predict(split.train.x), sigma) / opt.seeds;
+        row.test_error += split.test.rows() ? scaled_l1_error(split.test.y, learned.model->predict(split.test.x), sigma) / opt.seeds : 0.0;
+        print_progress("[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name +
+                       ": " + std::to_string(episodes) + " rollouts");
+        std::shared_ptr<const Model> model = learned.model;
+        const EvalStats st = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed,
+                                      opt.threads);
+        row.episodes += st.episodes;
+        row.stacked += static_cast<int>(std::lround(st.stacked.value * st.episodes));
+        row.walls += static_cast<int>(std::lround(st.wall_contact.value * st.episodes));
+        row.success += static_cast<int>(std::lround(st.realistic_success.value * st.episodes));
+        row.dice_in_cup += st.dice_in_cup_mean / opt.seeds;
+        row.us_per_step += st.policy_us_per_step / opt.seeds;
+      }
+      rows.push_back(row);
+      if (!partial.empty()) {
+        done[key] = row_json(row);
+        AtomicFile f(partial);
+        f.stream() << json{{"meta", meta}, {"rows", done}}.dump();
+        f.commit();
+      }
+    }
+  }
+  // Playback of the demonstrations themselves (paper VI-A), for reference.
+  print_progress("playback of the demonstrations");
+  const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads);
+  Row playback{"(demonstrations)", "playback"};
+  playback.train_error = playback.test_error = -1;
+  playback.episodes = pb.episodes;
+  playback.stacked = static_cast<int>(std::lround(pb.stacked.value * pb.episodes));
+  playback.walls = static_cast<int>(std::lround(pb.wall_contact.value * pb.episodes));
+  playback.success = static_cast<int>(std::lround(pb.realistic_success.value * pb.episodes));
+  playback.dice_in_cup = pb.dice_in_cup_mean;
+  rows.push_back(playback);
+  print_progress("");
+
+  const std::string table = render(rows, opt.format, header.str(), meta);
+  if (opt.out.empty()) {
+    std::cout << table << std::flush;
+  } else {
+    AtomicFile f(opt.out);
+    f.stream() << table;
+    f.commit();
+    std::filesystem::remove(partial);
+    std::cout << table << "wrote " << opt.out.string() << '\n' << std::flush;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_leaderboard_command(CLI::App& app) {
+  auto opt = std::make_shared<LeaderboardOptions>();
+  CLI::App* cmd = app.add_subcommand("leaderboard", "Train every regressor under every learner and print Table I");
+  opt->world.add_to(*cmd);
+  opt->demos.add_to(*cmd);
+  cmd->add_option("--regressors", opt->regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
+  cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc)")->delimiter(',');
+  cmd->add_option("--episodes", opt->episodes, "Rollouts per row and training seed (default: 20 quick, 100 paper)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--seeds", opt->seeds, "Training seeds per row")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "First seed")->capture_default_str();
+  cmd->add_option("--profile", opt->profile, "quick or paper")->check(CLI::IsMember({"quick", "paper"}))->capture_default_str();
+  cmd->add_option("--split", opt->split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25% of rows)")
+      ->check(CLI::IsMember({"episodes", "rows"}))
+      ->capture_default_str();
+  cmd->add_option("--format", opt->format, "md, csv, latex or json")->check(CLI::IsMember({"md", "csv", "latex", "json"}))->capture_default_str();
+  cmd->add_option("--out", opt->out, "Also write the table to this file (atomically)");
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->callback([opt] { run_leaderboard(*opt); });
+}
+
+}  // namespace dicestack::cli

@@ -1,0 +1,103 @@
+// `dicestack train`: a learner turns demonstrations and a regressor into a model file.
+#include <chrono>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/learner.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct TrainOptions {
+  WorldOption world;
+  DemosOption demos;
+  std::string regressor, learner = "bc", split = "episodes";
+  std::vector<std::string> sets, options;
+  std::filesystem::path out;
+  std::uint64_t seed = 0;
+  int threads = 0;
+  bool json = false;
+};
+
+int run_train(const TrainOptions& opt) {
+  const WorldConfig world = opt.world.load();
+  const auto dir = opt.demos.resolve(world);
+  const DemoSet set = read_demo_set(dir);
+  const auto learner = LearnerRegistry::global().create(opt.learner, opt.options);
+  RegressorRegistry::global().info(opt.regressor);  // unknown names fail before any work
+  std::vector<Episode> train = set.episodes, test;
+  if (opt.split == "episodes") {
+    train.clear();
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(set.episodes[i]);
+  }
+  LearnContext c;
+  c.demos = train;
+  c.world = world;
+  c.regressor = opt.regressor;
+  c.regressor_sets = opt.sets;
+  c.seed = opt.seed;
+  c.threads = opt.threads;
+  c.progress = [&](const Progress& p) {
+    print_progress(opt.learner + " " + opt.regressor + ": " + p.phase + " " + std::to_string(p.iteration) + "/" +
+                   std::to_string(p.iterations) + " (" + std::to_string(p.done) + "/" + std::to_string(p.total) + ")");
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  LearnResult r = learner->learn(c);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.model->record["learner"] = opt.learner;
+  r.model->record["learner_options"] = learner->params().summary();
+  r.model->record["demos"] = dir.string();
+  r.model->record["split"] = opt.split;
+  save_model(*r.model, opt.out);
+  const Dataset train_d = make_dataset(train);
+  const auto sigma = column_sigma(train_d.y);
+  const double train_error = scaled_l1_error(train_d.y, r.model->predict(train_d.x), sigma);
+  double test_error = -1.0;
+  if (!test.empty()) {
+    const Dataset test_d = make_dataset(test);
+    test_error = scaled_l1_error(test_d.y, r.model->predict(test_d.x), sigma);
+  }
+  if (opt.json) {
+    nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
+                     {"seconds", seconds},        {"train_error", train_error}};
+    if (test_error >= 0) j["test_error"] = test_error;
+    print_line(j.dump());
+  } else {
+    char line[256];
+    std::snprintf(line, sizeof line, "trained %s with %s in %.2f s: train error %.3f%s -> %s", opt.regressor.c_str(),
+                  opt.learner.c_str(), seconds, train_error,
+                  test_error >= 0 ? (", test error " + std::to_string(test_error).substr(0, 5)).c_str() : "",
+                  opt.out.string().c_str());
+    print_line(line);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_train_command(CLI::App& app) {
+  auto opt = std::make_shared<TrainOptions>();
+  CLI::App* cmd = app.add_subcommand("train", "Train a policy: a learner fits a regressor to demonstrations");
+  opt->world.add_to(*cmd);
+  opt->demos.add_to(*cmd);
+  cmd->add_option("--regressor", opt->regressor, "Regressor name (see `dicestack regressors`)")->required();
+  cmd->add_option("--set", opt->sets, "key=value parameter of the regressor; repeatable");
+  cmd->add_option("--learner", opt->learner, "Learner: bc (more with `dicestack learners`)")->capture_default_str();
+  cmd->add_option("--option", opt->options, "key=value option of the learner; repeatable");
+  cmd->add_option("--split", opt->split, "episodes: train on episodes i % 5 != 4 and report test error; none: all")
+      ->check(CLI::IsMember({"episodes", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--out", opt->out, "Model file to write")->required();
+  cmd->add_option("--seed", opt->seed, "Seed of every random choice")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] { run_train(*opt); });
+}
+
+}  // namespace dicestack::cli

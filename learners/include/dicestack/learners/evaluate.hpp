@@ -1,0 +1,56 @@
+#pragma once
+// Rolling policies out and measuring what they achieve (DESIGN "evaluate", issue 7).
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include <dicestack/core/env.hpp>
+#include <dicestack/datasets/episode.hpp>
+#include <dicestack/learners/policy.hpp>
+
+namespace dicestack {
+
+/// The paper's jump-start (VI-B): an extra push of the cup at the first step.
+enum class InitialPush { none, left, right };
+
+/// Parses "none", "left" or "right"; throws ConfigError otherwise.
+InitialPush initial_push_from(std::string_view text);
+
+/// Runs `policy` from `start` until termination or the time limit and records the episode
+/// (states before each action, the actions as applied, the outcome). `source` tags each step.
+Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
+                InitialPush push = InitialPush::none);
+
+/// A proportion with its 95% Wilson score interval.
+struct Rate {
+  double value = 0.0;
+  double low = 0.0;
+  double high = 0.0;
+};
+Rate wilson(int successes, int trials);
+
+/// What N rollouts achieved.
+struct EvalStats {
+  int episodes = 0;
+  double dice_in_cup_mean = 0.0;  ///< mean over episodes of the most dice held at once
+  Rate dice_in_cup_3;             ///< episodes that held all three dice at some point
+  Rate stacked;
+  Rate wall_contact;
+  Rate realistic_success;
+  double mean_length = 0.0;       ///< control steps per episode
+  double policy_us_per_step = 0.0;  ///< time inside the policy per control step
+  double seconds = 0.0;           ///< wall time of the whole evaluation
+};
+
+/// Makes one policy per worker thread (policies may keep per-episode state).
+using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
+
+/// Rolls a policy out from `episodes` random starts (seeds derived from `seed`), in parallel
+/// on `threads` threads with one world each; the result does not depend on the thread count.
+EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
+                   int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr);
+
+/// Replays every demonstration's actions from its own first state (paper VI-A).
+EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads);
+
+}  // namespace dicestack

@@ -1,0 +1,95 @@
+#pragma once
+// The Learner interface and its registry: a learner turns demonstrations and a regressor into
+// a trained Model. Learners are created by name with "key=value" options, like regressors.
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/world_config.hpp>
+#include <dicestack/datasets/episode.hpp>
+#include <dicestack/regressors/model.hpp>
+
+namespace dicestack {
+
+/// Where a learner stands, for progress bars.
+struct Progress {
+  std::string phase;    ///< e.g. "fit", "rollouts", "corrections"
+  int iteration = 0;    ///< 1-based, of `iterations`
+  int iterations = 0;
+  int done = 0;         ///< work items finished in this phase
+  int total = 0;
+};
+
+/// One point of a learning curve.
+struct CurvePoint {
+  int iteration = 0;
+  std::size_t dataset_rows = 0;
+  double deviation = 0.0;  ///< mean scaled distance of policy rollouts from the demonstrations
+  double stacked_rate = 0.0;
+  double realistic_success_rate = 0.0;
+  double dice_in_cup_mean = 0.0;
+};
+
+/// Everything a learner needs.
+struct LearnContext {
+  std::vector<Episode> demos;  ///< training demonstrations
+  WorldConfig world;
+  std::string regressor = "knn";
+  std::vector<std::string> regressor_sets;  ///< "key=value" for the regressor
+  std::uint64_t seed = 0;
+  int threads = 0;                           ///< 0 = all cores
+  const RegressorRegistry* registry = &RegressorRegistry::global();
+  std::function<void(const Progress&)> progress;  ///< may be empty
+  std::filesystem::path checkpoint_dir;      ///< empty: no checkpoints
+  bool resume = false;                       ///< continue from checkpoint_dir's last iteration
+};
+
+struct LearnResult {
+  std::shared_ptr<Model> model;
+  std::vector<CurvePoint> curve;  ///< one point per iteration (empty for one-shot learners)
+};
+
+class Learner {
+ public:
+  Learner(std::string name, Params params) : name_(std::move(name)), params_(std::move(params)) {}
+  virtual ~Learner() = default;
+  const std::string& name() const { return name_; }
+  const Params& params() const { return params_; }
+  /// Throws InputError if there are no demonstrations, ConfigError for a bad regressor.
+  virtual LearnResult learn(const LearnContext& context) const = 0;
+
+ private:
+  std::string name_;
+  Params params_;
+};
+
+struct LearnerInfo {
+  std::string name;
+  std::string description;
+  std::vector<ParamSpec> params;
+  std::function<std::unique_ptr<Learner>(std::string, Params)> factory;
+};
+
+/// Learners by name ("bc", "dagger", "dad"); built-ins registered on first use.
+class LearnerRegistry {
+ public:
+  static LearnerRegistry& global();
+  /// Throws ConfigError if the name is taken.
+  void add(LearnerInfo info);
+  /// Throws ConfigError for an unknown name (listing the registered ones) or bad options.
+  std::unique_ptr<Learner> create(std::string_view name, const std::vector<std::string>& assignments = {}) const;
+  const LearnerInfo& info(std::string_view name) const;
+  std::vector<std::string> names() const;
+
+ private:
+  std::map<std::string, LearnerInfo, std::less<>> entries_;
+};
+
+/// Fits `context.regressor` on every (state, action) pair of `context.demos` (the training
+/// half of the learner's data): behaviour cloning's one step.
+std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed);
+
+}  // namespace dicestack

@@ -1,0 +1,143 @@
+#include <dicestack/learners/evaluate.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/parallel.hpp>
+
+namespace dicestack {
+
+InitialPush initial_push_from(std::string_view text) {
+  if (text == "none") return InitialPush::none;
+  if (text == "left") return InitialPush::left;
+  if (text == "right") return InitialPush::right;
+  throw ConfigError("initial push \"" + std::string(text) + "\" is not one of none, left, right");
+}
+
+Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
+                InitialPush push) {
+  Episode e;
+  e.seed = seed;
+  e.origin = policy.name();
+  State s = env.reset_to(start, seed);
+  policy.reset(seed);
+  while (true) {
+    Action a = policy.act(s);
+    if (e.states.empty() && push != InitialPush::none) a[0] += push == InitialPush::left ? -1.0 : 1.0;
+    for (std::size_t k = 0; k < kActionDim; ++k)  // record what the world applies
+      a[k] = std::clamp(a[k], -env.config().action.limit[k], env.config().action.limit[k]);
+    e.states.push_back(s);
+    e.actions.push_back(a);
+    e.sources.push_back(source);
+    const StepResult r = env.step(a);
+    s = r.observation;
+    if (r.terminated || r.truncated) break;
+  }
+  e.outcome = env.outcome();
+  return e;
+}
+
+Rate wilson(int successes, int trials) {
+  if (trials <= 0) return {};
+  const double z = 1.96, n = trials, p = successes / n;
+  const double denom = 1.0 + z * z / n;
+  const double centre = (p + z * z / (2.0 * n)) / denom;
+  const double half = z * std::sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / denom;
+  return {p, std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+namespace {
+
+// A policy that measures how long its inner policy takes.
+class TimedPolicy final : public Policy {
+ public:
+  TimedPolicy(Policy& inner, double& seconds) : inner_(inner), seconds_(seconds) {}
+  void reset(std::uint64_t seed) override { inner_.reset(seed); }
+  Action act(const State& s) override {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Action a = inner_.act(s);
+    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return a;
+  }
+  std::string name() const override { return inner_.name(); }
+
+ private:
+  Policy& inner_;
+  double& seconds_;
+};
+
+EvalStats summarise(const std::vector<Episode>& eps, double policy_seconds, double wall) {
+  EvalStats s;
+  s.episodes = static_cast<int>(eps.size());
+  int in3 = 0, stacked = 0, walls = 0, success = 0;
+  double cup = 0.0, steps = 0.0;
+  for (const auto& e : eps) {
+    cup += e.outcome.dice_in_cup;
+    in3 += e.outcome.dice_in_cup == 3;
+    stacked += e.outcome.stacked;
+    walls += e.outcome.wall_contact;
+    success += e.outcome.realistic_success();
+    steps += static_cast<double>(e.size());
+  }
+  const double n = std::max(1, s.episodes);
+  s.dice_in_cup_mean = cup / n;
+  s.dice_in_cup_3 = wilson(in3, s.episodes);
+  s.stacked = wilson(stacked, s.episodes);
+  s.wall_contact = wilson(walls, s.episodes);
+  s.realistic_success = wilson(success, s.episodes);
+  s.mean_length = steps / n;
+  s.policy_us_per_step = steps > 0 ? 1e6 * policy_seconds / steps : 0.0;
+  s.seconds = wall;
+  return s;
+}
+
+}  // namespace
+
+EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
+                   int threads, InitialPush push, std::vector<Episode>* rollouts) {
+  const int workers = resolve_threads(threads);
+  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
+  std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
+  std::vector<double> policy_seconds(static_cast<std::size_t>(workers), 0.0);
+  std::vector<Episode> eps(static_cast<std::size_t>(episodes));
+  const auto t0 = std::chrono::steady_clock::now();
+  parallel_for(eps.size(), threads, [&](std::size_t i, int w) {
+    const auto slot = static_cast<std::size_t>(w);
+    if (!envs[slot]) envs[slot].emplace(world);
+    if (!policies[slot]) policies[slot] = make_policy();
+    TimedPolicy timed(*policies[slot], policy_seconds[slot]);
+    const std::uint64_t episode_seed = derive_seed(seed, i);
+    const State start = random_start_state(world, episode_seed);
+    eps[i] = rollout(*envs[slot], timed, start, episode_seed, StepSource::policy, push);
+  });
+  double total_policy = 0.0;
+  for (double s : policy_seconds) total_policy += s;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EvalStats stats = summarise(eps, total_policy, wall);
+  if (rollouts) *rollouts = std::move(eps);
+  return stats;
+}
+
+EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& config, int threads) {
+  // Long recordings must not be cut by the time limit; leave two seconds to settle.
+  WorldConfig world = config;
+  for (const auto& d : demos)
+    world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 60);
+  const int workers = resolve_threads(threads);
+  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
+  std::vector<Episode> eps(demos.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  parallel_for(demos.size(), threads, [&](std::size_t i, int w) {
+    auto& env = envs[static_cast<std::size_t>(w)];
+    if (!env) env.emplace(world);
+    PlaybackPolicy policy(demos[i]);
+    eps[i] = rollout(*env, policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
+  });
+  return summarise(eps, 0.0, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+}  // namespace dicestack

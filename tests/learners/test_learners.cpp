@@ -1,0 +1,115 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+
+#include "../core/helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+// A deterministic controller with per-episode state, for testing the evaluation machinery.
+class Swing final : public Policy {
+ public:
+  void reset(std::uint64_t seed) override { phase_ = static_cast<int>(seed % 7); }
+  Action act(const State& s) override {
+    ++phase_;
+    return {(phase_ / 10) % 2 ? 0.4 : -0.4, 4.0 / 30.0 - s[state_index::kCupVy] * 0.5, -0.1 * s[state_index::kCupW]};
+  }
+  std::string name() const override { return "swing"; }
+
+ private:
+  int phase_ = 0;
+};
+
+TEST(Evaluate, WilsonIntervalsMatchKnownValues) {
+  const Rate r = wilson(8, 10);
+  EXPECT_NEAR(r.value, 0.8, 1e-12);
+  EXPECT_NEAR(r.low, 0.4902, 1e-3);
+  EXPECT_NEAR(r.high, 0.9433, 1e-3);
+  const Rate zero = wilson(0, 20);
+  EXPECT_EQ(zero.low, 0.0);
+  EXPECT_NEAR(zero.high, 0.1611, 1e-3);
+}
+
+TEST(Evaluate, ResultsDoNotDependOnThreadCount) {
+  WorldConfig c;
+  c.episode.max_steps = 60;
+  std::vector<Episode> one, two;
+  const auto make = [] { return std::make_unique<Swing>(); };
+  const EvalStats a = evaluate(make, c, 6, 3, 1, InitialPush::none, &one);
+  const EvalStats b = evaluate(make, c, 6, 3, 2, InitialPush::none, &two);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states) << "episode " << i;
+    EXPECT_EQ(one[i].actions, two[i].actions);
+  }
+  EXPECT_EQ(a.wall_contact.value, b.wall_contact.value);
+  EXPECT_EQ(a.dice_in_cup_mean, b.dice_in_cup_mean);
+}
+
+TEST(Evaluate, RatesAgreeWithRollingOutByHand) {
+  WorldConfig c;
+  c.episode.max_steps = 80;
+  std::vector<Episode> eps;
+  const EvalStats s = evaluate([] { return std::make_unique<Swing>(); }, c, 5, 9, 2, InitialPush::left, &eps);
+  int walls = 0;
+  double cup = 0.0;
+  DiceEnv env(c);
+  for (std::size_t i = 0; i < 5; ++i) {
+    Swing p;
+    const std::uint64_t seed = derive_seed(9, i);
+    const Episode e = rollout(env, p, random_start_state(c, seed), seed, StepSource::policy, InitialPush::left);
+    EXPECT_EQ(e.states, eps[i].states);
+    walls += e.outcome.wall_contact;
+    cup += e.outcome.dice_in_cup;
+    EXPECT_NEAR(e.actions[0][0], -0.4 - 1.0, 1e-12) << "the left push adds -1 m/s at the first step";
+  }
+  EXPECT_EQ(s.wall_contact.value, walls / 5.0);
+  EXPECT_EQ(s.dice_in_cup_mean, cup / 5.0);
+  EXPECT_EQ(s.mean_length, 80.0);
+}
+
+TEST(Evaluate, PlaybackReplaysARecordedRolloutExactly) {
+  WorldConfig c;
+  c.episode.max_steps = 50;
+  DiceEnv env(c);
+  Swing p;
+  const Episode demo = rollout(env, p, random_start_state(c, 4), 4, StepSource::expert);
+  PlaybackPolicy playback(demo);
+  const Episode again = rollout(env, playback, demo.states.front(), 4, StepSource::policy);
+  EXPECT_EQ(again.states, demo.states);
+  EXPECT_EQ(again.outcome.wall_contact, demo.outcome.wall_contact);
+}
+
+TEST(Learners, BehaviourCloningEqualsFittingTheRegressorOnTheDemonstrations) {
+  const DemoSet set = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good");
+  LearnContext c;
+  c.demos = set.episodes;
+  c.regressor = "linear_svr";
+  c.seed = 5;
+  const LearnResult r = LearnerRegistry::global().create("bc")->learn(c);
+  const Dataset d = make_dataset(set.episodes);
+  const Model direct = Model::train(RegressorRegistry::global().create("linear_svr"), d.x, d.y, 5);
+  EXPECT_EQ(r.model->predict(d.x), direct.predict(d.x));
+}
+
+TEST(Learners, UnknownNamesAndEmptyDemosAreRejected) {
+  EXPECT_THAT(test::error_of([] { LearnerRegistry::global().create("dagr"); }), ::testing::HasSubstr("unknown learner \"dagr\"; registered: bc"));
+  LearnContext c;
+  c.regressor = "knn";
+  EXPECT_THROW(LearnerRegistry::global().create("bc")->learn(c), InputError);
+  c.demos = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good").episodes;
+  c.regressor = "nope";
+  EXPECT_THROW(LearnerRegistry::global().create("bc")->learn(c), ConfigError);
+}
+
+}  // namespace
+}  // namespace dicestack
