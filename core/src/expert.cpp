@@ -1,0 +1,241 @@
+#include <dicestack/core/expert.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <optional>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/geometry.hpp>
+#include <dicestack/core/rng.hpp>
+
+#include "swing_plan.hpp"
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+using detail::SwingPlan;
+
+void require_config(bool ok, const char* field, const std::string& rule, double got) {
+  if (!ok) throw ConfigError("expert config: field \"" + std::string(field) + "\" must be " + rule + ", got " +
+                             std::to_string(got));
+}
+
+void validate(const ExpertConfig& c) {
+  const SwingParams& p = c.swing;
+  require_config(p.first_direction == 1.0 || p.first_direction == -1.0, "swing.first_direction", "+1 or -1",
+                 p.first_direction);
+  require_config(p.amplitude >= 0.0, "swing.amplitude", ">= 0", p.amplitude);
+  require_config(p.half_period >= 1.0, "swing.half_period", ">= 1", p.half_period);
+  require_config(p.half_swings >= 0 && p.half_swings <= 50, "swing.half_swings", "in [0, 50]", p.half_swings);
+  require_config(p.pivot_depth > 0.0, "swing.pivot_depth", "> 0", p.pivot_depth);
+  require_config(p.clearance >= 0.0, "swing.clearance", ">= 0", p.clearance);
+  require_config(p.stop_speed >= 0.0, "swing.stop_speed", ">= 0", p.stop_speed);
+  require_config(p.final_duration >= 1.0, "swing.final_duration", ">= 1", p.final_duration);
+  require_config(p.tilt_time > 0.0, "swing.tilt_time", "> 0", p.tilt_time);
+  require_config(c.gain > 0.0, "gain", "> 0", c.gain);
+  require_config(c.wall_margin >= 0.0, "wall_margin", ">= 0", c.wall_margin);
+  require_config(c.search_budget >= 1, "search_budget", ">= 1", c.search_budget);
+  require_config(c.search_spread >= 0.0, "search_spread", ">= 0", c.search_spread);
+}
+
+bool same_state(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
+
+// Distance from a quarter turn.
+double off_square(double angle) {
+  const double q = std::numbers::pi / 2.0;
+  return std::abs(angle - q * std::round(angle / q));
+}
+
+// How far the dice are from a column at rest on the table (0 for a perfect one), m-ish.
+double column_error(const State& s, const WorldConfig& c) {
+  std::array<std::size_t, kDiceCount> order{0, 1, 2};
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return s[si::die(a) + 1] < s[si::die(b) + 1]; });
+  const double bottom = table_height(c.walls) + c.dice.half_size, side = 2.0 * c.dice.half_size;
+  double err = 0.0;
+  for (std::size_t k = 0; k < kDiceCount; ++k) {
+    const std::size_t d = si::die(order[k]);
+    err += std::abs(s[d] - s[si::die(order[0])]) + std::abs(s[d + 1] - bottom - side * static_cast<double>(k)) +
+           0.2 * off_square(s[d + 2]) + 0.1 * std::hypot(s[d + 3], s[d + 4]);
+  }
+  return err;
+}
+
+// Follows one swing plan with fixed parameters; re-anchors it whenever the episode's step count
+// does not continue the one it saw last (a new episode, or a state from elsewhere).
+class ScriptedExpert final : public Expert {
+ public:
+  explicit ScriptedExpert(const ExpertConfig& config) : config_(config) {}
+  std::string name() const override { return "scripted"; }
+
+ private:
+  void do_reset(std::uint64_t) override { last_step_ = -2; }
+  Action do_act(const DiceEnv& env) override {
+    const int t = env.t();
+    if (!plan_.valid() || t != last_step_ + 1) plan_ = SwingPlan(config_.swing, config_, env.config(), env.get_state(), t);
+    last_step_ = t;
+    return plan_.act(env.get_state(), t);
+  }
+
+  ExpertConfig config_;
+  SwingPlan plan_;
+  int last_step_ = -2;
+};
+
+// Searches swing plans by simulating each from an exact snapshot of the environment to the end
+// of the episode, and follows the first that succeeds (else the best). While the world stays on
+// the predicted trajectory nothing is simulated again; any other state (a DAgger query, noise)
+// first re-checks the current plan, then searches the nominal plan and seeded perturbations.
+class MpcExpert final : public Expert {
+ public:
+  explicit MpcExpert(const ExpertConfig& config) : config_(config) {}
+  std::string name() const override { return "mpc"; }
+
+ private:
+  struct Trial {
+    double score = -1e18;
+    std::vector<State> states;
+  };
+
+  void do_reset(std::uint64_t seed) override {
+    seed_ = seed;
+    plan_ = SwingPlan();
+    predicted_.clear();
+  }
+
+  Action do_act(const DiceEnv& env) override {
+    const int t = env.t();
+    const State s = env.get_state();
+    const int index = t - predicted_from_;
+    const bool on_track = plan_.valid() && index >= 0 && index < static_cast<int>(predicted_.size()) &&
+                          same_state(predicted_[static_cast<std::size_t>(index)], s);
+    if (!on_track) replan(env);
+    return plan_.act(s, t);
+  }
+
+  Trial simulate(SwingPlan plan, const EnvSnapshot& start) {
+    sim_->restore(start);
+    Trial trial;
+    trial.states.push_back(sim_->get_state());
+    const bool clean = !sim_->outcome().wall_contact;
+    StepResult r;
+    r.observation = sim_->get_state();
+    while (sim_->t() < sim_->config().episode.max_steps) {
+      r = sim_->step(plan.act(r.observation, sim_->t()));
+      trial.states.push_back(r.observation);
+      if (r.terminated) {
+        trial.score = 1000.0 - static_cast<double>(r.info.t);
+        return trial;
+      }
+      if (clean && r.info.outcome.wall_contact) break;
+    }
+    trial.score = -column_error(r.observation, sim_->config()) - (sim_->outcome().wall_contact ? 10.0 : 0.0);
+    return trial;
+  }
+
+  SwingParams perturbed(Rng& rng) const {
+    const SwingParams& n = config_.swing;
+    const double f = config_.search_spread;
+    auto jitter = [&](double x, double lo, double hi) { return std::clamp(x + f * (hi - lo) * rng.normal(), lo, hi); };
+    SwingParams p = n;
+    if (rng.uniform() < 0.25) p.first_direction = -p.first_direction;
+    p.amplitude = jitter(n.amplitude, 0.5, 2.8);
+    p.half_period = jitter(n.half_period, 8.0, 32.0);
+    p.half_swings = std::clamp(n.half_swings + static_cast<int>(std::lround(jitter(0.0, -6.0, 6.0))), 0, 7);
+    p.pivot_depth = jitter(n.pivot_depth, 1.5, 6.0);
+    p.clearance = jitter(n.clearance, 0.0, 0.15);
+    p.centre_offset = jitter(n.centre_offset, -0.3, 0.3);
+    p.stop_offset = jitter(n.stop_offset, -0.6, 0.6);
+    p.stop_speed = jitter(n.stop_speed, 0.0, 16.0);
+    p.final_duration = jitter(n.final_duration, 6.0, 30.0);
+    p.end_tilt = jitter(n.end_tilt, -0.4, 0.4);
+    p.tilt_time = jitter(n.tilt_time, 1.0, 15.0);
+    return p;
+  }
+
+  void replan(const DiceEnv& env) {
+    if (!sim_) sim_.emplace(env.config());
+    const EnvSnapshot start = env.snapshot();
+    const State s = env.get_state();
+    const int t = env.t();
+    Rng rng(derive_seed(seed_, static_cast<std::uint64_t>(t)));
+    std::optional<SwingPlan> best_plan;
+    Trial best;
+    auto consider = [&](const SwingPlan& plan) {
+      Trial trial = simulate(plan, start);
+      if (!best_plan || trial.score > best.score) {
+        best = std::move(trial);
+        best_plan = plan;
+      }
+      return best.score >= 0.0;
+    };
+    bool done = false;
+    int budget = config_.search_budget;
+    // The plan in force continues if it still succeeds from here (same episode only).
+    if (plan_.valid() && t > plan_.anchor_step()) {
+      done = consider(plan_);
+      --budget;
+    }
+    for (int c = 0; !done && c < std::max(1, budget); ++c) {
+      const SwingParams p = c == 0 ? config_.swing : perturbed(rng);
+      done = consider(SwingPlan(p, config_, env.config(), s, t));
+    }
+    plan_ = *best_plan;
+    predicted_ = std::move(best.states);
+    predicted_from_ = t;
+  }
+
+  ExpertConfig config_;
+  std::uint64_t seed_ = 0;
+  SwingPlan plan_;
+  std::vector<State> predicted_;
+  int predicted_from_ = 0;
+  std::optional<DiceEnv> sim_;
+};
+
+}  // namespace
+
+void Expert::reset(std::uint64_t seed) { do_reset(seed); }
+
+Action Expert::act(const DiceEnv& env) {
+  require_finite(env.get_state(), "expert: state");
+  Action a = do_act(env);
+  require_finite(a, name() + " expert: action");
+  const auto& limit = env.config().action.limit;
+  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
+  return a;
+}
+
+std::vector<ExpertInfo> expert_list() {
+  return {{"scripted", "the tuned swing plan (scoop, swing, stop) tracked by feedback; no simulation"},
+          {"mpc", "searches swing plans in the simulator from the current state; replans when off its prediction"}};
+}
+
+std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config) {
+  validate(config);
+  if (name == "scripted") return std::make_unique<ScriptedExpert>(config);
+  if (name == "mpc") return std::make_unique<MpcExpert>(config);
+  std::string known;
+  for (const auto& e : expert_list()) known += (known.empty() ? "" : ", ") + e.name;
+  throw ConfigError("unknown expert \"" + std::string(name) + "\"; known: " + known);
+}
+
+ExpertEpisode run_expert_episode(Expert& expert, DiceEnv& env, bool keep_trajectory) {
+  ExpertEpisode episode;
+  while (env.t() < env.config().episode.max_steps) {
+    const State s = env.get_state();
+    const Action a = expert.act(env);
+    if (keep_trajectory) {
+      episode.states.push_back(s);
+      episode.actions.push_back(a);
+    }
+    if (env.step(a).terminated) break;
+  }
+  episode.outcome = env.outcome();
+  return episode;
+}
+
+}  // namespace dicestack
