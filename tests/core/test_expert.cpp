@@ -1,0 +1,112 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
+
+#include "helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+using test::bit_equal;
+
+ExpertEpisode run_from(const std::string& name, const State& start, std::uint64_t seed, bool keep = false) {
+  const WorldConfig c;
+  DiceEnv env(c);
+  env.reset_to(start, seed);
+  auto expert = make_expert(name);
+  expert->reset(seed);
+  return run_expert_episode(*expert, env, keep);
+}
+
+TEST(Expert, BothExpertsStackFromThePaperStartWithoutTouchingAWall) {
+  for (const std::string name : {"scripted", "mpc"}) {
+    const ExpertEpisode e = run_from(name, paper_start_state(WorldConfig{}), 0);
+    EXPECT_TRUE(e.outcome.realistic_success()) << name;
+    EXPECT_FALSE(e.outcome.wall_contact) << name;
+    EXPECT_LT(e.outcome.steps, WorldConfig{}.episode.max_steps) << name;
+  }
+}
+
+TEST(Expert, MpcStacksFromRandomStarts) {
+  const WorldConfig c;
+  int successes = 0;
+  for (std::uint64_t seed = 0; seed < 4; ++seed) {
+    DiceEnv env(c);
+    env.reset(seed);
+    auto expert = make_expert("mpc");
+    expert->reset(seed);
+    successes += run_expert_episode(*expert, env).outcome.realistic_success();
+  }
+  EXPECT_GE(successes, 3);
+}
+
+TEST(Expert, ActionsAreFiniteAndWithinTheLimits) {
+  const WorldConfig c;
+  const ExpertEpisode e = run_from("scripted", random_start_state(c, 5), 5, true);
+  ASSERT_EQ(e.actions.size(), e.states.size());
+  ASSERT_FALSE(e.actions.empty());
+  for (const Action& a : e.actions)
+    for (std::size_t k = 0; k < kActionDim; ++k) {
+      EXPECT_TRUE(std::isfinite(a[k]));
+      EXPECT_LE(std::abs(a[k]), c.action.limit[k]);
+    }
+}
+
+TEST(Expert, TheHumanStrategy_CupStaysMouthDownAndSwingsBothWays) {
+  // The recordings keep the cup mouth-down and swing it left and right (docs/expert.md).
+  const ExpertEpisode e = run_from("scripted", paper_start_state(WorldConfig{}), 0, true);
+  double min_x = 1e9, max_x = -1e9;
+  for (const State& s : e.states) {
+    EXPECT_LT(std::cos(s[si::kCupAngle]), 0.0);
+    min_x = std::min(min_x, s[si::kCupX]);
+    max_x = std::max(max_x, s[si::kCupX]);
+  }
+  EXPECT_GT(max_x - min_x, 2.0);
+}
+
+TEST(Expert, SameSeedGivesTheSameEpisode) {
+  const WorldConfig c;
+  const State start = random_start_state(c, 11);
+  const ExpertEpisode a = run_from("mpc", start, 11, true), b = run_from("mpc", start, 11, true);
+  ASSERT_EQ(a.states.size(), b.states.size());
+  for (std::size_t t = 0; t < a.states.size(); ++t) {
+    ASSERT_TRUE(bit_equal(a.states[t], b.states[t])) << t;
+    ASSERT_EQ(a.actions[t], b.actions[t]) << t;
+  }
+}
+
+TEST(Expert, AnswersQueriesFromStatesOffItsOwnTrajectory) {
+  // A DAgger-style query: a state reached by other actions, mid-episode; the expert takes over.
+  const WorldConfig c;
+  DiceEnv env(c);
+  env.reset(3);
+  for (const auto& a : test::random_actions(c, 4, 15)) env.step(a);
+  auto expert = make_expert("mpc");
+  expert->reset(3);
+  const Action first = expert->act(env);
+  for (double v : first) EXPECT_TRUE(std::isfinite(v));
+  const Outcome o = run_expert_episode(*expert, env).outcome;
+  EXPECT_FALSE(o.wall_contact);
+  EXPECT_GE(o.steps, 15);
+}
+
+TEST(Expert, UnknownNamesAndBadConfigsAreConfigErrors) {
+  EXPECT_THAT(test::error_of([] { make_expert("scriptd"); }), testing::HasSubstr("known: scripted, mpc"));
+  EXPECT_THROW(make_expert("nope"), ConfigError);
+  ExpertConfig bad;
+  bad.search_budget = 0;
+  EXPECT_THAT(test::error_of([&] { make_expert("mpc", bad); }), testing::HasSubstr("search_budget"));
+  ExpertConfig dir;
+  dir.swing.first_direction = 0.5;
+  EXPECT_THROW(make_expert("scripted", dir), ConfigError);
+  for (const auto& info : expert_list()) EXPECT_EQ(make_expert(info.name)->name(), info.name);
+}
+
+}  // namespace
+}  // namespace dicestack
