@@ -39,6 +39,8 @@ void validate(const ExpertConfig& c) {
   require_config(c.wall_margin >= 0.0, "wall_margin", ">= 0", c.wall_margin);
   require_config(c.search_budget >= 1, "search_budget", ">= 1", c.search_budget);
   require_config(c.search_spread >= 0.0, "search_spread", ">= 0", c.search_spread);
+  require_config(c.replan_budget >= 1, "replan_budget", ">= 1", c.replan_budget);
+  require_config(c.replan_interval >= 1, "replan_interval", ">= 1", c.replan_interval);
 }
 
 bool same_state(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
@@ -104,6 +106,7 @@ class MpcExpert final : public Expert {
     seed_ = seed;
     plan_ = SwingPlan();
     predicted_.clear();
+    last_replan_ = 0;
   }
 
   Action do_act(const DiceEnv& env) override {
@@ -112,7 +115,8 @@ class MpcExpert final : public Expert {
     const int index = t - predicted_from_;
     const bool on_track = plan_.valid() && index >= 0 && index < static_cast<int>(predicted_.size()) &&
                           same_state(predicted_[static_cast<std::size_t>(index)], s);
-    if (!on_track) replan(env);
+    const bool fresh = !plan_.valid() || t < last_replan_ || t - last_replan_ >= config_.replan_interval;
+    if (!on_track && fresh) replan(env);
     return plan_.act(s, t);
   }
 
@@ -131,20 +135,23 @@ class MpcExpert final : public Expert {
         return trial;
       }
       if (clean && r.info.outcome.wall_contact) break;
+      if (plan.finished(sim_->t())) break;
     }
     trial.score = -column_error(r.observation, sim_->config()) - (sim_->outcome().wall_contact ? 10.0 : 0.0);
     return trial;
   }
 
-  SwingParams perturbed(Rng& rng) const {
-    const SwingParams& n = config_.swing;
+  // A plan near `n`; with `shorter`, sometimes one with fewer swings (a state met mid-episode
+  // may need fewer, and the time limit may allow no more).
+  SwingParams perturbed(const SwingParams& n, Rng& rng, bool shorter) const {
     const double f = config_.search_spread;
     auto jitter = [&](double x, double lo, double hi) { return std::clamp(x + f * (hi - lo) * rng.normal(), lo, hi); };
     SwingParams p = n;
     if (rng.uniform() < 0.25) p.first_direction = -p.first_direction;
+    if (shorter && rng.uniform() < 0.5) p.half_swings = static_cast<int>(rng.below(static_cast<std::uint64_t>(n.half_swings) + 1));
+    else p.half_swings = std::clamp(n.half_swings + static_cast<int>(std::lround(jitter(0.0, -6.0, 6.0))), 0, 7);
     p.amplitude = jitter(n.amplitude, 0.5, 2.8);
     p.half_period = jitter(n.half_period, 8.0, 32.0);
-    p.half_swings = std::clamp(n.half_swings + static_cast<int>(std::lround(jitter(0.0, -6.0, 6.0))), 0, 7);
     p.pivot_depth = jitter(n.pivot_depth, 1.5, 6.0);
     p.clearance = jitter(n.clearance, 0.0, 0.15);
     p.centre_offset = jitter(n.centre_offset, -0.3, 0.3);
@@ -173,19 +180,26 @@ class MpcExpert final : public Expert {
       return best.score >= 0.0;
     };
     bool done = false;
-    int budget = config_.search_budget;
-    // The plan in force continues if it still succeeds from here (same episode only).
-    if (plan_.valid() && t > plan_.anchor_step()) {
-      done = consider(plan_);
-      --budget;
+    const bool same_episode = plan_.valid() && t > plan_.anchor_step();
+    int budget = same_episode ? config_.replan_budget : config_.search_budget;
+    if (same_episode) {
+      // Same episode: first the plan in force, then plans in the same phase (same anchor, nearby
+      // parameters), so that a replan does not start the swinging over.
+      const SwingPlan current = plan_;
+      done = consider(current);
+      for (int c = 1; !done && c < budget / 2; ++c)
+        done = consider(SwingPlan(perturbed(current.params(), rng, false), config_, env.config(), current.anchor(),
+                                  current.anchor_step()));
+      budget -= budget / 2;
     }
     for (int c = 0; !done && c < std::max(1, budget); ++c) {
-      const SwingParams p = c == 0 ? config_.swing : perturbed(rng);
+      const SwingParams p = c == 0 ? config_.swing : perturbed(config_.swing, rng, t > 0);
       done = consider(SwingPlan(p, config_, env.config(), s, t));
     }
     plan_ = *best_plan;
     predicted_ = std::move(best.states);
     predicted_from_ = t;
+    last_replan_ = t;
   }
 
   ExpertConfig config_;
@@ -193,6 +207,7 @@ class MpcExpert final : public Expert {
   SwingPlan plan_;
   std::vector<State> predicted_;
   int predicted_from_ = 0;
+  int last_replan_ = 0;
   std::optional<DiceEnv> sim_;
 };
 

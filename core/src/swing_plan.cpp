@@ -32,7 +32,8 @@ SwingPlan::SwingPlan(const SwingParams& params, const ExpertConfig& config, cons
       margin_(config.wall_margin),
       g_dt_(-world.physics.gravity.y * world.physics.control_dt),
       dt_(world.physics.control_dt),
-      anchor_step_(anchor_step) {
+      anchor_step_(anchor_step),
+      anchor_(anchor) {
   double mean_x = 0.0;
   for (std::size_t i = 0; i < kDiceCount; ++i) mean_x += anchor[si::die(i)] / static_cast<double>(kDiceCount);
   xc_ = mean_x + p_.centre_offset;
@@ -75,6 +76,12 @@ double SwingPlan::safe_x(double x) const {
     x = std::clamp(x, wall_left_ + margin_ + reach(a, -1.0), wall_right_ - margin_ - reach(a, 1.0));
   }
   return x;
+}
+
+bool SwingPlan::finished(int step) const {
+  if (release_k_ < 0) return false;
+  const double lift_steps = p_.lift_speed > 0.0 ? p_.lift_height / (p_.lift_speed * dt_) : 0.0;
+  return step - anchor_step_ - release_k_ > std::max(1.0, p_.release_steps) + lift_steps;
 }
 
 void SwingPlan::reference_x(double k, double& x, double& v) const {

@@ -23,7 +23,10 @@ class SwingPlan {
   Action act(const State& s, int step);
 
   bool valid() const { return !wx_.empty(); }
+  /// True once the plan has stopped, released and lifted the cup: nothing it does changes the dice any more.
+  bool finished(int step) const;
   int anchor_step() const { return anchor_step_; }
+  const State& anchor() const { return anchor_; }
   const SwingParams& params() const { return p_; }
 
  private:
@@ -39,6 +42,7 @@ class SwingPlan {
   double table_ = 1.0, wall_left_ = 0.0, wall_right_ = 0.0, margin_ = 0.1;
   double g_dt_ = 0.0, dt_ = 1.0 / 30.0;
   int anchor_step_ = 0;
+  State anchor_{};
   double xc_ = 0.0, xstop_ = 0.0, v0_ = 0.0, stop_speed_ = 0.0;
   std::vector<double> wx_, wt_;
   int stop_k_ = -1;

@@ -21,16 +21,16 @@ namespace dicestack {
 /// One swing plan: a reference trajectory for the cup that a feedback controller tracks.
 /// Defaults are the tuned nominal plan (docs/expert.md); distances are metres, times control steps.
 struct SwingParams {
-  double first_direction = 1.0;  ///< sign of the first swing: +1 right, -1 left
+  double first_direction = 1.0;   ///< sign of the first swing: +1 right, -1 left
   double amplitude = 2.203;       ///< swing extremes sit this far from the swing centre, m (clamped off the walls)
   double half_period = 23.422;    ///< duration of one left-to-right swing, steps (the first is 0.6 of it; rounded)
   int half_swings = 6;            ///< number of swings before the stop, >= 0
   double pivot_depth = 2.857;     ///< the mouth aims at a point this far below the cup's centre of mass, m
   double clearance = 0.003;       ///< gap between the cup's lowest point and the table, m
-  double centre_offset = -0.157;   ///< swing centre relative to the dice' mean x, m
-  double stop_offset = -0.407;     ///< where the cup stops, relative to the swing centre, m
-  double stop_speed = 3.122;       ///< the last swing reaches the stop point at this speed and halts in one step, m/s
-  double final_duration = 27.731;   ///< duration of the last swing, steps (rounded: the stop falls on a control step)
+  double centre_offset = -0.157;  ///< swing centre relative to the dice' mean x, m
+  double stop_offset = -0.407;    ///< where the cup stops, relative to the swing centre, m
+  double stop_speed = 3.122;      ///< the last swing reaches the stop point at this speed and halts in one step, m/s
+  double final_duration = 27.731; ///< duration of the last swing, steps (rounded: the stop falls on a control step)
   double end_tilt = -0.138;       ///< tilt from mouth-down the cup turns to after the stop, rad
   double tilt_time = 4.520;       ///< time constant of that turn, steps
   double settle_steps = 30.0;     ///< after the stop, the cup holds still this long while the column lands, steps
@@ -41,11 +41,15 @@ struct SwingParams {
 
 /// Settings of every expert; make_expert() reads the fields its expert uses.
 struct ExpertConfig {
-  SwingParams swing;             ///< the nominal plan ("scripted" follows it, "mpc" searches around it)
-  double gain = 10.0;            ///< feedback gain of the cup's pose tracking, 1/s
-  double wall_margin = 0.10;     ///< the plan keeps the cup this far from the side walls, m
-  int search_budget = 64;        ///< "mpc": most plans simulated per replanning, >= 1
-  double search_spread = 0.03;   ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
+  SwingParams swing;              ///< the nominal plan ("scripted" follows it, "mpc" searches around it)
+  double gain = 10.0;             ///< feedback gain of the cup's pose tracking, 1/s
+  double wall_margin = 0.10;      ///< the plan keeps the cup this far from the side walls, m
+  int search_budget = 64;         ///< "mpc": most plans simulated when it has no plan for this episode, >= 1
+  int replan_budget = 16;         ///< "mpc": most plans simulated when a state leaves its prediction, >= 1
+  /// "mpc": off its predicted trajectory, re-check and re-search the plan at most once per this
+  /// many steps and follow the current plan's feedback in between (cheap DAgger labels), >= 1.
+  int replan_interval = 10;
+  double search_spread = 0.03;    ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
 };
 
 /// A policy that may use the simulator. act() works from any state of an episode, not only
@@ -78,8 +82,9 @@ std::vector<ExpertInfo> expert_list();
 
 /// Creates an expert by its command-line name: "scripted" (the swing plan, fixed parameters,
 /// feedback only) or "mpc" (searches swing plans in the simulator from the current state and
-/// replans when the world leaves its prediction). Throws ConfigError for an unknown name or a
-/// bad config field.
+/// replans when the world leaves its prediction). An "mpc" expert simulates with the WorldConfig
+/// of the first environment it is given; use one expert per world. Throws ConfigError for an
+/// unknown name or a bad config field.
 std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config = {});
 
 /// What one expert episode did.
