@@ -23,6 +23,7 @@ int run(int argc, char** argv) {
   add_leaderboard_command(app);
   add_play_command(app);
   add_train_command(app);
+  add_record_command(app);
   add_regressors_command(app);
   add_rollout_command(app);
   try {

@@ -16,6 +16,7 @@ void add_evaluate_command(CLI::App& app);
 void add_leaderboard_command(CLI::App& app);
 void add_play_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_record_command(CLI::App& app);
 void add_regressors_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <dicestack/datasets/builtin.hpp>
+#include <dicestack/learners/record.hpp>
 
 namespace dicestack::cli {
 
@@ -25,11 +26,15 @@ void print_progress(const std::string& text) {
 }
 
 void DemosOption::add_to(CLI::App& app) {
-  app.add_option("--demos", path, "Demonstration folder (default: the built-in set; see docs/datasets.md)");
+  app.add_option("--demos", path,
+                 "Demonstration folder, or `builtin` (default: 80 expert successes) or `human` (the paper's 68 "
+                 "recordings, converted)");
 }
 
 std::filesystem::path DemosOption::resolve(const WorldConfig& world) const {
-  return path.empty() ? human_demo_set(world) : path;
+  if (path.empty() || (path == "builtin" && !std::filesystem::exists(path))) return builtin_demo_set(world);
+  if (path == "human" && !std::filesystem::exists(path)) return human_demo_set(world);
+  return path;
 }
 
 }  // namespace dicestack::cli

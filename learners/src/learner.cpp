@@ -6,11 +6,13 @@
 namespace dicestack {
 
 void register_bc(LearnerRegistry&);
+void register_dagger(LearnerRegistry&);
 
 LearnerRegistry& LearnerRegistry::global() {
   static LearnerRegistry* registry = [] {
     auto* r = new LearnerRegistry;
     register_bc(*r);
+    register_dagger(*r);
     return r;
   }();
   return *registry;

@@ -9,6 +9,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/core/expert.hpp>
 
 #include "../core/helpers.hpp"
 
@@ -109,6 +110,91 @@ TEST(Learners, UnknownNamesAndEmptyDemosAreRejected) {
   c.demos = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good").episodes;
   c.regressor = "nope";
   EXPECT_THROW(LearnerRegistry::global().create("bc")->learn(c), ConfigError);
+}
+
+}  // namespace
+}  // namespace dicestack
+
+#include <dicestack/learners/record.hpp>
+
+namespace dicestack {
+namespace {
+
+LearnContext small_context(int threads) {
+  LearnContext c;
+  c.world.episode.max_steps = 60;
+  c.regressor = "knn";
+  c.seed = 11;
+  c.threads = threads;
+  return c;
+}
+
+TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
+  WorldConfig w;
+  w.episode.max_steps = 80;
+  const auto a = record_expert("scripted", {}, w, 4, 3, 1), b = record_expert("scripted", {}, w, 4, 3, 2);
+  ASSERT_EQ(a.size(), 4u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].states, b[i].states);
+    EXPECT_EQ(a[i].actions, b[i].actions);
+    EXPECT_EQ(a[i].sources.front(), StepSource::expert);
+  }
+  EXPECT_THROW(record_expert("nobody", {}, w, 1, 0, 1), ConfigError);
+}
+
+TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {
+  LearnContext c = small_context(2);
+  const auto learner = LearnerRegistry::global().create(
+      "dagger", {"iterations=1", "rollouts=3", "beta=1", "include_demos=false", "expert=scripted"});
+  c.checkpoint_dir = std::filesystem::temp_directory_path() / "dicestack_dagger_beta1";
+  std::filesystem::remove_all(c.checkpoint_dir);
+  const LearnResult r = learner->learn(c);
+  const DemoSet data = read_demo_set(c.checkpoint_dir / "data");
+  ASSERT_EQ(data.episodes.size(), 3u);
+  for (const auto& e : data.episodes)
+    for (auto s : e.sources) ASSERT_EQ(s, StepSource::expert);
+  // The expert's own episodes from the same starts: the labels are exactly its actions.
+  DiceEnv env(c.world);
+  auto expert = make_expert("scripted");
+  const std::uint64_t seed = derive_seed(derive_seed(c.seed, 1), 0);
+  env.reset_to(random_start_state(c.world, seed), seed);
+  expert->reset(seed);
+  const ExpertEpisode run = run_expert_episode(*expert, env, true);
+  EXPECT_EQ(data.episodes[0].actions, run.actions);
+  std::filesystem::remove_all(c.checkpoint_dir);
+}
+
+TEST(Dagger, LearnerActsWhenBetaIsZeroAndResultsIgnoreThreads) {
+  const std::vector<std::string> opts{"iterations=2", "rollouts=3", "beta=0", "expert=scripted"};
+  const DemoSet demos = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good");
+  LearnContext one = small_context(1), two = small_context(2);
+  one.demos = two.demos = demos.episodes;
+  const LearnResult a = LearnerRegistry::global().create("dagger", opts)->learn(one);
+  const LearnResult b = LearnerRegistry::global().create("dagger", opts)->learn(two);
+  const Dataset probe = make_dataset(demos.episodes);
+  EXPECT_EQ(a.model->predict(probe.x), b.model->predict(probe.x));
+  ASSERT_EQ(a.curve.size(), 2u);
+  EXPECT_EQ(a.curve[1].dataset_rows, b.curve[1].dataset_rows);
+  EXPECT_GT(a.curve[1].dataset_rows, a.curve[0].dataset_rows);
+}
+
+TEST(Dagger, ResumeEqualsUninterrupted) {
+  const DemoSet demos = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good");
+  LearnContext c = small_context(2);
+  c.demos = demos.episodes;
+  const auto dir = std::filesystem::temp_directory_path() / "dicestack_dagger_resume";
+  std::filesystem::remove_all(dir);
+  const LearnResult whole = LearnerRegistry::global().create("dagger", {"iterations=3", "rollouts=2", "expert=scripted"})->learn(c);
+  // Run two rounds (as if killed after round 2), then resume to three.
+  c.checkpoint_dir = dir;
+  LearnerRegistry::global().create("dagger", {"iterations=2", "rollouts=2", "expert=scripted"})->learn(c);
+  c.resume = true;
+  const LearnResult resumed = LearnerRegistry::global().create("dagger", {"iterations=3", "rollouts=2", "expert=scripted"})->learn(c);
+  const Dataset probe = make_dataset(demos.episodes);
+  EXPECT_EQ(resumed.model->predict(probe.x), whole.model->predict(probe.x));
+  ASSERT_EQ(resumed.curve.size(), 3u);
+  EXPECT_EQ(resumed.curve.back().dataset_rows, whole.curve.back().dataset_rows);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

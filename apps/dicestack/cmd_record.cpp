@@ -1,0 +1,92 @@
+// `dicestack record`: demonstrations from an automatic expert (docs/expert.md).
+#include <chrono>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/learners/record.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct RecordOptions {
+  WorldOption world;
+  std::string expert = "mpc";
+  int episodes = 100;
+  std::uint64_t seed = 0;
+  std::filesystem::path out;
+  int threads = 0;
+  bool successes_only = false;
+  bool json = false;
+};
+
+int run_record(const RecordOptions& opt) {
+  const WorldConfig world = opt.world.load();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Episode> eps = record_expert(opt.expert, {}, world, opt.episodes, opt.seed, opt.threads);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  int success = 0, stacked = 0, walls = 0;
+  double cup = 0.0;
+  for (const auto& e : eps) {
+    success += e.outcome.realistic_success();
+    stacked += e.outcome.stacked;
+    walls += e.outcome.wall_contact;
+    cup += e.outcome.dice_in_cup;
+  }
+  DemoSet set;
+  set.world = world;
+  set.description = "dicestack record --expert " + opt.expert;
+  set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
+                   std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
+                   "; episode i starts from random_start_state(world, derive_seed(seed, i))";
+  for (auto& e : eps)
+    if (!opt.successes_only || e.outcome.realistic_success()) set.episodes.push_back(std::move(e));
+  write_demo_set(set, opt.out);
+  const double n = std::max(1, opt.episodes);
+  if (opt.json) {
+    print_line(nlohmann::json{{"expert", opt.expert},
+                              {"episodes", opt.episodes},
+                              {"written", set.episodes.size()},
+                              {"realistic_success_rate", success / n},
+                              {"stacked_rate", stacked / n},
+                              {"dice_in_cup_mean", cup / n},
+                              {"wall_contact_rate", walls / n},
+                              {"seconds_per_episode", seconds / n},
+                              {"seconds", seconds},
+                              {"out", opt.out.string()}}
+                   .dump());
+    return 0;
+  }
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "expert %s, %d episodes from seed %llu: realistic success %.1f%%, stacked %.1f%%, dice in cup %.2f, "
+                "wall contact %.1f%%; %.3f s per episode (%.1f s)\nwrote %zu episodes to %s",
+                opt.expert.c_str(), opt.episodes, static_cast<unsigned long long>(opt.seed), 100 * success / n,
+                100 * stacked / n, cup / n, 100 * walls / n, seconds / n, seconds, set.episodes.size(),
+                opt.out.string().c_str());
+  print_line(line);
+  return 0;
+}
+
+}  // namespace
+
+void add_record_command(CLI::App& app) {
+  auto opt = std::make_shared<RecordOptions>();
+  std::string experts;
+  for (const auto& e : expert_list()) experts += "\n  " + e.name + ": " + e.description;
+  CLI::App* cmd = app.add_subcommand("record", "Record demonstrations from an automatic expert:" + experts);
+  opt->world.add_to(*cmd);
+  cmd->add_option("--expert", opt->expert, "Expert name")->capture_default_str();
+  cmd->add_option("--episodes", opt->episodes, "Episodes from random starts")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the starts")->capture_default_str();
+  cmd->add_option("--out", opt->out, "Demonstration folder to write (replaced whole)")->required();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_flag("--successes-only", opt->successes_only, "Keep only realistic successes");
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] { run_record(*opt); });
+}
+
+}  // namespace dicestack::cli

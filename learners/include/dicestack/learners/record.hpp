@@ -1,0 +1,29 @@
+#pragma once
+// Demonstrations from an automatic expert, and the built-in demonstration set made from them.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/expert.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+namespace dicestack {
+
+/// Runs expert `name` from `episodes` random starts (episode i from
+/// random_start_state(world, derive_seed(seed, i))), in parallel with one world and one expert
+/// per thread. Returns every episode, successes and failures, each with its outcome; the
+/// result does not depend on the thread count. Throws ConfigError for an unknown expert.
+std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
+                                   int episodes, std::uint64_t seed, int threads);
+
+/// Seed and size of the built-in set.
+inline constexpr std::uint64_t kBuiltinSeed = 2026;
+inline constexpr int kBuiltinSuccesses = 80;
+
+/// The built-in demonstration set: the first kBuiltinSuccesses realistic successes of the
+/// "mpc" expert from random starts seeded with kBuiltinSeed (the paper's "almost 70"), with
+/// provenance in meta.json. Generated into the cache on first use (a few seconds), keyed by
+/// the world config; afterwards read from there.
+std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads = 0);
+
+}  // namespace dicestack

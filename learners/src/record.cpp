@@ -1,0 +1,73 @@
+#include <dicestack/learners/record.hpp>
+
+#include <cstdio>
+#include <optional>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/parallel.hpp>
+#include <dicestack/datasets/builtin.hpp>
+
+namespace dicestack {
+
+std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
+                                   int episodes, std::uint64_t seed, int threads) {
+  make_expert(name, config);  // an unknown name fails here, before any thread starts
+  const auto workers = static_cast<std::size_t>(resolve_threads(threads));
+  std::vector<std::optional<DiceEnv>> envs(workers);
+  std::vector<std::unique_ptr<Expert>> experts(workers);
+  std::vector<Episode> out(static_cast<std::size_t>(std::max(0, episodes)));
+  parallel_for(out.size(), threads, [&](std::size_t i, int w) {
+    auto& env = envs[static_cast<std::size_t>(w)];
+    auto& expert = experts[static_cast<std::size_t>(w)];
+    if (!env) env.emplace(world);
+    if (!expert) expert = make_expert(name, config);
+    const std::uint64_t s = derive_seed(seed, i);
+    env->reset_to(random_start_state(world, s), s);
+    expert->reset(s);
+    const ExpertEpisode run = run_expert_episode(*expert, *env, true);
+    Episode& e = out[i];
+    e.seed = s;
+    e.origin = "expert " + name;
+    e.states = run.states;
+    e.actions = run.actions;
+    e.sources.assign(e.states.size(), StepSource::expert);
+    e.outcome = run.outcome;
+  });
+  return out;
+}
+
+std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
+  std::string key = to_json(world);
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : key) h = (h ^ c) * 0x100000001b3ULL;
+  char name[40];
+  std::snprintf(name, sizeof name, "expert-v1-%08llx", static_cast<unsigned long long>(h >> 32));
+  const auto dir = cache_dir() / name;
+  if (std::filesystem::exists(dir / "meta.json")) return dir;
+
+  DemoSet set;
+  set.world = world;
+  set.description = "Built-in demonstrations: the first " + std::to_string(kBuiltinSuccesses) +
+                    " realistic successes (stacked, no wall contact) of dicestack's mpc expert from random starts";
+  int batch_start = 0, tried = 0;
+  while (static_cast<int>(set.episodes.size()) < kBuiltinSuccesses) {
+    if (batch_start > 50 * kBuiltinSuccesses)
+      throw Error("built-in demonstrations: the mpc expert found too few successes in this world");
+    // Episodes batch_start.. of the seeded sequence; successes kept in index order.
+    auto batch = record_expert("mpc", {}, world, kBuiltinSuccesses, derive_seed(kBuiltinSeed, static_cast<std::uint64_t>(batch_start)), threads);
+    for (auto& e : batch) {
+      ++tried;
+      if (e.outcome.realistic_success() && static_cast<int>(set.episodes.size()) < kBuiltinSuccesses)
+        set.episodes.push_back(std::move(e));
+    }
+    batch_start += kBuiltinSuccesses;
+  }
+  set.provenance = "dicestack builtin_demo_set: expert mpc (default ExpertConfig), random starts with seeds "
+                   "derive_seed(derive_seed(" + std::to_string(kBuiltinSeed) + ", batch), i); " +
+                   std::to_string(set.episodes.size()) + " successes kept of " + std::to_string(tried) + " episodes";
+  write_demo_set(set, dir);
+  return dir;
+}
+
+}  // namespace dicestack
