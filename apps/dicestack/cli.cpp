@@ -25,6 +25,7 @@ int run(int argc, char** argv) {
   add_train_command(app);
   add_record_command(app);
   add_regressors_command(app);
+  add_render_command(app);
   add_rollout_command(app);
   try {
     RegressorRegistry::global().load_plugins_from_environment();

@@ -18,6 +18,7 @@ void add_play_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_record_command(CLI::App& app);
 void add_regressors_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`
 

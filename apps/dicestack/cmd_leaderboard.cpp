@@ -28,7 +28,7 @@ using nlohmann::json;
 struct LeaderboardOptions {
   WorldOption world;
   DemosOption demos;
-  std::vector<std::string> regressors, learners;
+  std::vector<std::string> regressors, learners, options;
   std::string profile = "quick", format = "md", split = "episodes";
   int episodes = 0, seeds = 1, threads = 0;
   std::uint64_t seed = 0;
@@ -139,7 +139,22 @@ int run_leaderboard(const LeaderboardOptions& opt) {
   const auto dir = opt.demos.resolve(world);
   const DemoSet set = read_demo_set(dir);
   const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
-  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc"} : opt.learners;
+  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger"} : opt.learners;
+  // Learner options: the profile's defaults, then --option (for every learner that has the key).
+  auto options_for = [&](const std::string& learner) {
+    std::vector<std::string> out;
+    if (learner == "dagger") out = paper ? std::vector<std::string>{"iterations=5", "rollouts=20"}
+                                         : std::vector<std::string>{"iterations=2", "rollouts=10"};
+    for (const auto& kv : opt.options) {
+      const auto key = kv.substr(0, kv.find('='));
+      for (const auto& p : LearnerRegistry::global().info(learner).params)
+        if (p.name == key) {
+          std::erase_if(out, [&](const std::string& o) { return o.substr(0, o.find('=')) == key; });
+          out.push_back(kv);
+        }
+    }
+    return out;
+  };
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   for (const auto& l : learners) LearnerRegistry::global().info(l);
 
@@ -163,7 +178,10 @@ int run_leaderboard(const LeaderboardOptions& opt) {
          << " episodes, " << frames << " frames); split " << split.description << "; profile " << opt.profile << "; "
          << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
          << " training seed(s); rates with 95% Wilson intervals";
-  const json meta{{"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
+  json learner_options = json::object();
+  for (const auto& l : learners) learner_options[l] = options_for(l);
+  header << "; learner options " << learner_options.dump();
+  const json meta{{"learner_options", learner_options}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
                   {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
 
@@ -217,7 +235,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
           c.demos = train;
         }
         const auto t0 = std::chrono::steady_clock::now();
-        const LearnResult learned = LearnerRegistry::global().create(learner_name)->learn(c);
+        const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
         row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
         row.train_error += scaled_l1_error(split.train.y, learned.model->predict(split.train.x), sigma) / opt.seeds;
         row.test_error += split.test.rows() ? scaled_l1_error(split.test.y, learned.model->predict(split.test.x), sigma) / opt.seeds : 0.0;
@@ -276,7 +294,8 @@ void add_leaderboard_command(CLI::App& app) {
   opt->world.add_to(*cmd);
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressors", opt->regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
-  cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc)")->delimiter(',');
+  cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc, dagger)")->delimiter(',');
+  cmd->add_option("--option", opt->options, "key=value learner option (applied to the learners that have it); repeatable");
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row and training seed (default: 20 quick, 100 paper)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seeds", opt->seeds, "Training seeds per row")->check(CLI::PositiveNumber)->capture_default_str();

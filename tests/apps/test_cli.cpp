@@ -177,3 +177,33 @@ TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
 
 }  // namespace
 }  // namespace dicestack
+
+#include <opencv2/videoio.hpp>
+
+namespace dicestack {
+namespace {
+
+TEST(CliRender, VideoFramesAndPlotOfARecordedEpisode) {
+  const auto dir = std::filesystem::temp_directory_path() / "dicestack_cli_render";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string episode = std::string(DICESTACK_SOURCE_DIR) + "/tests/datasets/data/good/episode_0000.csv";  // 4 steps
+  const Process p = run("render --episode " + episode + " --out " + (dir / "ep.avi").string() + " --plot " +
+                        (dir / "plot.png").string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  cv::VideoCapture video((dir / "ep.avi").string());
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  for (cv::Mat f; video.read(f);) ++frames;
+  EXPECT_EQ(frames, 4) << "one frame per recorded step";
+  EXPECT_GT(std::filesystem::file_size(dir / "plot.png"), 5000u);
+  ASSERT_EQ(run("render --episode " + episode + " --out " + (dir / "frames").string()).status, 0);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir / "frames"), std::filesystem::directory_iterator{}), 4);
+  const Process bad = run("render --episode " + episode + " --out " + (dir / "x.webm").string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("unknown output kind"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace dicestack
