@@ -21,5 +21,6 @@ void add_regressors_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`
+void add_bench_load_command(CLI::App& bench);        // under `bench`
 
 }  // namespace dicestack::cli

@@ -249,6 +249,7 @@ void add_bench_command(CLI::App& app) {
   cmd->callback([snap] { run_snapshot(*snap); });
 
   add_bench_regressors_command(*bench);
+  add_bench_load_command(*bench);
 }
 
 }  // namespace dicestack::cli

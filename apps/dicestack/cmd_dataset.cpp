@@ -1,12 +1,14 @@
 // `dicestack import cupdice` and `dicestack dataset info|validate`: getting demonstrations in,
 // and looking at them.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
 
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/datasets/builtin.hpp>
 #include <dicestack/datasets/cupdice_import.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
@@ -110,7 +112,52 @@ int run_validate(const DatasetOptions& opt) {
   return 0;
 }
 
+struct LoadBenchOptions {
+  WorldOption world;
+  DemosOption demos;
+  int repeats = 9;
+  bool json = false;
+};
+
+// Reading a whole set (every file checked) and stacking X and Y; median of `repeats` runs.
+int run_bench_load(const LoadBenchOptions& opt) {
+  const auto dir = opt.demos.path.empty() ? human_demo_set(opt.world.load()) : opt.demos.resolve(opt.world.load());
+  std::vector<double> seconds;
+  std::size_t rows = 0, episodes = 0;
+  for (int r = 0; r < opt.repeats; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const DemoSet set = read_demo_set(dir);
+    const Dataset d = make_dataset(set.episodes);
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    rows = d.rows();
+    episodes = d.episodes();
+  }
+  std::sort(seconds.begin(), seconds.end());
+  const double median = seconds[seconds.size() / 2];
+  if (opt.json) {
+    print_line(nlohmann::json{{"demos", dir.string()}, {"episodes", episodes}, {"rows", rows}, {"load_s", median},
+                              {"rows_per_s", rows / median}, {"repeats", opt.repeats}}
+                   .dump());
+    return 0;
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "bench load: %s: %zu episodes, %zu rows read, checked and stacked in %.3f s (median of %d; %.0f rows/s)",
+                dir.string().c_str(), episodes, rows, median, opt.repeats, rows / median);
+  print_line(line);
+  return 0;
+}
+
 }  // namespace
+
+void add_bench_load_command(CLI::App& bench) {
+  auto opt = std::make_shared<LoadBenchOptions>();
+  CLI::App* cmd = bench.add_subcommand("load", "Time to read a demonstration set and build X and Y");
+  opt->world.add_to(*cmd);
+  opt->demos.add_to(*cmd);
+  cmd->add_option("--repeats", opt->repeats, "Runs (the median is reported)")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] { run_bench_load(*opt); });
+}
 
 void add_dataset_commands(CLI::App& app) {
   CLI::App* import = app.add_subcommand("import", "Convert recordings from other tools into dicestack's format");

@@ -75,7 +75,8 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
     }
     return;
   }
-  if (ext != ".mp4" && ext != ".avi" && ext != ".gif" && ext != ".png")
+  // (OpenCV 4.6 writes no GIF; a folder of PNGs converts to one with any GIF tool.)
+  if (ext != ".mp4" && ext != ".avi" && ext != ".png")
     throw InputError(out.string() + ": unknown output kind; use .mp4, .avi, .png (last frame) or a folder");
   if (ext == ".png") {
     render_state_into(img, states.back(), world, {static_cast<int>(states.size() - 1), outcomes.back(), title});
@@ -85,7 +86,7 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
   render_state_into(img, states.front(), world, {0, outcomes.front(), title});
   const fs::path tmp = out.parent_path() / (".tmp-" + out.filename().string());
   const int fourcc = ext == ".mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v') : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
-  cv::VideoWriter video(tmp.string(), ext == ".gif" ? cv::CAP_ANY : cv::CAP_FFMPEG, fourcc, 1.0 / world.physics.control_dt,
+  cv::VideoWriter video(tmp.string(), cv::CAP_FFMPEG, fourcc, 1.0 / world.physics.control_dt,
                         cv::Size(img.width, img.height));
   if (!video.isOpened()) throw InputError(out.string() + ": OpenCV cannot write this video format here");
   for (std::size_t t = 0; t < states.size(); ++t) {
