@@ -147,7 +147,7 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
 }
 
 TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
-  const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn,linear_svr --episodes 2 --seed 4 ";
+  const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn,linear_svr --learners bc --episodes 2 --seed 4 ";
   const Process a = run(args + "--format json", false), b = run(args + "--format json", false);
   ASSERT_EQ(a.status, 0) << a.output;
   const auto ja = nlohmann::json::parse(a.output), jb = nlohmann::json::parse(b.output);
