@@ -21,6 +21,7 @@ int run(int argc, char** argv) {
   add_dataset_commands(app);
   add_evaluate_command(app);
   add_leaderboard_command(app);
+  add_learners_command(app);
   add_play_command(app);
   add_train_command(app);
   add_record_command(app);

@@ -14,6 +14,7 @@ void add_config_command(CLI::App& app);
 void add_dataset_commands(CLI::App& app);  // import, dataset
 void add_evaluate_command(CLI::App& app);
 void add_leaderboard_command(CLI::App& app);
+void add_learners_command(CLI::App& app);
 void add_play_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_record_command(CLI::App& app);

@@ -10,6 +10,7 @@
 #include <dicestack/datasets/builtin.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/learner.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include "cli.hpp"
@@ -21,6 +22,35 @@ namespace {
 struct ListOptions {
   bool json = false;
 };
+
+// Prints "--set name= type default range help" lines of a schema.
+void print_params(const std::vector<ParamSpec>& params, const char* flag) {
+  for (const auto& p : params) {
+    std::string range;
+    if (p.type == ParamType::choice) {
+      for (const auto& c : p.choices) range += (range.empty() ? "" : "|") + c;
+    } else if (p.type != ParamType::boolean) {
+      std::ostringstream os;
+      os << "[" << p.min << ", " << p.max << "]";
+      range = os.str();
+    }
+    char line[512];
+    std::snprintf(line, sizeof line, "    %s %-14s %-8s default %-8s %-18s %s", flag, (p.name + "=").c_str(),
+                  std::string(to_string(p.type)).c_str(), p.default_value.c_str(), range.c_str(), p.help.c_str());
+    print_line(line);
+  }
+}
+
+int run_learners() {
+  const auto& reg = LearnerRegistry::global();
+  for (const auto& name : reg.names()) {
+    const auto& i = reg.info(name);
+    print_line(name + "\n    " + i.description);
+    print_params(i.params, "--option");
+  }
+  print_line("(playback is an evaluation: the leaderboard's last row replays the demonstrations)");
+  return 0;
+}
 
 int run_list(const ListOptions& opt) {
   const auto& reg = RegressorRegistry::global();
@@ -39,20 +69,7 @@ int run_list(const ListOptions& opt) {
   for (const auto& name : reg.names()) {
     const auto& i = reg.info(name);
     print_line(name + "  (" + i.source + ")\n    " + i.description);
-    for (const auto& p : i.params) {
-      std::string range;
-      if (p.type == ParamType::choice) {
-        for (const auto& c : p.choices) range += (range.empty() ? "" : "|") + c;
-      } else if (p.type != ParamType::boolean) {
-        std::ostringstream os;
-        os << "[" << p.min << ", " << p.max << "]";
-        range = os.str();
-      }
-      char line[512];
-      std::snprintf(line, sizeof line, "    --set %-14s %-8s default %-8s %-18s %s", (p.name + "=").c_str(),
-                    std::string(to_string(p.type)).c_str(), p.default_value.c_str(), range.c_str(), p.help.c_str());
-      print_line(line);
-    }
+    print_params(i.params, "--set");
   }
   return 0;
 }
@@ -136,6 +153,11 @@ void add_regressors_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("regressors", "List the registered regressors and their parameters");
   cmd->add_flag("--json", list->json, "Print JSON");
   cmd->callback([list] { run_list(*list); });
+}
+
+void add_learners_command(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("learners", "List the learners and their options");
+  cmd->callback([] { run_learners(); });
 }
 
 void add_bench_regressors_command(CLI::App& bench) {
