@@ -158,16 +158,26 @@ int run_leaderboard(const LeaderboardOptions& opt) {
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   for (const auto& l : learners) LearnerRegistry::global().info(l);
 
-  std::vector<Episode> train, test;
-  if (opt.split == "rows") {
-    train = set.episodes;  // learners see whole episodes; errors use the row split below
-  } else {
-    for (std::size_t i = 0; i < set.episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(set.episodes[i]);
-  }
+  // Episode split: learners get the training episodes. Row split (the paper's protocol): they
+  // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
   const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
+  std::vector<Episode> train;
   if (opt.split == "rows") {
-    // The paper's protocol fits on the training rows only.
-    train.clear();
+    Episode rows;
+    rows.name = "training-rows";
+    for (Eigen::Index i = 0; i < split.train.x.rows(); ++i) {
+      State st;
+      Action a;
+      for (std::size_t j = 0; j < kStateDim; ++j) st[j] = split.train.x(i, static_cast<Eigen::Index>(j));
+      for (std::size_t j = 0; j < kActionDim; ++j) a[j] = split.train.y(i, static_cast<Eigen::Index>(j));
+      rows.states.push_back(st);
+      rows.actions.push_back(a);
+      rows.sources.push_back(StepSource::human);
+    }
+    train.push_back(std::move(rows));
+  } else {
+    for (std::size_t i = 0; i < set.episodes.size(); ++i)
+      if (i % 5 != 4) train.push_back(set.episodes[i]);
   }
   const auto sigma = column_sigma(split.train.y);
 
@@ -217,23 +227,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
         c.regressor = name;
         c.seed = seed;
         c.threads = opt.threads;
-        if (opt.split == "rows") {
-          // Fit on the row split's training rows directly (one pseudo-episode).
-          Episode all;
-          all.name = "train-rows";
-          for (Eigen::Index i = 0; i < split.train.x.rows(); ++i) {
-            State st;
-            Action a;
-            for (std::size_t j = 0; j < kStateDim; ++j) st[j] = split.train.x(i, static_cast<Eigen::Index>(j));
-            for (std::size_t j = 0; j < kActionDim; ++j) a[j] = split.train.y(i, static_cast<Eigen::Index>(j));
-            all.states.push_back(st);
-            all.actions.push_back(a);
-            all.sources.push_back(StepSource::human);
-          }
-          c.demos = {all};
-        } else {
-          c.demos = train;
-        }
+        c.demos = train;
         const auto t0 = std::chrono::steady_clock::now();
         const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
         row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
@@ -271,7 +265,6 @@ int run_leaderboard(const LeaderboardOptions& opt) {
   playback.success = static_cast<int>(std::lround(pb.realistic_success.value * pb.episodes));
   playback.dice_in_cup = pb.dice_in_cup_mean;
   rows.push_back(playback);
-  print_progress("");
 
   const std::string table = render(rows, opt.format, header.str(), meta);
   if (opt.out.empty()) {
