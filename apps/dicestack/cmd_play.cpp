@@ -37,7 +37,8 @@ void add_play_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "play",
       "Play the game in a window: arrows push the cup (released keys stop it), q/e turn it, m toggles mouse aim,\n"
-      "r resets, s saves the episode and starts over, p saves a screenshot, Escape quits");
+      "r discards the episode and starts over, s saves it and starts over, p saves a screenshot, Escape saves and quits;\n"
+      "episodes that end (success or time limit) are saved too");
   cmd->world.add_to(*sub);
   sub->add_option("--record", cmd->play.record, "Append every episode to this demonstration folder");
   sub->add_option("--seed", cmd->play.seed, "Seed of the first start state")->capture_default_str();

@@ -117,8 +117,8 @@ PlayReport play(const PlayOptions& opt) {
       switch (ev.key.keysym.sym) {
         case SDLK_ESCAPE: running = false; break;
         case SDLK_m: aim = !aim; break;
-        case SDLK_r: finish_episode(); start_episode(); break;
-        case SDLK_s: finish_episode(); start_episode(); break;
+        case SDLK_r: start_episode(); break;                   // discard and start over
+        case SDLK_s: finish_episode(); start_episode(); break;  // save and start over
         case SDLK_p: screenshot = "dicestack_" + std::to_string(shots++) + ".png"; break;
         default: break;
       }
