@@ -1,3 +1,4 @@
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -46,14 +47,15 @@ class Dagger final : public Learner {
     for (int i = first; i <= iterations; ++i) {
       const double beta = beta_at(i, iterations);
       std::vector<Episode> fresh(static_cast<std::size_t>(rollouts));
-      int finished = 0;
+      std::atomic<int> finished{0};
       parallel_for(fresh.size(), c.threads, [&](std::size_t k, int w) {
         auto& env = envs[static_cast<std::size_t>(w)];
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!env) env.emplace(c.world);
         if (!expert) expert = make_expert(expert_name);
         fresh[k] = mixture_rollout(*env, *expert, model.get(), beta, derive_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
-        if (c.progress && w == 0) c.progress({"rollouts", i, iterations, ++finished, rollouts});
+        const int done = ++finished;
+        if (c.progress && w == 0) c.progress({"rollouts", i, iterations, done, rollouts});  // one thread reports
       });
       CurvePoint point{i, 0, 0.0, 0.0, 0.0, 0.0};
       for (const auto& e : fresh) {
