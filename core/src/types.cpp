@@ -44,10 +44,13 @@ Action to_action(std::span<const double> values, std::string_view what) {
   return to_array<kActionDim>(values, what, "an action");
 }
 
-std::uint64_t hash_state(const State& state, std::uint64_t seed) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(state.data());
-  for (std::size_t i = 0; i < sizeof(State); ++i) seed = (seed ^ bytes[i]) * 0x100000001b3ULL;
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t seed) {
+  for (unsigned char c : bytes) seed = (seed ^ c) * 0x100000001b3ULL;
   return seed;
+}
+
+std::uint64_t hash_state(const State& state, std::uint64_t seed) {
+  return fnv1a({reinterpret_cast<const char*>(state.data()), sizeof(State)}, seed);
 }
 
 void require_finite(std::span<const double> values, std::string_view what) {

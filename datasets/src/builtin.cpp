@@ -13,8 +13,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string short_hash(const std::string& text) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ULL;
+  const std::uint64_t h = fnv1a(text);
   char hex[9];
   std::snprintf(hex, sizeof hex, "%08llx", static_cast<unsigned long long>(h >> 32));
   return hex;

@@ -38,9 +38,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
 }
 
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
-  std::string key = to_json(world);
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : key) h = (h ^ c) * 0x100000001b3ULL;
+  const std::uint64_t h = fnv1a(to_json(world));
   char name[40];
   std::snprintf(name, sizeof name, "expert-v1-%08llx", static_cast<unsigned long long>(h >> 32));
   const auto dir = cache_dir() / name;
