@@ -145,6 +145,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
     std::vector<std::string> out;
     if (learner == "dagger") out = paper ? std::vector<std::string>{"iterations=5", "rollouts=20"}
                                          : std::vector<std::string>{"iterations=2", "rollouts=10"};
+    if (learner == "dad" && !paper) out = {"windows=2", "iterations=1", "corrector_iterations=10"};  // paper: its defaults
     for (const auto& kv : opt.options) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -156,12 +157,14 @@ int run_leaderboard(const LeaderboardOptions& opt) {
     return out;
   };
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
-  for (const auto& l : learners) LearnerRegistry::global().info(l);
+  for (const auto& l : learners)
+    if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
+      throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
 
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
   const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
-  std::vector<Episode> train;
+  std::vector<Episode> train, held_out;
   if (opt.split == "rows") {
     Episode rows;
     rows.name = "training-rows";
@@ -176,8 +179,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
     }
     train.push_back(std::move(rows));
   } else {
-    for (std::size_t i = 0; i < set.episodes.size(); ++i)
-      if (i % 5 != 4) train.push_back(set.episodes[i]);
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) (is_test_episode(i) ? held_out : train).push_back(set.episodes[i]);
   }
   const auto sigma = column_sigma(split.train.y);
 
@@ -228,6 +230,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
         c.seed = seed;
         c.threads = opt.threads;
         c.demos = train;
+        c.held_out = held_out;
         const auto t0 = std::chrono::steady_clock::now();
         const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
         row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;

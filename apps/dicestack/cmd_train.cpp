@@ -19,10 +19,10 @@ struct TrainOptions {
   DemosOption demos;
   std::string regressor, learner = "bc", split = "episodes";
   std::vector<std::string> sets, options;
-  std::filesystem::path out;
+  std::filesystem::path out, checkpoint;
   std::uint64_t seed = 0;
   int threads = 0;
-  bool json = false;
+  bool json = false, resume = false;
 };
 
 int run_train(const TrainOptions& opt) {
@@ -34,27 +34,38 @@ int run_train(const TrainOptions& opt) {
   std::vector<Episode> train = set.episodes, test;
   if (opt.split == "episodes") {
     train.clear();
-    for (std::size_t i = 0; i < set.episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(set.episodes[i]);
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) (is_test_episode(i) ? test : train).push_back(set.episodes[i]);
   }
   LearnContext c;
   c.demos = train;
+  c.held_out = test;
   c.world = world;
   c.regressor = opt.regressor;
   c.regressor_sets = opt.sets;
   c.seed = opt.seed;
   c.threads = opt.threads;
+  c.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
+  c.resume = opt.resume;
+  ProgressBar bar;
   c.progress = [&](const Progress& p) {
-    print_progress(opt.learner + " " + opt.regressor + ": " + p.phase + " " + std::to_string(p.iteration) + "/" +
-                   std::to_string(p.iterations) + " (" + std::to_string(p.done) + "/" + std::to_string(p.total) + ")");
+    std::string text = opt.learner + " " + opt.regressor + ": iteration " + std::to_string(p.iteration) + "/" +
+                       std::to_string(p.iterations);
+    if (p.windows > 0) text += ", window " + std::to_string(p.window) + "/" + std::to_string(p.windows);
+    text += ", " + p.phase;
+    if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
+    bar.update(p.fraction, text);
   };
   const auto t0 = std::chrono::steady_clock::now();
   LearnResult r = learner->learn(c);
+  bar.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.model->record["learner"] = opt.learner;
   r.model->record["learner_options"] = learner->params().summary();
   r.model->record["demos"] = dir.string();
   r.model->record["split"] = opt.split;
   save_model(*r.model, opt.out);
+  const std::filesystem::path curve_path = opt.out.string() + ".curve.csv";
+  if (!r.curve.empty()) write_curve_csv(r.curve, curve_path);
   const Dataset train_d = make_dataset(train);
   const auto sigma = column_sigma(train_d.y);
   const double train_error = scaled_l1_error(train_d.y, r.model->predict(train_d.x), sigma);
@@ -67,6 +78,7 @@ int run_train(const TrainOptions& opt) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
                      {"seconds", seconds},        {"train_error", train_error}};
     if (test_error >= 0) j["test_error"] = test_error;
+    if (!r.curve.empty()) j["curve"] = curve_path.string();
     print_line(j.dump());
   } else {
     char line[256];
@@ -88,14 +100,19 @@ void add_train_command(CLI::App& app) {
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressor", opt->regressor, "Regressor name (see `dicestack regressors`)")->required();
   cmd->add_option("--set", opt->sets, "key=value parameter of the regressor; repeatable");
-  cmd->add_option("--learner", opt->learner, "Learner: bc (more with `dicestack learners`)")->capture_default_str();
+  cmd->add_option("--learner", opt->learner, "Learner: bc, dagger, dad (see `dicestack learners`)")->capture_default_str();
   cmd->add_option("--option", opt->options, "key=value option of the learner; repeatable");
-  cmd->add_option("--split", opt->split, "episodes: train on episodes i % 5 != 4 and report test error; none: all")
+  cmd->add_option("--split", opt->split,
+                  "episodes: train on episodes i % 5 != 4, report test error and give the rest to learners as "
+                  "held-out demonstrations; none: all")
       ->check(CLI::IsMember({"episodes", "none"}))
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Model file to write")->required();
   cmd->add_option("--seed", opt->seed, "Seed of every random choice")->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--checkpoint", opt->checkpoint,
+                  "Folder for an iterative learner's checkpoints (default: MODEL.checkpoint); kept after the run");
+  cmd->add_flag("--resume", opt->resume, "Continue from the checkpoint's last finished iteration");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt] { run_train(*opt); });
 }

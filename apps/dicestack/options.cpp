@@ -1,5 +1,6 @@
 #include "options.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -23,6 +24,44 @@ void print_progress(const std::string& text) {
   static const bool tty = isatty(fileno(stderr));
   if (tty) std::cerr << "\r\033[K" << text << std::flush;
   else std::cerr << text << '\n';
+}
+
+namespace {
+
+std::string clock_text(double seconds) {
+  const auto s = static_cast<long>(seconds + 0.5);
+  char out[32];
+  if (s >= 3600) std::snprintf(out, sizeof out, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  else std::snprintf(out, sizeof out, "%ld:%02ld", s / 60, s % 60);
+  return out;
+}
+
+}  // namespace
+
+ProgressBar::ProgressBar(double quiet_seconds)
+    : start_(std::chrono::steady_clock::now()), last_print_(start_), quiet_(quiet_seconds) {}
+
+void ProgressBar::update(double fraction, const std::string& text) {
+  static const bool tty = isatty(fileno(stderr));
+  const auto now = std::chrono::steady_clock::now();
+  if (!tty && printed_ && std::chrono::duration<double>(now - last_print_).count() < quiet_) return;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  constexpr int width = 20;
+  const int filled = static_cast<int>(fraction * width);
+  std::string line = "[" + std::string(static_cast<std::size_t>(filled), '#') + std::string(static_cast<std::size_t>(width - filled), '-') + "] ";
+  char pct[16];
+  std::snprintf(pct, sizeof pct, "%3.0f%% ", 100.0 * fraction);
+  line += pct + text + "  elapsed " + clock_text(elapsed);
+  if (fraction > 0.01) line += ", left ~" + clock_text(elapsed * (1.0 - fraction) / fraction);
+  print_progress(line);
+  last_print_ = now;
+  printed_ = true;
+}
+
+void ProgressBar::finish() {
+  static const bool tty = isatty(fileno(stderr));
+  if (tty && printed_) std::cerr << '\n';
 }
 
 void DemosOption::add_to(CLI::App& app) {

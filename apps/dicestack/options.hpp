@@ -1,5 +1,6 @@
 #pragma once
 // Options shared by several subcommands.
+#include <chrono>
 #include <filesystem>
 #include <string>
 
@@ -23,6 +24,22 @@ void print_line(const std::string& text);
 
 /// Prints progress on stderr (overwriting the line when stderr is a terminal).
 void print_progress(const std::string& text);
+
+/// A progress bar on stderr: [#####-----] 50% text, elapsed and estimated time left. On a
+/// terminal it redraws one line; otherwise it prints at most one line per `quiet_seconds`.
+class ProgressBar {
+ public:
+  explicit ProgressBar(double quiet_seconds = 10.0);
+  /// `fraction` of the whole job done, in [0, 1].
+  void update(double fraction, const std::string& text);
+  /// Ends the bar's line on a terminal.
+  void finish();
+
+ private:
+  std::chrono::steady_clock::time_point start_, last_print_;
+  double quiet_;
+  bool printed_ = false;
+};
 
 /// `--demos DIR`: a demonstration folder; without it, the built-in set.
 struct DemosOption {

@@ -5,9 +5,11 @@
 
 namespace dicestack {
 
-double state_distance(const State& a, const State& b, const CostConfig& cost) {
+namespace {
+
+double scaled_sq(const State& a, const State& b, const CostConfig& cost, std::size_t first) {
   double sum = 0.0;
-  for (std::size_t j = 3; j < kStateDim; ++j) {
+  for (std::size_t j = first; j < kStateDim; ++j) {
     double diff = a[j] - b[j];
     const bool die_angle = j < 21 && (j - 3) % 6 == 2;
     if (die_angle) {
@@ -17,8 +19,14 @@ double state_distance(const State& a, const State& b, const CostConfig& cost) {
     diff /= cost.sigma[j];
     sum += diff * diff;
   }
-  return std::sqrt(sum);
+  return sum;
 }
+
+}  // namespace
+
+double state_distance(const State& a, const State& b, const CostConfig& cost) { return std::sqrt(scaled_sq(a, b, cost, 3)); }
+
+double tracking_distance_sq(const State& a, const State& b, const CostConfig& cost) { return scaled_sq(a, b, cost, 0); }
 
 double discounted_cost(std::span<const State> trajectory, const State& goal, const CostConfig& cost) {
   // Summed from the end so the weight is a running product, not a power per step.

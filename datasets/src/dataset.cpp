@@ -46,9 +46,11 @@ Dataset make_dataset(const std::vector<Episode>& episodes) {
   return stack(all);
 }
 
+bool is_test_episode(std::size_t index) { return index % 5 == 4; }
+
 Split split_by_episode(const std::vector<Episode>& episodes) {
   std::vector<const Episode*> train, test;
-  for (std::size_t i = 0; i < episodes.size(); ++i) (i % 5 == 4 ? test : train).push_back(&episodes[i]);
+  for (std::size_t i = 0; i < episodes.size(); ++i) (is_test_episode(i) ? test : train).push_back(&episodes[i]);
   if (train.empty()) throw InputError("episode split: no training episode among " + std::to_string(episodes.size()));
   Split s{stack(train), stack(test),
           "episodes: i % 5 == 4 is test (" + std::to_string(test.size()) + " of " + std::to_string(episodes.size()) +

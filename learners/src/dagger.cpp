@@ -1,17 +1,15 @@
 #include <atomic>
 #include <cmath>
-#include <fstream>
 #include <optional>
 
-#include <nlohmann/json.hpp>
-
-#include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/learner.hpp>
+
+#include "checkpoint.hpp"
 
 namespace dicestack {
 namespace {
@@ -32,12 +30,10 @@ class Dagger final : public Learner {
     std::shared_ptr<Model> model;
     LearnResult result;
     int first = 1;
-    if (c.resume && !c.checkpoint_dir.empty() && fs::exists(c.checkpoint_dir / "dagger.json")) {
-      const auto state = nlohmann::json::parse(std::ifstream(c.checkpoint_dir / "dagger.json"));
+    if (const auto state = load_checkpoint_state(c, "dagger.json"); !state.is_null()) {
       first = state.at("iteration").get<int>() + 1;
       data = read_demo_set(c.checkpoint_dir / "data").episodes;
-      for (const auto& p : state.at("curve"))
-        result.curve.push_back({p.at(0), p.at(1), 0.0, p.at(2), p.at(3), p.at(4)});
+      result.curve = curve_from_json(state.at("curve"));
     }
     if (!data.empty()) model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
 
@@ -55,20 +51,20 @@ class Dagger final : public Learner {
         if (!expert) expert = make_expert(expert_name);
         fresh[k] = mixture_rollout(*env, *expert, model.get(), beta, derive_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
         const int done = ++finished;
-        if (c.progress && w == 0) c.progress({"rollouts", i, iterations, done, rollouts});  // one thread reports
+        if (c.progress && w == 0)  // one thread reports
+          c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
       });
-      CurvePoint point{i, 0, 0.0, 0.0, 0.0, 0.0};
-      for (const auto& e : fresh) {
-        point.stacked_rate += e.outcome.stacked / static_cast<double>(rollouts);
-        point.realistic_success_rate += e.outcome.realistic_success() / static_cast<double>(rollouts);
-        point.dice_in_cup_mean += e.outcome.dice_in_cup / static_cast<double>(rollouts);
-      }
       for (auto& e : fresh) data.push_back(std::move(e));
-      if (c.progress) c.progress({"fit", i, iterations, 0, 1});
+      if (c.progress) c.progress({"fit", i, iterations, 0, 0, 0, 1, static_cast<double>(i) / iterations});
       model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(i)));
-      for (const auto& e : data) point.dataset_rows += e.size();
-      result.curve.push_back(point);
-      if (!c.checkpoint_dir.empty()) save_checkpoint(c, i, data, result.curve, beta);
+      std::size_t rows = 0;
+      for (const auto& e : data) rows += e.size();
+      result.curve.push_back(measure_policy(model, c, c.demos, i, rows));
+      if (!c.checkpoint_dir.empty())
+        save_checkpoint(c.checkpoint_dir, "dagger.json",
+                        {{"iteration", i}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta},
+                         {"curve", curve_to_json(result.curve)}},
+                        c, data, "DAgger aggregate after round " + std::to_string(i));
     }
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";
@@ -116,25 +112,6 @@ class Dagger final : public Learner {
     }
     e.outcome = env.outcome();
     return e;
-  }
-
-  // Each round's aggregate is saved whole (so a person could also label between rounds), then
-  // the small state file that points at it; a run killed in between resumes from the last one.
-  static void save_checkpoint(const LearnContext& c, int i, const std::vector<Episode>& data,
-                              const std::vector<CurvePoint>& curve, double beta) {
-    fs::create_directories(c.checkpoint_dir);
-    DemoSet set;
-    set.world = c.world;
-    set.description = "DAgger aggregate after round " + std::to_string(i);
-    set.provenance = "dicestack dagger, seed " + std::to_string(c.seed) + ", beta " + std::to_string(beta);
-    set.episodes = data;
-    write_demo_set(set, c.checkpoint_dir / "data");
-    nlohmann::json points = nlohmann::json::array();
-    for (const auto& p : curve)
-      points.push_back({p.iteration, p.dataset_rows, p.stacked_rate, p.realistic_success_rate, p.dice_in_cup_mean});
-    AtomicFile f(c.checkpoint_dir / "dagger.json");
-    f.stream() << nlohmann::json{{"iteration", i}, {"seed", c.seed}, {"regressor", c.regressor}, {"curve", points}}.dump();
-    f.commit();
   }
 };
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
@@ -122,22 +123,49 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
   return stats;
 }
 
-EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& config, int threads) {
-  // Long recordings must not be cut by the time limit; leave two seconds to settle.
+namespace {
+
+// Rolls a policy out from every demonstration's first state. Long recordings must not be cut by
+// the time limit; leave two seconds to settle.
+std::vector<Episode> rollouts_from_demos(const std::function<std::unique_ptr<Policy>(std::size_t)>& make_policy,
+                                         const std::vector<Episode>& demos, const WorldConfig& config, int threads) {
   WorldConfig world = config;
   for (const auto& d : demos)
     world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 60);
   const int workers = resolve_threads(threads);
   std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
   std::vector<Episode> eps(demos.size());
-  const auto t0 = std::chrono::steady_clock::now();
   parallel_for(demos.size(), threads, [&](std::size_t i, int w) {
     auto& env = envs[static_cast<std::size_t>(w)];
     if (!env) env.emplace(world);
-    PlaybackPolicy policy(demos[i]);
-    eps[i] = rollout(*env, policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
+    const auto policy = make_policy(i);
+    eps[i] = rollout(*env, *policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
   });
+  return eps;
+}
+
+}  // namespace
+
+EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto eps = rollouts_from_demos([&](std::size_t i) { return std::make_unique<PlaybackPolicy>(demos[i]); },
+                                       demos, world, threads);
   return summarise(eps, 0.0, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+Tracking track_demos(const PolicyFactory& make_policy, const std::vector<Episode>& demos, const WorldConfig& world,
+                     int threads) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto eps = rollouts_from_demos([&](std::size_t) { return make_policy(); }, demos, world, threads);
+  Tracking t;
+  for (std::size_t i = 0; i < demos.size(); ++i) {
+    const std::size_t n = std::min(demos[i].size(), eps[i].size());
+    double sum = 0.0;
+    for (std::size_t k = 0; k < n; ++k) sum += std::sqrt(tracking_distance_sq(eps[i].states[k], demos[i].states[k], world.cost));
+    t.deviation += sum / static_cast<double>(std::max<std::size_t>(n, 1)) / static_cast<double>(demos.size());
+  }
+  t.stats = summarise(eps, 0.0, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  return t;
 }
 
 }  // namespace dicestack

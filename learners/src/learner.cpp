@@ -1,18 +1,27 @@
 #include <dicestack/learners/learner.hpp>
 
+#include <fstream>
+
+#include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/evaluate.hpp>
+
+#include "checkpoint.hpp"
 
 namespace dicestack {
 
 void register_bc(LearnerRegistry&);
 void register_dagger(LearnerRegistry&);
+void register_dad(LearnerRegistry&);
 
 LearnerRegistry& LearnerRegistry::global() {
   static LearnerRegistry* registry = [] {
     auto* r = new LearnerRegistry;
     register_bc(*r);
     register_dagger(*r);
+    register_dad(*r);
     return r;
   }();
   return *registry;
@@ -54,6 +63,67 @@ std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episod
   model->record["episodes"] = std::to_string(d.episodes());
   model->record["seed"] = std::to_string(seed);
   return model;
+}
+
+namespace fs = std::filesystem;
+
+void write_curve_csv(const std::vector<CurvePoint>& curve, const fs::path& path) {
+  AtomicFile f(path);
+  auto& os = f.stream();
+  os.precision(17);
+  os << "iteration,window,dataset_rows,deviation,stacked_rate,realistic_success_rate,dice_in_cup_mean\n";
+  for (const auto& p : curve)
+    os << p.iteration << ',' << p.window << ',' << p.dataset_rows << ',' << p.deviation << ',' << p.stacked_rate << ','
+       << p.realistic_success_rate << ',' << p.dice_in_cup_mean << '\n';
+  f.commit();
+}
+
+nlohmann::json curve_to_json(const std::vector<CurvePoint>& curve) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& p : curve)
+    out.push_back({{"iteration", p.iteration}, {"window", p.window}, {"dataset_rows", p.dataset_rows},
+                   {"deviation", p.deviation}, {"stacked_rate", p.stacked_rate},
+                   {"realistic_success_rate", p.realistic_success_rate}, {"dice_in_cup_mean", p.dice_in_cup_mean}});
+  return out;
+}
+
+std::vector<CurvePoint> curve_from_json(const nlohmann::json& json) {
+  std::vector<CurvePoint> out;
+  for (const auto& p : json)
+    out.push_back({p.at("iteration"), p.at("window"), p.at("dataset_rows"), p.at("deviation"), p.at("stacked_rate"),
+                   p.at("realistic_success_rate"), p.at("dice_in_cup_mean")});
+  return out;
+}
+
+void save_checkpoint(const fs::path& dir, const std::string& state_file, const nlohmann::json& state,
+                     const LearnContext& c, const std::vector<Episode>& data, const std::string& description) {
+  fs::create_directories(dir);
+  DemoSet set;
+  set.world = c.world;
+  set.description = description;
+  set.provenance = "dicestack " + description + ", seed " + std::to_string(c.seed) + ", regressor " + c.regressor;
+  set.episodes = data;
+  write_demo_set(set, dir / "data");
+  AtomicFile f(dir / state_file);
+  f.stream() << state.dump();
+  f.commit();
+}
+
+nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file) {
+  if (!c.resume || c.checkpoint_dir.empty() || !fs::exists(c.checkpoint_dir / state_file)) return nullptr;
+  const fs::path path = c.checkpoint_dir / state_file;
+  try {
+    return nlohmann::json::parse(std::ifstream(path));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
+  }
+}
+
+CurvePoint measure_policy(const std::shared_ptr<const Model>& model, const LearnContext& c,
+                          const std::vector<Episode>& fallback, int iteration, std::size_t rows) {
+  const auto& demos = c.held_out.empty() ? fallback : c.held_out;
+  const Tracking t = track_demos([&] { return std::make_unique<ModelPolicy>(model); }, demos, c.world, c.threads);
+  return {iteration, 0, rows, t.deviation, t.stats.stacked.value, t.stats.realistic_success.value, t.stats.dice_in_cup_mean};
 }
 
 }  // namespace dicestack

@@ -13,6 +13,10 @@ namespace dicestack {
 /// cup's pose is free. Die angles compare modulo 90 degrees (a turned die is the same die).
 double state_distance(const State& a, const State& b, const CostConfig& cost);
 
+/// Squared scaled L2 distance over all 24 dimensions, die angles modulo 90 degrees: how far a
+/// state is from the demonstration state it should follow (eq. 11; the cup's pose counts).
+double tracking_distance_sq(const State& a, const State& b, const CostConfig& cost);
+
 /// Eq. 6 for one trajectory s_1..s_T: sum_j gamma^(T - j) d(s_j, goal).
 double discounted_cost(std::span<const State> trajectory, const State& goal, const CostConfig& cost);
 

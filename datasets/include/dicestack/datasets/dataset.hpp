@@ -35,6 +35,9 @@ struct Split {
   std::string description;  ///< e.g. "episodes: i % 5 == 4 is test (14 of 68)"
 };
 
+/// DESIGN's default split rule: episode i (in file-name order) is a test episode when i % 5 == 4.
+bool is_test_episode(std::size_t index);
+
 /// DESIGN's default: episode i (in file-name order) is a test episode when i % 5 == 4.
 /// Throws InputError if that leaves no training episode.
 Split split_by_episode(const std::vector<Episode>& episodes);

@@ -53,4 +53,15 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
 /// Replays every demonstration's actions from its own first state (paper VI-A).
 EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads);
 
+/// How a policy follows demonstrations when started from each one's first state.
+struct Tracking {
+  double deviation = 0.0;  ///< mean over demonstrations of the mean over steps of sqrt(eq. 11's term)
+  EvalStats stats;         ///< outcomes of those rollouts
+};
+
+/// Rolls `policy` out from every demonstration's first state (in parallel, one world per
+/// thread; the time limit stretched to cover the longest) and compares with the demonstration.
+Tracking track_demos(const PolicyFactory& make_policy, const std::vector<Episode>& demos, const WorldConfig& world,
+                     int threads);
+
 }  // namespace dicestack

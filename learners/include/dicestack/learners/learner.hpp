@@ -19,23 +19,32 @@ struct Progress {
   std::string phase;    ///< e.g. "fit", "rollouts", "corrections"
   int iteration = 0;    ///< 1-based, of `iterations`
   int iterations = 0;
+  int window = 0;       ///< DaD: 1-based window of `windows` (0 for other learners)
+  int windows = 0;
   int done = 0;         ///< work items finished in this phase
   int total = 0;
+  double fraction = 0.0;  ///< of the whole run's work, in [0, 1], for an estimate of the time left
 };
 
-/// One point of a learning curve.
+/// One point of a learning curve: the policy after an iteration, rolled out from the
+/// evaluation demonstrations' first states (the held-out ones when there are any).
 struct CurvePoint {
   int iteration = 0;
-  std::size_t dataset_rows = 0;
-  double deviation = 0.0;  ///< mean scaled distance of policy rollouts from the demonstrations
+  int window = 0;               ///< DaD's window (0 for other learners)
+  std::size_t dataset_rows = 0; ///< rows the policy was fitted on
+  double deviation = 0.0;       ///< mean over steps of the scaled distance to the demonstration
   double stacked_rate = 0.0;
   double realistic_success_rate = 0.0;
   double dice_in_cup_mean = 0.0;
 };
 
+/// Writes a learning curve as CSV (one header row, one row per point), atomically.
+void write_curve_csv(const std::vector<CurvePoint>& curve, const std::filesystem::path& path);
+
 /// Everything a learner needs.
 struct LearnContext {
   std::vector<Episode> demos;  ///< training demonstrations
+  std::vector<Episode> held_out;  ///< demonstrations not trained on, to measure and select policies; may be empty
   WorldConfig world;
   std::string regressor = "knn";
   std::vector<std::string> regressor_sets;  ///< "key=value" for the regressor
@@ -71,6 +80,7 @@ struct LearnerInfo {
   std::string description;
   std::vector<ParamSpec> params;
   std::function<std::unique_ptr<Learner>(std::string, Params)> factory;
+  bool needs_trajectories = false;  ///< learns from whole episodes, so not from shuffled rows
 };
 
 /// Learners by name ("bc", "dagger", "dad"); built-ins registered on first use.

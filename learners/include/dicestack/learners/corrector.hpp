@@ -1,0 +1,54 @@
+#pragma once
+// DaD's corrector (paper eq. 11): from the world a policy drifted into, find the next w actions
+// whose simulated states follow the demonstration's next w states. Pluggable: CMA-ES (ours) by
+// default, differential evolution from pagmo as the alternative.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/core/env.hpp>
+
+namespace dicestack {
+
+/// One window to correct.
+struct CorrectionProblem {
+  EnvSnapshot start;           ///< the world where the window begins (the policy's, drifted)
+  std::vector<State> target;   ///< the demonstration's states after each of the w steps
+  std::vector<Action> warm;    ///< the policy's own w actions from `start`: the search starts here
+};
+
+/// The best actions found and the trajectory they produce.
+struct Correction {
+  std::vector<State> states;    ///< the state before each corrected action (states[0] is start's)
+  std::vector<Action> actions;  ///< in the world's units, within its limits: labels as they are applied
+  double cost = 0.0;            ///< eq. 11: sum over the window of the squared scaled distance
+  double warm_cost = 0.0;       ///< the same for the policy's own actions
+  int evaluations = 0;          ///< window simulations spent
+};
+
+/// Squared scaled distance (all 24 dimensions) summed over the window when `actions` are
+/// applied from `problem.start`; fills `states` (may be null) with the states before each action.
+double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
+                   std::vector<State>* states = nullptr);
+
+/// Searches in the optimisers' scaled action space (x = action / ActionConfig::scale), clipped
+/// to the world's limits.
+class Corrector {
+ public:
+  virtual ~Corrector() = default;
+  /// `env` is scratch: its episode is overwritten. Never returns worse than the warm start.
+  virtual Correction correct(DiceEnv& env, const CorrectionProblem& problem, std::uint64_t seed) const = 0;
+};
+
+struct CorrectorOptions {
+  int iterations = 50;   ///< generations
+  double sigma0 = 0.25;  ///< initial spread in scaled action units
+  int population = 0;    ///< 0: pycma's 4 + floor(3 ln n)
+};
+
+/// "cmaes" or "de"; throws ConfigError for another name.
+std::unique_ptr<Corrector> make_corrector(std::string_view name, const CorrectorOptions& options);
+
+}  // namespace dicestack

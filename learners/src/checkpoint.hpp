@@ -1,0 +1,31 @@
+#pragma once
+// What the iterative learners (DAgger, DaD) share: the checkpoint of a finished iteration (the
+// aggregated data as a demonstration folder, then a small JSON state that points at it) and
+// the measurement of a policy that goes into the learning curve.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/learners/learner.hpp>
+
+namespace dicestack {
+
+nlohmann::json curve_to_json(const std::vector<CurvePoint>& curve);
+std::vector<CurvePoint> curve_from_json(const nlohmann::json& json);
+
+/// Writes `data` to dir/data, then `state` to dir/<state_file> (both atomically), in that order,
+/// so the state never points at data that is not there.
+void save_checkpoint(const std::filesystem::path& dir, const std::string& state_file, const nlohmann::json& state,
+                     const LearnContext& context, const std::vector<Episode>& data, const std::string& description);
+
+/// The state of the last finished iteration, or null when there is none to resume from.
+nlohmann::json load_checkpoint_state(const LearnContext& context, const std::string& state_file);
+
+/// A curve point for `model`: rolled out from the held-out demonstrations' first states, or
+/// from `fallback`'s when there are none.
+CurvePoint measure_policy(const std::shared_ptr<const Model>& model, const LearnContext& context,
+                          const std::vector<Episode>& fallback, int iteration, std::size_t rows);
+
+}  // namespace dicestack
