@@ -146,6 +146,45 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
   EXPECT_THAT(p.output, HasSubstr("unknown learner \"nope\""));
 }
 
+TEST(CliLearning, DadTrainsWithACurveAndRefusesTheRowSplit) {
+  const auto model = std::filesystem::temp_directory_path() / "dicestack_cli_dad.dsm";
+  const Process t = run("train --demos " + kTinyDemos + " --regressor knn --learner dad --split none --option windows=1 "
+                        "--option corrector_iterations=1 --option demos=1 --json --out " + model.string(), false);
+  ASSERT_EQ(t.status, 0) << t.output;
+  const auto j = nlohmann::json::parse(t.output);
+  std::ifstream curve(j.at("curve").get<std::string>());
+  std::string header, line;
+  std::getline(curve, header);
+  EXPECT_EQ(header, "iteration,window,dataset_rows,deviation,stacked_rate,realistic_success_rate,dice_in_cup_mean");
+  int rows = 0;
+  while (std::getline(curve, line)) ++rows;
+  EXPECT_EQ(rows, 4);  // the starting policy and 3 iterations of the one window
+  std::filesystem::remove_all(model.string() + ".checkpoint");
+  std::filesystem::remove(model.string() + ".curve.csv");
+  std::filesystem::remove(model);
+  const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners dad --split rows");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("use --split episodes"));
+}
+
+TEST(CliBaselines, OptimiseWritesTheBestSequenceAndItsOutcome) {
+  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_optimise";
+  std::filesystem::remove_all(out);
+  const Process o = run("optimise --method cmaes --steps 5 --evaluations 40 --seed 3 --json --out " + out.string(), false);
+  ASSERT_EQ(o.status, 0) << o.output;
+  const auto j = nlohmann::json::parse(o.output);
+  for (const char* key : {"best_cost", "evaluations", "evaluations_per_second", "dice_in_cup", "stacked", "wall_contact",
+                          "realistic_success"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_LE(j["evaluations"].get<int>(), 40);
+  const Process d = run("dataset validate " + out.string());
+  EXPECT_EQ(d.status, 0) << d.output;
+  EXPECT_TRUE(std::filesystem::exists(out / "optimise.json"));
+  std::filesystem::remove_all(out);
+  EXPECT_NE(run("optimise --method annealing --out " + out.string()).status, 0);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
   const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn,linear_svr --learners bc --episodes 2 --seed 4 ";
   const Process a = run(args + "--format json", false), b = run(args + "--format json", false);

@@ -1,0 +1,199 @@
+// `dicestack optimise`: the paper's open-loop baselines (Section V-B), and `dicestack bench
+// optimise`: evaluations per second of each optimiser against the bare simulator.
+#include <chrono>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/open_loop.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct OptimiseCommandOptions {
+  WorldOption world;
+  OptimiseOptions optimiser;
+  OpenLoopSettings settings;
+  double gravity_scale = 1.0, noise = 0.0, discount = -1.0;
+  int threads = 0;
+  std::filesystem::path out;
+  bool json = false;
+};
+
+// The world the options describe: gravity scaled, action noise and discount set.
+WorldConfig open_loop_world(const OptimiseCommandOptions& opt) {
+  WorldConfig w = opt.world.load();
+  w.physics.gravity.x *= opt.gravity_scale;
+  w.physics.gravity.y *= opt.gravity_scale;
+  w.physics.action_noise = opt.noise;
+  if (opt.discount >= 0.0) w.cost.gamma = opt.discount;
+  return w;
+}
+
+// The best sequence played once from the paper's start (with the first repeat's noise seed).
+Episode replay(const WorldConfig& world, const OpenLoopProblem& problem, const OptimiseResult& r, std::uint64_t seed) {
+  DiceEnv env(problem.world());
+  Episode e;
+  e.name = "episode_0000";
+  e.origin = "dicestack optimise";
+  e.seed = derive_seed(seed, 0);
+  State s = env.reset_to(paper_start_state(world), e.seed);
+  for (const Action& a : problem.actions(r.best.data())) {
+    e.states.push_back(s);
+    e.actions.push_back(a);
+    e.sources.push_back(StepSource::policy);
+    s = env.step(a).observation;
+  }
+  e.outcome = env.outcome();
+  return e;
+}
+
+int run_optimise(OptimiseCommandOptions opt) {
+  const WorldConfig world = open_loop_world(opt);
+  OpenLoopProblem problem(world, opt.settings, opt.threads);
+  ProgressBar bar;
+  const OptimiseResult r = optimise(problem, opt.optimiser, [&](int evaluations, double best) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%s: %d/%d evaluations, best cost %.4g", opt.optimiser.method.c_str(), evaluations,
+                  opt.optimiser.evaluations, best);
+    bar.update(static_cast<double>(evaluations) / opt.optimiser.evaluations, text);
+  });
+  bar.finish();
+  const Episode best = replay(world, problem, r, opt.settings.seed);
+  DemoSet set;
+  set.world = problem.world();
+  set.description = "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method;
+  set.provenance = "dicestack optimise --method " + opt.optimiser.method + " --steps " + std::to_string(opt.settings.steps) +
+                   " --evaluations " + std::to_string(opt.optimiser.evaluations) + " --seed " + std::to_string(opt.optimiser.seed);
+  set.episodes.push_back(best);
+  write_demo_set(set, opt.out);
+  const double rate = r.evaluations / std::max(r.seconds, 1e-9);
+  nlohmann::json curve = nlohmann::json::array();
+  for (const auto& [evals, cost] : r.curve) curve.push_back({evals, cost});
+  const nlohmann::json j{{"method", opt.optimiser.method},   {"steps", opt.settings.steps},
+                         {"evaluations", r.evaluations},      {"seconds", r.seconds},
+                         {"evaluations_per_second", rate},    {"best_cost", r.best_cost},
+                         {"dice_in_cup", best.outcome.dice_in_cup}, {"stacked", best.outcome.stacked},
+                         {"wall_contact", best.outcome.wall_contact}, {"realistic_success", best.outcome.realistic_success()},
+                         {"gravity_scale", opt.gravity_scale}, {"noise", opt.noise}, {"repeats", opt.settings.repeats},
+                         {"discount", world.cost.gamma},      {"seed", opt.optimiser.seed}, {"out", opt.out.string()}};
+  AtomicFile f(opt.out / "optimise.json");
+  nlohmann::json with_curve = j;
+  with_curve["curve"] = curve;
+  f.stream() << with_curve.dump(1);
+  f.commit();
+  if (opt.json) {
+    print_line(j.dump());
+    return 0;
+  }
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%s: best cost %.4g after %d evaluations in %.1f s (%.0f evaluations/s)\n"
+                "best sequence: dice in cup %d, stacked %s, wall contact %s, realistic success %s -> %s",
+                opt.optimiser.method.c_str(), r.best_cost, r.evaluations, r.seconds, rate, best.outcome.dice_in_cup,
+                best.outcome.stacked ? "yes" : "no", best.outcome.wall_contact ? "yes" : "no",
+                best.outcome.realistic_success() ? "yes" : "no", opt.out.string().c_str());
+  print_line(line);
+  return 0;
+}
+
+void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt) {
+  opt.world.add_to(cmd);
+  cmd.add_option("--steps", opt.settings.steps, "Control steps of the sequence (the original used 50, the paper's text 30)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd.add_option("--gravity-scale", opt.gravity_scale, "Multiplies gravity (the paper's text: 3)")->capture_default_str();
+  cmd.add_option("--noise", opt.noise, "Std of action noise, as a fraction of the action scale (0: deterministic)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd.add_option("--repeats", opt.settings.repeats, "Noisy runs averaged per evaluation")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd.add_option("--discount", opt.discount, "Discount gamma of eq. 6 (default: the world's, 0.1)")->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--threads", opt.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+}
+
+struct BenchOptimiseOptions {
+  OptimiseCommandOptions base;
+  std::vector<std::string> methods{"cmaes", "de", "basinhop", "bayes"};
+  int bayes_evaluations = 200;
+  bool json = false;
+};
+
+// Evaluations per second of each optimiser against evaluating the same number of random
+// sequences with no optimiser at all (simulation and cost only), on the same threads.
+int run_bench_optimise(BenchOptimiseOptions opt) {
+  const WorldConfig world = open_loop_world(opt.base);
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& method : opt.methods) {
+    OptimiseOptions o = opt.base.optimiser;
+    o.method = method;
+    if (method == "bayes") o.evaluations = std::min(o.evaluations, opt.bayes_evaluations);
+    OpenLoopProblem problem(world, opt.base.settings, opt.base.threads);
+    const OptimiseResult r = optimise(problem, o);
+    // Bare: the same evaluations as batches of 64 random sequences (parallel, like CMA-ES's).
+    OpenLoopProblem bare(world, opt.base.settings, method == "cmaes" ? opt.base.threads : 1);
+    Rng rng(o.seed);
+    Eigen::MatrixXd xs(64, static_cast<Eigen::Index>(bare.dim()));
+    for (Eigen::Index i = 0; i < xs.size(); ++i) xs.data()[i] = rng.uniform(-1.0, 1.0);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (bare.evaluations() < r.evaluations) bare.cost_batch(xs);
+    const double bare_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double rate = r.evaluations / r.seconds, bare_rate = bare.evaluations() / bare_s;
+    rows.push_back({{"method", method}, {"evaluations", r.evaluations}, {"seconds", r.seconds},
+                    {"evaluations_per_second", rate}, {"bare_evaluations_per_second", bare_rate},
+                    {"threads", method == "cmaes" ? opt.base.threads : 1}, {"best_cost", r.best_cost}});
+    if (!opt.json) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%-9s %6d evaluations %8.2f s  %8.0f eval/s  bare %8.0f eval/s (%s)  ratio %.2f  best cost %.4g",
+                    method.c_str(), r.evaluations, r.seconds, rate, bare_rate,
+                    method == "cmaes" ? "all threads" : "1 thread", rate / bare_rate, r.best_cost);
+      print_line(line);
+    }
+  }
+  if (opt.json) print_line(rows.dump());
+  return 0;
+}
+
+}  // namespace
+
+void add_optimise_command(CLI::App& app) {
+  auto opt = std::make_shared<OptimiseCommandOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "optimise", "Optimise an open-loop action sequence to the goal stack (paper V-B): cmaes, de, basinhop, bayes");
+  cmd->add_option("--method", opt->optimiser.method, "cmaes (ours), de (pagmo), basinhop (Metropolis + COBYLA), bayes (GP-EI)")
+      ->check(CLI::IsMember(optimiser_names()))
+      ->capture_default_str();
+  cmd->add_option("--evaluations", opt->optimiser.evaluations, "Budget of evaluations")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--sigma0", opt->optimiser.sigma0, "Initial step in x units ([-1, 1] per action)")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", opt->optimiser.seed, "Seed of the optimiser")->capture_default_str();
+  add_problem_options(*cmd, *opt);
+  cmd->add_option("--out", opt->out, "Folder for the best sequence (a demonstration set) and optimise.json")->required();
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] {
+    opt->settings.seed = opt->optimiser.seed;
+    run_optimise(*opt);
+  });
+}
+
+void add_bench_optimise_command(CLI::App& bench) {
+  auto opt = std::make_shared<BenchOptimiseOptions>();
+  opt->base.optimiser.evaluations = 1000;
+  CLI::App* cmd = bench.add_subcommand("optimise", "Evaluations per second of each optimiser against the bare simulator");
+  cmd->add_option("--methods", opt->methods, "Only these (comma-separated)")->delimiter(',');
+  cmd->add_option("--evaluations", opt->base.optimiser.evaluations, "Budget per optimiser")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--bayes-evaluations", opt->bayes_evaluations, "Budget for bayes (O(N^2) per evaluation)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--seed", opt->base.optimiser.seed, "Seed")->capture_default_str();
+  add_problem_options(*cmd, opt->base);
+  cmd->add_flag("--json", opt->json, "Print a JSON list");
+  cmd->callback([opt] { run_bench_optimise(*opt); });
+}
+
+}  // namespace dicestack::cli
