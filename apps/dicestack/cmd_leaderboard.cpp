@@ -231,6 +231,15 @@ int run_leaderboard(const LeaderboardOptions& opt) {
         c.threads = opt.threads;
         c.demos = train;
         c.held_out = held_out;
+        std::string last_phase;
+        c.progress = [&](const Progress& p) {  // one line per iteration and phase
+          const std::string phase = std::to_string(p.iteration) + p.phase;
+          if (phase == last_phase) return;
+          last_phase = phase;
+          print_progress("[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name +
+                         ": training (seed " + std::to_string(seed) + "), iteration " + std::to_string(p.iteration) + "/" +
+                         std::to_string(p.iterations) + ", " + p.phase);
+        };
         const auto t0 = std::chrono::steady_clock::now();
         const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
         row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
