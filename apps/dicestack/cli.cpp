@@ -23,6 +23,7 @@ int run(int argc, char** argv) {
   add_leaderboard_command(app);
   add_learners_command(app);
   add_optimise_command(app);
+  add_reinforce_command(app);
   add_play_command(app);
   add_train_command(app);
   add_record_command(app);

@@ -1,5 +1,7 @@
-// `dicestack optimise`: the paper's open-loop baselines (Section V-B), and `dicestack bench
-// optimise`: evaluations per second of each optimiser against the bare simulator.
+// The paper's baselines without demonstrations: `dicestack optimise` (open-loop sequences,
+// Section V-B), `dicestack reinforce` (Section V-C), and `dicestack bench optimise`:
+// evaluations per second of each optimiser against the bare simulator.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -8,6 +10,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/open_loop.hpp>
+#include <dicestack/core/reinforce.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
@@ -37,15 +40,15 @@ WorldConfig open_loop_world(const OptimiseCommandOptions& opt) {
   return w;
 }
 
-// The best sequence played once from the paper's start (with the first repeat's noise seed).
-Episode replay(const WorldConfig& world, const OpenLoopProblem& problem, const OptimiseResult& r, std::uint64_t seed) {
-  DiceEnv env(problem.world());
+// A baseline's action sequence played once from the paper's start, as an episode.
+Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin) {
+  DiceEnv env(world);
   Episode e;
   e.name = "episode_0000";
-  e.origin = "dicestack optimise";
-  e.seed = derive_seed(seed, 0);
+  e.origin = origin;
+  e.seed = seed;
   State s = env.reset_to(paper_start_state(world), e.seed);
-  for (const Action& a : problem.actions(r.best.data())) {
+  for (const Action& a : actions) {
     e.states.push_back(s);
     e.actions.push_back(a);
     e.sources.push_back(StepSource::policy);
@@ -53,6 +56,16 @@ Episode replay(const WorldConfig& world, const OpenLoopProblem& problem, const O
   }
   e.outcome = env.outcome();
   return e;
+}
+
+void write_episode_set(const WorldConfig& world, const Episode& e, const std::string& description,
+                       const std::string& provenance, const std::filesystem::path& out) {
+  DemoSet set;
+  set.world = world;
+  set.description = description;
+  set.provenance = provenance;
+  set.episodes.push_back(e);
+  write_demo_set(set, out);
 }
 
 int run_optimise(OptimiseCommandOptions opt) {
@@ -66,14 +79,12 @@ int run_optimise(OptimiseCommandOptions opt) {
     bar.update(static_cast<double>(evaluations) / opt.optimiser.evaluations, text);
   });
   bar.finish();
-  const Episode best = replay(world, problem, r, opt.settings.seed);
-  DemoSet set;
-  set.world = problem.world();
-  set.description = "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method;
-  set.provenance = "dicestack optimise --method " + opt.optimiser.method + " --steps " + std::to_string(opt.settings.steps) +
-                   " --evaluations " + std::to_string(opt.optimiser.evaluations) + " --seed " + std::to_string(opt.optimiser.seed);
-  set.episodes.push_back(best);
-  write_demo_set(set, opt.out);
+  // With noise, the first repeat's noise seed.
+  const Episode best = replay(problem.world(), problem.actions(r.best.data()), derive_seed(opt.settings.seed, 0), "dicestack optimise");
+  write_episode_set(problem.world(), best, "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method,
+                    "dicestack optimise --method " + opt.optimiser.method + " --steps " + std::to_string(opt.settings.steps) +
+                        " --evaluations " + std::to_string(opt.optimiser.evaluations) + " --seed " + std::to_string(opt.optimiser.seed),
+                    opt.out);
   const double rate = r.evaluations / std::max(r.seconds, 1e-9);
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& [evals, cost] : r.curve) curve.push_back({evals, cost});
@@ -160,7 +171,83 @@ int run_bench_optimise(BenchOptimiseOptions opt) {
   return 0;
 }
 
+struct ReinforceCommandOptions {
+  WorldOption world;
+  ReinforceOptions reinforce;
+  std::filesystem::path out;
+  bool json = false;
+};
+
+int run_reinforce(const ReinforceCommandOptions& opt) {
+  const WorldConfig world = opt.world.load();
+  ProgressBar bar;
+  const ReinforceResult r = reinforce(world, opt.reinforce, [&](const ReinforcePoint& p) {
+    char text[160];
+    std::snprintf(text, sizeof text, "reinforce: iteration %d/%d, mean return %.3g, greedy cost %.4g", p.iteration,
+                  opt.reinforce.iterations, p.mean_return, p.greedy_cost);
+    bar.update(static_cast<double>(p.iteration) / opt.reinforce.iterations, text);
+  });
+  bar.finish();
+  WorldConfig played = world;
+  played.episode.max_steps = std::max(played.episode.max_steps, opt.reinforce.steps);
+  const Episode greedy = replay(played, r.greedy_actions, 0, "dicestack reinforce");
+  write_episode_set(played, greedy, "the mean actions of the policy learned by dicestack reinforce",
+                    "dicestack reinforce --iterations " + std::to_string(opt.reinforce.iterations) + " --batch " +
+                        std::to_string(opt.reinforce.batch) + " --steps " + std::to_string(opt.reinforce.steps) + " --seed " +
+                        std::to_string(opt.reinforce.seed),
+                    opt.out);
+  nlohmann::json curve = nlohmann::json::array();
+  for (const auto& p : r.curve) curve.push_back({p.iteration, p.mean_return, p.greedy_cost});
+  const nlohmann::json j{{"iterations", opt.reinforce.iterations}, {"episodes", opt.reinforce.iterations * opt.reinforce.batch},
+                         {"seconds", r.seconds},  {"final_greedy_cost", r.curve.back().greedy_cost},
+                         {"final_mean_return", r.curve.back().mean_return},
+                         {"dice_in_cup", greedy.outcome.dice_in_cup}, {"stacked", greedy.outcome.stacked},
+                         {"wall_contact", greedy.outcome.wall_contact}, {"realistic_success", greedy.outcome.realistic_success()},
+                         {"seed", opt.reinforce.seed}, {"out", opt.out.string()}};
+  AtomicFile f(opt.out / "reinforce.json");
+  nlohmann::json with_curve = j;
+  with_curve["curve (iteration, mean return, greedy cost)"] = curve;
+  f.stream() << with_curve.dump(1);
+  f.commit();
+  if (opt.json) {
+    print_line(j.dump());
+    return 0;
+  }
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "reinforce: %d episodes in %.1f s; mean return %.4g -> %.4g, greedy cost %.4g -> %.4g\n"
+                "greedy policy: dice in cup %d, stacked %s, wall contact %s, realistic success %s -> %s",
+                opt.reinforce.iterations * opt.reinforce.batch, r.seconds, r.curve.front().mean_return, r.curve.back().mean_return,
+                r.curve.front().greedy_cost, r.curve.back().greedy_cost, greedy.outcome.dice_in_cup,
+                greedy.outcome.stacked ? "yes" : "no", greedy.outcome.wall_contact ? "yes" : "no",
+                greedy.outcome.realistic_success() ? "yes" : "no", opt.out.string().c_str());
+  print_line(line);
+  return 0;
+}
+
 }  // namespace
+
+void add_reinforce_command(CLI::App& app) {
+  auto opt = std::make_shared<ReinforceCommandOptions>();
+  auto& r = opt->reinforce;
+  CLI::App* cmd = app.add_subcommand("reinforce", "REINFORCE from the paper's start (paper V-C): a Gaussian policy on a 3-layer network");
+  opt->world.add_to(*cmd);
+  cmd->add_option("--iterations", r.iterations, "Policy updates")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--batch", r.batch, "Episodes per update")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--steps", r.steps, "Control steps per episode")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--hidden", r.hidden, "Units per hidden layer")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--sigma", r.sigma, "Exploration std, scaled action units")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--discount", r.discount, "Return discount")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  cmd->add_option("--baseline-decay", r.baseline_decay, "Moving-average factor of the per-timestep baseline")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--learning-rate", r.learning_rate, "Adam step size")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed")->capture_default_str();
+  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--out", opt->out, "Folder for the greedy episode (a demonstration set) and reinforce.json")->required();
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] { run_reinforce(*opt); });
+}
 
 void add_optimise_command(CLI::App& app) {
   auto opt = std::make_shared<OptimiseCommandOptions>();
