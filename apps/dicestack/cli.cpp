@@ -24,6 +24,7 @@ int run(int argc, char** argv) {
   add_learners_command(app);
   add_optimise_command(app);
   add_reinforce_command(app);
+  add_rrt_command(app);
   add_play_command(app);
   add_train_command(app);
   add_record_command(app);

@@ -26,5 +26,6 @@ void add_bench_load_command(CLI::App& bench);        // under `bench`
 void add_bench_optimise_command(CLI::App& bench);    // under `bench`
 void add_optimise_command(CLI::App& app);
 void add_reinforce_command(CLI::App& app);
+void add_rrt_command(CLI::App& app);
 
 }  // namespace dicestack::cli

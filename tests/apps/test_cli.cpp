@@ -185,6 +185,32 @@ TEST(CliBaselines, OptimiseWritesTheBestSequenceAndItsOutcome) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(CliBaselines, RrtWritesItsResult) {
+  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_rrt";
+  std::filesystem::remove_all(out);
+  const Process r = run("rrt --nodes 5 --extend-steps 2 --extend-iterations 2 --seed 1 --json --out " + out.string(), false);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["nodes"], 5);
+  EXPECT_EQ(j["path_steps"].get<int>() % 2, 0);
+  EXPECT_TRUE(std::filesystem::exists(out / "rrt.json"));
+  std::filesystem::remove_all(out);
+}
+
+TEST(CliBaselines, ReinforceWritesTheGreedyEpisodeAndItsCurve) {
+  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_reinforce";
+  std::filesystem::remove_all(out);
+  const Process r = run("reinforce --iterations 3 --batch 2 --steps 6 --seed 1 --json --out " + out.string(), false);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["episodes"], 6);
+  EXPECT_TRUE(j.contains("final_greedy_cost"));
+  const auto saved = nlohmann::json::parse(std::ifstream(out / "reinforce.json"));
+  EXPECT_EQ(saved["curve (iteration, mean return, greedy cost)"].size(), 3u);
+  EXPECT_EQ(run("dataset validate " + out.string()).status, 0);
+  std::filesystem::remove_all(out);
+}
+
 TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
   const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn,linear_svr --learners bc --episodes 2 --seed 4 ";
   const Process a = run(args + "--format json", false), b = run(args + "--format json", false);

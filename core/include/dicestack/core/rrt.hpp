@@ -1,0 +1,35 @@
+#pragma once
+// The paper's RRT variant (Section V-D): grow a tree of reachable world states from the paper's
+// start; each extension picks the node nearest a sampled state and optimises a few steps of
+// actions (CMA-ES) to move towards it. Nodes keep exact snapshots, so an extension continues
+// the very world its node reached (the original's reset to a bare state did not).
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <dicestack/core/env.hpp>
+
+namespace dicestack {
+
+struct RrtOptions {
+  int nodes = 300;             ///< extensions (tree size without the root)
+  int extend_steps = 5;        ///< control steps optimised per extension
+  int extend_iterations = 5;   ///< CMA-ES generations per extension
+  double goal_bias = 0.1;      ///< probability of sampling the goal state instead of a random one
+  int max_depth_steps = 400;   ///< a node this many steps from the root is not extended
+  std::uint64_t seed = 0;
+  int threads = 0;             ///< an extension's CMA-ES population is evaluated in parallel
+};
+
+struct RrtResult {
+  std::vector<Action> actions;  ///< from the root to the node nearest the goal
+  double best_distance = 0.0;   ///< eq. 6's d(s, goal) at that node
+  int nodes = 0;
+  long long simulated_steps = 0;
+  double seconds = 0.0;
+};
+
+/// Deterministic for a seed whatever the thread count. Throws ConfigError for bad options.
+RrtResult rrt(const WorldConfig& world, const RrtOptions& options, const std::function<void(int, double)>& progress = {});
+
+}  // namespace dicestack
