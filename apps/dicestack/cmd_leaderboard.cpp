@@ -13,6 +13,9 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/metrics.hpp>
+#include <dicestack/core/open_loop.hpp>
+#include <dicestack/core/reinforce.hpp>
+#include <dicestack/core/rrt.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/version.hpp>
@@ -28,7 +31,7 @@ using nlohmann::json;
 struct LeaderboardOptions {
   WorldOption world;
   DemosOption demos;
-  std::vector<std::string> regressors, learners, options;
+  std::vector<std::string> regressors, learners, options, baselines;
   std::string profile = "quick", format = "md", split = "episodes";
   int episodes = 0, seeds = 1, threads = 0;
   std::uint64_t seed = 0;
@@ -50,6 +53,58 @@ json row_json(const Row& r) {
           {"wall_contact_rate", wc.value}, {"wall_contact_ci95", {wc.low, wc.high}},
           {"realistic_success_rate", rs.value}, {"realistic_success_ci95", {rs.low, rs.high}},
           {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
+}
+
+void add_outcomes(Row& row, const EvalStats& st, int seeds) {
+  row.episodes += st.episodes;
+  row.stacked += static_cast<int>(std::lround(st.stacked.value * st.episodes));
+  row.walls += static_cast<int>(std::lround(st.wall_contact.value * st.episodes));
+  row.success += static_cast<int>(std::lround(st.realistic_success.value * st.episodes));
+  row.dice_in_cup += st.dice_in_cup_mean / seeds;
+  row.us_per_step += st.policy_us_per_step / seeds;
+}
+
+// The network REINFORCE learned, acting on states.
+class NetworkPolicy final : public Policy {
+ public:
+  NetworkPolicy(std::shared_ptr<const PolicyNetwork> net, const WorldConfig& world) : net_(std::move(net)), world_(world) {}
+  Action act(const State& s) override { return net_->act(s, world_); }
+  std::string name() const override { return "reinforce"; }
+
+ private:
+  std::shared_ptr<const PolicyNetwork> net_;
+  WorldConfig world_;
+};
+
+// Runs a baseline with the profile's budget: an open-loop sequence (optimisers, RRT) played
+// from every start, or REINFORCE's network acting on the states.
+PolicyFactory baseline_policy(const std::string& name, const WorldConfig& world, bool paper, std::uint64_t seed, int threads) {
+  std::vector<Action> actions;
+  if (name == "reinforce") {
+    ReinforceOptions o;
+    o.iterations = paper ? 1000 : 100;
+    o.seed = seed;
+    o.threads = threads;
+    auto net = std::make_shared<const PolicyNetwork>(reinforce(world, o).policy);
+    return [net, world] { return std::make_unique<NetworkPolicy>(net, world); };
+  }
+  if (name == "rrt") {
+    RrtOptions o;
+    o.nodes = paper ? 1000 : 100;
+    o.seed = seed;
+    o.threads = threads;
+    actions = rrt(world, o).actions;
+  } else {
+    OptimiseOptions o;
+    o.method = name;
+    o.evaluations = name == "bayes" ? (paper ? 500 : 200) : (paper ? 5000 : 1000);
+    o.seed = seed;
+    OpenLoopProblem problem(world, {}, threads);
+    actions = problem.actions(optimise(problem, o).best.data());
+  }
+  Episode sequence;
+  sequence.actions = actions;
+  return [sequence] { return std::make_unique<PlaybackPolicy>(sequence); };
 }
 
 Row row_from(const json& j) {
@@ -132,7 +187,7 @@ std::string render(const std::vector<Row>& rows, const std::string& format, cons
   return os.str();
 }
 
-int run_leaderboard(const LeaderboardOptions& opt) {
+int run_leaderboard(LeaderboardOptions opt) {
   const WorldConfig world = opt.world.load();
   const bool paper = opt.profile == "paper";
   const int episodes = opt.episodes > 0 ? opt.episodes : (paper ? 100 : 20);
@@ -157,6 +212,12 @@ int run_leaderboard(const LeaderboardOptions& opt) {
     return out;
   };
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
+  std::vector<std::string> known_baselines = optimiser_names();
+  known_baselines.insert(known_baselines.end(), {"reinforce", "rrt"});
+  if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = known_baselines;
+  for (const auto& b : opt.baselines)
+    if (std::find(known_baselines.begin(), known_baselines.end(), b) == known_baselines.end())
+      throw ConfigError("unknown baseline \"" + b + "\"; expected cmaes, de, basinhop, bayes, reinforce, rrt or all");
   for (const auto& l : learners)
     if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
@@ -193,6 +254,9 @@ int run_leaderboard(const LeaderboardOptions& opt) {
   json learner_options = json::object();
   for (const auto& l : learners) learner_options[l] = options_for(l);
   header << "; learner options " << learner_options.dump();
+  if (!opt.baselines.empty())
+    header << "; baselines optimised from the paper's start with the " << opt.profile
+           << " budgets, then played from the same random starts";
   const json meta{{"learner_options", learner_options}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
                   {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
@@ -250,12 +314,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
         std::shared_ptr<const Model> model = learned.model;
         const EvalStats st = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed,
                                       opt.threads);
-        row.episodes += st.episodes;
-        row.stacked += static_cast<int>(std::lround(st.stacked.value * st.episodes));
-        row.walls += static_cast<int>(std::lround(st.wall_contact.value * st.episodes));
-        row.success += static_cast<int>(std::lround(st.realistic_success.value * st.episodes));
-        row.dice_in_cup += st.dice_in_cup_mean / opt.seeds;
-        row.us_per_step += st.policy_us_per_step / opt.seeds;
+        add_outcomes(row, st, opt.seeds);
       }
       rows.push_back(row);
       if (!partial.empty()) {
@@ -265,6 +324,20 @@ int run_leaderboard(const LeaderboardOptions& opt) {
         f.commit();
       }
     }
+  }
+  // The baselines without demonstrations (paper V), rolled out from the same random starts.
+  for (const auto& name : opt.baselines) {
+    print_progress("baseline " + name);
+    const auto t0 = std::chrono::steady_clock::now();
+    const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
+    Row row{name, "baseline"};
+    row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    row.train_error = row.test_error = -1;
+    for (int s = 0; s < opt.seeds; ++s) {
+      const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads);
+      add_outcomes(row, st, opt.seeds);
+    }
+    rows.push_back(row);
   }
   // Playback of the demonstrations themselves (paper VI-A), for reference.
   print_progress("playback of the demonstrations");
@@ -301,6 +374,11 @@ void add_leaderboard_command(CLI::App& app) {
   cmd->add_option("--regressors", opt->regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
   cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc, dagger)")->delimiter(',');
   cmd->add_option("--option", opt->options, "key=value learner option (applied to the learners that have it); repeatable");
+  cmd->add_option("--baselines", opt->baselines,
+                  "Baselines without demonstrations as rows of their own: cmaes, de, basinhop, bayes, reinforce, rrt "
+                  "or all (quick: 1000 evaluations (bayes 200), 100 REINFORCE updates, 100 RRT nodes; paper: 5000 "
+                  "(bayes 500), 1000, 1000)")
+      ->delimiter(',');
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row and training seed (default: 20 quick, 100 paper)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seeds", opt->seeds, "Training seeds per row")->check(CLI::PositiveNumber)->capture_default_str();

@@ -133,6 +133,10 @@ EpisodeTrace run_episode(DiceEnv& env, const PolicyNetwork& net, const State& st
 
 }  // namespace
 
+Action PolicyNetwork::act(const State& state, const WorldConfig& world) const {
+  return to_action(mean(scaled_input(state, world.cost)), world);
+}
+
 ReinforceResult reinforce(const WorldConfig& config, const ReinforceOptions& o,
                           const std::function<void(const ReinforcePoint&)>& progress) {
   if (o.iterations < 1 || o.batch < 1 || o.steps < 1 || o.hidden < 1)

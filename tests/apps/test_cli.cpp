@@ -144,6 +144,9 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
   p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners nope");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown learner \"nope\""));
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --baselines annealing");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("unknown baseline \"annealing\""));
 }
 
 TEST(CliLearning, DadTrainsWithACurveAndRefusesTheRowSplit) {

@@ -31,6 +31,8 @@ class PolicyNetwork {
   PolicyNetwork(int hidden, double leak, std::uint64_t seed);
   /// The mean action in scaled units ([-1, 1]^3) for a state already divided by the scales.
   Eigen::Vector3d mean(const Eigen::VectorXd& x) const;
+  /// The mean action for a raw state of `world` (the policy's greedy action, in world units).
+  Action act(const State& state, const WorldConfig& world) const;
   /// Adds d log N(a; mean(x), sigma^2) / d parameters, times `weight`, to `grad` (same layout as params()).
   void accumulate_gradient(const Eigen::VectorXd& x, const Eigen::Vector3d& a, double sigma, double weight,
                            Eigen::VectorXd& grad) const;
