@@ -69,6 +69,31 @@ void write_episode_set(const WorldConfig& world, const Episode& e, const std::st
   write_demo_set(set, out);
 }
 
+// A baseline's episode outcome, for its JSON summary and its text line.
+nlohmann::json outcome_json(const Outcome& o) {
+  return {{"dice_in_cup", o.dice_in_cup}, {"stacked", o.stacked}, {"wall_contact", o.wall_contact},
+          {"realistic_success", o.realistic_success()}};
+}
+
+std::string outcome_text(const Outcome& o) {
+  auto yes = [](bool b) { return b ? "yes" : "no"; };
+  return "dice in cup " + std::to_string(o.dice_in_cup) + ", stacked " + yes(o.stacked) + ", wall contact " +
+         yes(o.wall_contact) + ", realistic success " + yes(o.realistic_success());
+}
+
+// Writes `summary` (with `curve` under `curve_key`) to `file` atomically, then prints the summary
+// as JSON or the text.
+int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, const std::string& curve_key,
+                    const nlohmann::json& curve, bool json, const std::string& text) {
+  nlohmann::json saved = summary;
+  if (!curve.is_null()) saved[curve_key] = curve;
+  AtomicFile f(file);
+  f.stream() << saved.dump(1);
+  f.commit();
+  print_line(json ? summary.dump() : text);
+  return 0;
+}
+
 int run_optimise(OptimiseCommandOptions opt) {
   const WorldConfig world = open_loop_world(opt);
   OpenLoopProblem problem(world, opt.settings, opt.threads);
@@ -89,31 +114,17 @@ int run_optimise(OptimiseCommandOptions opt) {
   const double rate = r.evaluations / std::max(r.seconds, 1e-9);
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& [evals, cost] : r.curve) curve.push_back({evals, cost});
-  const nlohmann::json j{{"method", opt.optimiser.method},   {"steps", opt.settings.steps},
-                         {"evaluations", r.evaluations},      {"seconds", r.seconds},
-                         {"evaluations_per_second", rate},    {"best_cost", r.best_cost},
-                         {"dice_in_cup", best.outcome.dice_in_cup}, {"stacked", best.outcome.stacked},
-                         {"wall_contact", best.outcome.wall_contact}, {"realistic_success", best.outcome.realistic_success()},
-                         {"gravity_scale", opt.gravity_scale}, {"noise", opt.noise}, {"repeats", opt.settings.repeats},
-                         {"discount", world.cost.gamma},      {"seed", opt.optimiser.seed}, {"out", opt.out.string()}};
-  AtomicFile f(opt.out / "optimise.json");
-  nlohmann::json with_curve = j;
-  with_curve["curve"] = curve;
-  f.stream() << with_curve.dump(1);
-  f.commit();
-  if (opt.json) {
-    print_line(j.dump());
-    return 0;
-  }
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "%s: best cost %.4g after %d evaluations in %.1f s (%.0f evaluations/s)\n"
-                "best sequence: dice in cup %d, stacked %s, wall contact %s, realistic success %s -> %s",
-                opt.optimiser.method.c_str(), r.best_cost, r.evaluations, r.seconds, rate, best.outcome.dice_in_cup,
-                best.outcome.stacked ? "yes" : "no", best.outcome.wall_contact ? "yes" : "no",
-                best.outcome.realistic_success() ? "yes" : "no", opt.out.string().c_str());
-  print_line(line);
-  return 0;
+  nlohmann::json j{{"method", opt.optimiser.method},   {"steps", opt.settings.steps},
+                   {"evaluations", r.evaluations},      {"seconds", r.seconds},
+                   {"evaluations_per_second", rate},    {"best_cost", r.best_cost},
+                   {"gravity_scale", opt.gravity_scale}, {"noise", opt.noise}, {"repeats", opt.settings.repeats},
+                   {"discount", world.cost.gamma},      {"seed", opt.optimiser.seed}, {"out", opt.out.string()}};
+  j.update(outcome_json(best.outcome));
+  char line[256];
+  std::snprintf(line, sizeof line, "%s: best cost %.4g after %d evaluations in %.1f s (%.0f evaluations/s)\n",
+                opt.optimiser.method.c_str(), r.best_cost, r.evaluations, r.seconds, rate);
+  return finish_baseline(opt.out / "optimise.json", j, "curve", curve, opt.json,
+                         line + ("best sequence: " + outcome_text(best.outcome) + " -> " + opt.out.string()));
 }
 
 void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt) {
@@ -199,31 +210,16 @@ int run_reinforce(const ReinforceCommandOptions& opt) {
                     opt.out);
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& p : r.curve) curve.push_back({p.iteration, p.mean_return, p.greedy_cost});
-  const nlohmann::json j{{"iterations", opt.reinforce.iterations}, {"episodes", opt.reinforce.iterations * opt.reinforce.batch},
-                         {"seconds", r.seconds},  {"final_greedy_cost", r.curve.back().greedy_cost},
-                         {"final_mean_return", r.curve.back().mean_return},
-                         {"dice_in_cup", greedy.outcome.dice_in_cup}, {"stacked", greedy.outcome.stacked},
-                         {"wall_contact", greedy.outcome.wall_contact}, {"realistic_success", greedy.outcome.realistic_success()},
-                         {"seed", opt.reinforce.seed}, {"out", opt.out.string()}};
-  AtomicFile f(opt.out / "reinforce.json");
-  nlohmann::json with_curve = j;
-  with_curve["curve (iteration, mean return, greedy cost)"] = curve;
-  f.stream() << with_curve.dump(1);
-  f.commit();
-  if (opt.json) {
-    print_line(j.dump());
-    return 0;
-  }
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "reinforce: %d episodes in %.1f s; mean return %.4g -> %.4g, greedy cost %.4g -> %.4g\n"
-                "greedy policy: dice in cup %d, stacked %s, wall contact %s, realistic success %s -> %s",
+  nlohmann::json j{{"iterations", opt.reinforce.iterations}, {"episodes", opt.reinforce.iterations * opt.reinforce.batch},
+                   {"seconds", r.seconds},  {"final_greedy_cost", r.curve.back().greedy_cost},
+                   {"final_mean_return", r.curve.back().mean_return}, {"seed", opt.reinforce.seed}, {"out", opt.out.string()}};
+  j.update(outcome_json(greedy.outcome));
+  char line[256];
+  std::snprintf(line, sizeof line, "reinforce: %d episodes in %.1f s; mean return %.4g -> %.4g, greedy cost %.4g -> %.4g\n",
                 opt.reinforce.iterations * opt.reinforce.batch, r.seconds, r.curve.front().mean_return, r.curve.back().mean_return,
-                r.curve.front().greedy_cost, r.curve.back().greedy_cost, greedy.outcome.dice_in_cup,
-                greedy.outcome.stacked ? "yes" : "no", greedy.outcome.wall_contact ? "yes" : "no",
-                greedy.outcome.realistic_success() ? "yes" : "no", opt.out.string().c_str());
-  print_line(line);
-  return 0;
+                r.curve.front().greedy_cost, r.curve.back().greedy_cost);
+  return finish_baseline(opt.out / "reinforce.json", j, "curve (iteration, mean return, greedy cost)", curve, opt.json,
+                         line + ("greedy policy: " + outcome_text(greedy.outcome) + " -> " + opt.out.string()));
 }
 
 struct RrtCommandOptions {
@@ -253,27 +249,16 @@ int run_rrt(const RrtCommandOptions& opt) {
                           std::to_string(opt.rrt.extend_steps) + " --seed " + std::to_string(opt.rrt.seed),
                       opt.out);
   const double rate = static_cast<double>(r.simulated_steps) / std::max(r.seconds, 1e-9);
-  const nlohmann::json j{{"nodes", r.nodes},          {"simulated_steps", r.simulated_steps}, {"seconds", r.seconds},
-                         {"steps_per_second", rate},  {"best_distance", r.best_distance},   {"path_steps", r.actions.size()},
-                         {"dice_in_cup", path.outcome.dice_in_cup}, {"stacked", path.outcome.stacked},
-                         {"wall_contact", path.outcome.wall_contact}, {"realistic_success", path.outcome.realistic_success()},
-                         {"seed", opt.rrt.seed},      {"out", opt.out.string()}};
-  AtomicFile f(opt.out / "rrt.json");
-  f.stream() << j.dump(1);
-  f.commit();
-  if (opt.json) {
-    print_line(j.dump());
-    return 0;
-  }
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "rrt: %d nodes, %lld simulated steps in %.1f s (%.0f steps/s); nearest to the goal %.4g after %zu steps\n"
-                "path (none if no node got nearer than the start): dice in cup %d, stacked %s, wall contact %s, realistic success %s -> %s",
-                r.nodes, r.simulated_steps, r.seconds, rate, r.best_distance, r.actions.size(), path.outcome.dice_in_cup,
-                path.outcome.stacked ? "yes" : "no", path.outcome.wall_contact ? "yes" : "no",
-                path.outcome.realistic_success() ? "yes" : "no", opt.out.string().c_str());
-  print_line(line);
-  return 0;
+  nlohmann::json j{{"nodes", r.nodes},          {"simulated_steps", r.simulated_steps}, {"seconds", r.seconds},
+                   {"steps_per_second", rate},  {"best_distance", r.best_distance},   {"path_steps", r.actions.size()},
+                   {"seed", opt.rrt.seed},      {"out", opt.out.string()}};
+  j.update(outcome_json(path.outcome));
+  char line[256];
+  std::snprintf(line, sizeof line, "rrt: %d nodes, %lld simulated steps in %.1f s (%.0f steps/s); nearest to the goal %.4g after %zu steps\n",
+                r.nodes, r.simulated_steps, r.seconds, rate, r.best_distance, r.actions.size());
+  return finish_baseline(opt.out / "rrt.json", j, "", nullptr, opt.json,
+                         line + ("path (none if no node got nearer than the start): " + outcome_text(path.outcome) + " -> " +
+                                 opt.out.string()));
 }
 
 }  // namespace
