@@ -15,10 +15,14 @@ namespace dicestack {
 nlohmann::json curve_to_json(const std::vector<CurvePoint>& curve);
 std::vector<CurvePoint> curve_from_json(const nlohmann::json& json);
 
-/// Writes `data` to dir/data, then `state` to dir/<state_file> (both atomically), in that order,
-/// so the state never points at data that is not there.
-void save_checkpoint(const std::filesystem::path& dir, const std::string& state_file, const nlohmann::json& state,
+/// Writes `data` to dir/data-<iteration>, then `state` (plus "iteration" and "data") to
+/// dir/<state_file>, both atomically and in that order, then removes older data folders: the
+/// state always names complete data of its own iteration, whenever the run is killed.
+void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::json state, const std::string& state_file,
                      const LearnContext& context, const std::vector<Episode>& data, const std::string& description);
+
+/// The aggregated data a checkpoint state names.
+std::vector<Episode> load_checkpoint_data(const LearnContext& context, const nlohmann::json& state);
 
 /// The state of the last finished iteration, or null when there is none to resume from.
 nlohmann::json load_checkpoint_state(const LearnContext& context, const std::string& state_file);

@@ -50,11 +50,11 @@ class Dad final : public Learner {
     std::size_t corrections = 0, filtered = 0;
     if (const auto state = load_checkpoint_state(c, "dad.json"); !state.is_null()) {
       first = state.at("iteration").get<int>() + 1;
-      data = read_demo_set(c.checkpoint_dir / "data").episodes;
+      data = load_checkpoint_data(c, state);
       result.curve = curve_from_json(state.at("curve"));
       best_iteration = state.at("best_iteration");
       best_deviation = state.at("best_deviation");
-      best = std::make_shared<Model>(load_model(c.checkpoint_dir / "best.model", *c.registry));
+      best = std::make_shared<Model>(load_model(c.checkpoint_dir / state.at("best_model").get<std::string>(), *c.registry));
       corrections = state.at("corrections_kept");
       filtered = state.at("corrections_filtered");
     }
@@ -109,13 +109,19 @@ class Dad final : public Learner {
         best_iteration = k;
       }
       if (!c.checkpoint_dir.empty()) {
+        // The best model is named by its iteration and written before the state that names it.
+        const std::string best_file = "best-" + std::to_string(best_iteration) + ".model";
         fs::create_directories(c.checkpoint_dir);
-        save_model(*best, c.checkpoint_dir / "best.model");
-        save_checkpoint(c.checkpoint_dir, "dad.json",
-                        {{"iteration", k}, {"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
-                         {"best_deviation", best_deviation}, {"corrections_kept", corrections},
+        if (!fs::exists(c.checkpoint_dir / best_file)) save_model(*best, c.checkpoint_dir / best_file);
+        save_checkpoint(c.checkpoint_dir, k,
+                        {{"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
+                         {"best_model", best_file}, {"best_deviation", best_deviation}, {"corrections_kept", corrections},
                          {"corrections_filtered", filtered}, {"curve", curve_to_json(result.curve)}},
-                        c, data, "DaD data after iteration " + std::to_string(k));
+                        "dad.json", c, data, "DaD data after iteration " + std::to_string(k));
+        for (const auto& entry : fs::directory_iterator(c.checkpoint_dir)) {
+          const std::string name = entry.path().filename().string();
+          if (name.rfind("best-", 0) == 0 && name != best_file) fs::remove(entry.path());
+        }
       }
     }
     const std::shared_ptr<Model> chosen = params().boolean("keep_best") ? best : model;

@@ -32,7 +32,7 @@ class Dagger final : public Learner {
     int first = 1;
     if (const auto state = load_checkpoint_state(c, "dagger.json"); !state.is_null()) {
       first = state.at("iteration").get<int>() + 1;
-      data = read_demo_set(c.checkpoint_dir / "data").episodes;
+      data = load_checkpoint_data(c, state);
       result.curve = curve_from_json(state.at("curve"));
     }
     if (!data.empty()) model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
@@ -61,10 +61,9 @@ class Dagger final : public Learner {
       for (const auto& e : data) rows += e.size();
       result.curve.push_back(measure_policy(model, c, c.demos, i, rows));
       if (!c.checkpoint_dir.empty())
-        save_checkpoint(c.checkpoint_dir, "dagger.json",
-                        {{"iteration", i}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta},
-                         {"curve", curve_to_json(result.curve)}},
-                        c, data, "DAgger aggregate after round " + std::to_string(i));
+        save_checkpoint(c.checkpoint_dir, i,
+                        {{"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
+                        "dagger.json", c, data, "DAgger aggregate after round " + std::to_string(i));
     }
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";

@@ -95,7 +95,7 @@ std::vector<CurvePoint> curve_from_json(const nlohmann::json& json) {
   return out;
 }
 
-void save_checkpoint(const fs::path& dir, const std::string& state_file, const nlohmann::json& state,
+void save_checkpoint(const fs::path& dir, int iteration, nlohmann::json state, const std::string& state_file,
                      const LearnContext& c, const std::vector<Episode>& data, const std::string& description) {
   fs::create_directories(dir);
   DemoSet set;
@@ -103,10 +103,21 @@ void save_checkpoint(const fs::path& dir, const std::string& state_file, const n
   set.description = description;
   set.provenance = "dicestack " + description + ", seed " + std::to_string(c.seed) + ", regressor " + c.regressor;
   set.episodes = data;
-  write_demo_set(set, dir / "data");
+  const std::string folder = "data-" + std::to_string(iteration);
+  write_demo_set(set, dir / folder);
+  state["iteration"] = iteration;
+  state["data"] = folder;
   AtomicFile f(dir / state_file);
   f.stream() << state.dump();
   f.commit();
+  for (const auto& entry : fs::directory_iterator(dir)) {  // older iterations' data, now unreferenced
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("data-", 0) == 0 && name != folder) fs::remove_all(entry.path());
+  }
+}
+
+std::vector<Episode> load_checkpoint_data(const LearnContext& c, const nlohmann::json& state) {
+  return read_demo_set(c.checkpoint_dir / state.at("data").get<std::string>()).episodes;
 }
 
 nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file) {

@@ -130,6 +130,9 @@ TEST(Dad, ResumeEqualsUninterrupted) {
     if (p.iteration == 3) throw std::runtime_error("killed");
   };
   EXPECT_THROW(LearnerRegistry::global().create("dad", kSmall)->learn(c), std::runtime_error);
+  // As if killed after writing iteration 3's data but before its state: the state still names
+  // iteration 2's data, and the stray folder is not read.
+  std::filesystem::copy(dir / "data-2", dir / "data-3", std::filesystem::copy_options::recursive);
   c.progress = nullptr;
   c.resume = true;
   const LearnResult resumed = LearnerRegistry::global().create("dad", kSmall)->learn(c);

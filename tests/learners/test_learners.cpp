@@ -149,7 +149,7 @@ TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {
   c.checkpoint_dir = std::filesystem::temp_directory_path() / "dicestack_dagger_beta1";
   std::filesystem::remove_all(c.checkpoint_dir);
   const LearnResult r = learner->learn(c);
-  const DemoSet data = read_demo_set(c.checkpoint_dir / "data");
+  const DemoSet data = read_demo_set(c.checkpoint_dir / "data-1");
   ASSERT_EQ(data.episodes.size(), 3u);
   for (const auto& e : data.episodes)
     for (auto s : e.sources) ASSERT_EQ(s, StepSource::expert);
