@@ -13,11 +13,12 @@ packages=(
   xgboost                 # (libxgboost-dev's CMake config checks for its /usr/bin/xgboost)
   libnanoflann-dev        # k-NN
   libpagmo-dev            # differential evolution, basin hopping
-  libnlopt-cxx-dev        # L-BFGS
+  libnlopt-cxx-dev        # COBYLA, the local minimiser of basin hopping
   libcli11-dev            # command line
   nlohmann-json3-dev      # JSON
   libtbb-dev              # threads
   libsdl2-dev             # the interactive player
+  libgif-dev              # GIF output of `dicestack render`
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xdotool            # the headless test of `dicestack play`
 )

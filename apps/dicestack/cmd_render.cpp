@@ -16,6 +16,7 @@
 #include <dicestack/learners/evaluate.hpp>
 
 #include "cli.hpp"
+#include "gif_writer.hpp"
 #include "options.hpp"
 
 namespace dicestack::cli {
@@ -75,9 +76,8 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
     }
     return;
   }
-  // (OpenCV 4.6 writes no GIF; a folder of PNGs converts to one with any GIF tool.)
-  if (ext != ".mp4" && ext != ".avi" && ext != ".png")
-    throw InputError(out.string() + ": unknown output kind; use .mp4, .avi, .png (last frame) or a folder");
+  if (ext != ".mp4" && ext != ".avi" && ext != ".gif" && ext != ".png")
+    throw InputError(out.string() + ": unknown output kind; use .mp4, .avi, .gif, .png (last frame) or a folder");
   if (ext == ".png") {
     render_state_into(img, states.back(), world, {static_cast<int>(states.size() - 1), outcomes.back(), title});
     write_png(img, out);
@@ -85,6 +85,17 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
   }
   render_state_into(img, states.front(), world, {0, outcomes.front(), title});
   const fs::path tmp = out.parent_path() / (".tmp-" + out.filename().string());
+  if (ext == ".gif") {
+    GifWriter gif(tmp, img.width, img.height);
+    const double cs = 100.0 * world.physics.control_dt;  // GIF delays are whole centiseconds: carry the rest
+    for (std::size_t t = 0; t < states.size(); ++t) {
+      render_state_into(img, states[t], world, {static_cast<int>(t), outcomes[t], title});
+      gif.add(img, static_cast<int>(std::lround((t + 1) * cs) - std::lround(t * cs)));
+    }
+    gif.close();
+    fs::rename(tmp, out);
+    return;
+  }
   const int fourcc = ext == ".mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v') : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
   cv::VideoWriter video(tmp.string(), cv::CAP_FFMPEG, fourcc, 1.0 / world.physics.control_dt,
                         cv::Size(img.width, img.height));
@@ -170,7 +181,7 @@ void add_render_command(CLI::App& app) {
   opt->world.add_to(*cmd);
   cmd->add_option("--model", opt->model, "Roll this model out from a random start")->check(CLI::ExistingFile);
   cmd->add_option("--episode", opt->episode, "Replay this episode CSV's actions from its first state")->check(CLI::ExistingFile);
-  cmd->add_option("--out", opt->out, "FILE.mp4 or FILE.avi (video), FILE.png (last frame), or a folder (one PNG per frame)");
+  cmd->add_option("--out", opt->out, "FILE.mp4, FILE.avi or FILE.gif (video; GIF via giflib), FILE.png (last frame), or a folder (one PNG per frame)");
   cmd->add_option("--plot", opt->plot, "FILE.png: cup x, dice x and y, cup angle and velocities over time");
   cmd->add_option("--seed", opt->seed, "Seed of the model's start state")->capture_default_str();
   cmd->add_option("--initial-push", opt->push, "none, left or right")->check(CLI::IsMember({"none", "left", "right"}))->capture_default_str();

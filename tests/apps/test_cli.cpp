@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include <gif_lib.h>
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/env.hpp>
@@ -264,6 +265,15 @@ TEST(CliRender, VideoFramesAndPlotOfARecordedEpisode) {
   int frames = 0;
   for (cv::Mat f; video.read(f);) ++frames;
   EXPECT_EQ(frames, 4) << "one frame per recorded step";
+  ASSERT_EQ(run("render --episode " + episode + " --out " + (dir / "ep.gif").string()).status, 0);
+  int error = 0;
+  GifFileType* gif = DGifOpenFileName((dir / "ep.gif").c_str(), &error);
+  ASSERT_NE(gif, nullptr);
+  ASSERT_EQ(DGifSlurp(gif), GIF_OK);
+  EXPECT_EQ(gif->ImageCount, 4) << "one GIF frame per recorded step";
+  EXPECT_EQ(gif->SWidth, 900);
+  EXPECT_EQ(gif->SHeight, 700);
+  DGifCloseFile(gif, &error);
   EXPECT_GT(std::filesystem::file_size(dir / "plot.png"), 5000u);
   ASSERT_EQ(run("render --episode " + episode + " --out " + (dir / "frames").string()).status, 0);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir / "frames"), std::filesystem::directory_iterator{}), 4);
