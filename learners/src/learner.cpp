@@ -33,26 +33,14 @@ void LearnerRegistry::add(LearnerInfo info) {
   entries_.emplace(std::move(name), std::move(info));
 }
 
-const LearnerInfo& LearnerRegistry::info(std::string_view name) const {
-  const auto it = entries_.find(name);
-  if (it == entries_.end()) {
-    std::string list;
-    for (const auto& n : names()) list += (list.empty() ? "" : ", ") + n;
-    throw ConfigError("unknown learner \"" + std::string(name) + "\"; registered: " + list);
-  }
-  return it->second;
-}
+const LearnerInfo& LearnerRegistry::info(std::string_view name) const { return registered_entry(entries_, name, "learner"); }
 
 std::unique_ptr<Learner> LearnerRegistry::create(std::string_view name, const std::vector<std::string>& assignments) const {
   const LearnerInfo& i = info(name);
   return i.factory(i.name, Params(i.params, assignments, i.name));
 }
 
-std::vector<std::string> LearnerRegistry::names() const {
-  std::vector<std::string> out;
-  for (const auto& [name, info] : entries_) out.push_back(name);
-  return out;
-}
+std::vector<std::string> LearnerRegistry::names() const { return registered_names(entries_); }
 
 std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
   if (data.empty()) throw InputError("no demonstrations to learn from");

@@ -28,15 +28,7 @@ void RegressorRegistry::add(RegressorInfo info) {
   entries_.emplace(std::move(name), std::move(info));
 }
 
-const RegressorInfo& RegressorRegistry::info(std::string_view name) const {
-  const auto it = entries_.find(name);
-  if (it == entries_.end()) {
-    std::string list;
-    for (const auto& n : names()) list += (list.empty() ? "" : ", ") + n;
-    throw ConfigError("unknown regressor \"" + std::string(name) + "\"; registered: " + list);
-  }
-  return it->second;
-}
+const RegressorInfo& RegressorRegistry::info(std::string_view name) const { return registered_entry(entries_, name, "regressor"); }
 
 std::unique_ptr<Regressor> RegressorRegistry::create(std::string_view name,
                                                      const std::vector<std::string>& assignments) const {
@@ -44,11 +36,7 @@ std::unique_ptr<Regressor> RegressorRegistry::create(std::string_view name,
   return i.factory(i.name, Params(i.params, assignments, i.name));
 }
 
-std::vector<std::string> RegressorRegistry::names() const {
-  std::vector<std::string> out;
-  for (const auto& [name, info] : entries_) out.push_back(name);
-  return out;
-}
+std::vector<std::string> RegressorRegistry::names() const { return registered_names(entries_); }
 
 void RegressorRegistry::load_plugin(const std::filesystem::path& library) {
   const std::string who = "plugin " + library.string();
