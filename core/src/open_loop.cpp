@@ -187,7 +187,8 @@ void run_basinhop(OpenLoopProblem& p, const OptimiseOptions& o, Recorder& rec) {
 
 // Bayesian optimisation: a Gaussian process (squared-exponential kernel, length scale
 // 0.5 sqrt(n), standardised values) with expected improvement maximised over random and
-// best-centred candidates. O(N^2) per evaluation in the number of points N: slow, as the paper found.
+// best-centred candidates. The kernel matrix grows by a row per point; its Cholesky factor is
+// recomputed, O(N^3) per evaluation in the number of points N: slow, as the paper found.
 void run_bayes(OpenLoopProblem& p, const OptimiseOptions& o, Recorder& rec) {
   const auto n = static_cast<Eigen::Index>(p.dim());
   const double length = 0.5 * std::sqrt(static_cast<double>(n)), jitter = 1e-6;
@@ -195,12 +196,15 @@ void run_bayes(OpenLoopProblem& p, const OptimiseOptions& o, Recorder& rec) {
   Rng rng(o.seed);
   Eigen::MatrixXd xs(0, n);
   std::vector<double> ys;
-  auto kernel = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    return std::exp(-(a - b).squaredNorm() / (2.0 * length * length));
-  };
+  auto kernel = [&](const auto& a, const auto& b) { return std::exp(-(a - b).squaredNorm() / (2.0 * length * length)); };
+  Eigen::MatrixXd k(0, 0);  // the kernel matrix of the points so far, grown by one row and column per point
   auto add = [&](const Eigen::VectorXd& x, double y) {
-    xs.conservativeResize(xs.rows() + 1, n);
-    xs.row(xs.rows() - 1) = x.transpose();
+    const Eigen::Index m = xs.rows();
+    xs.conservativeResize(m + 1, n);
+    xs.row(m) = x.transpose();
+    k.conservativeResize(m + 1, m + 1);
+    for (Eigen::Index a = 0; a < m; ++a) k(a, m) = k(m, a) = kernel(xs.row(a), xs.row(m));
+    k(m, m) = 1.0 + jitter;
     ys.push_back(y);
     rec.offer(x.data(), y);
   };
@@ -215,9 +219,6 @@ void run_bayes(OpenLoopProblem& p, const OptimiseOptions& o, Recorder& rec) {
     const Eigen::Map<const Eigen::VectorXd> y(ys.data(), m);
     const double mean = y.mean(), sd = std::max(std::sqrt((y.array() - mean).square().mean()), 1e-12);
     const Eigen::VectorXd z = (y.array() - mean) / sd;
-    Eigen::MatrixXd k(m, m);
-    for (Eigen::Index a = 0; a < m; ++a)
-      for (Eigen::Index b = 0; b <= a; ++b) k(a, b) = k(b, a) = kernel(xs.row(a), xs.row(b)) + (a == b ? jitter : 0.0);
     const Eigen::LLT<Eigen::MatrixXd> llt(k);
     const Eigen::VectorXd alpha = llt.solve(z);
     const double best = z.minCoeff();
@@ -230,7 +231,7 @@ void run_bayes(OpenLoopProblem& p, const OptimiseOptions& o, Recorder& rec) {
       for (Eigen::Index j = 0; j < n; ++j)
         x[j] = c % 2 ? rng.uniform(-1.0, 1.0) : std::clamp(xs(best_row, j) + 0.1 * rng.normal(), -1.0, 1.0);
       Eigen::VectorXd kx(m);
-      for (Eigen::Index a = 0; a < m; ++a) kx[a] = kernel(xs.row(a), x);
+      for (Eigen::Index a = 0; a < m; ++a) kx[a] = kernel(xs.row(a), x.transpose());
       const double mu = kx.dot(alpha);
       const double var = std::max(1.0 - kx.dot(llt.solve(kx)), 1e-12), s = std::sqrt(var);
       const double u = (best - mu) / s;
