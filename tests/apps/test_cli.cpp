@@ -244,6 +244,20 @@ TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
   EXPECT_THAT(tex.output, HasSubstr("\\end{tabular}"));
 }
 
+TEST(CliBaselines, LeaderboardAddsBaselineRowsFromTheSameStarts) {
+  const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 2 --seed 4 "
+                        "--baselines de,rrt --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  const auto rows = nlohmann::json::parse(p.output)["rows"];
+  ASSERT_EQ(rows.size(), 4u);  // knn under bc, the two baselines, playback
+  EXPECT_EQ(rows[1]["regressor"], "de");
+  EXPECT_EQ(rows[2]["regressor"], "rrt");
+  for (std::size_t i = 1; i <= 2; ++i) {
+    EXPECT_EQ(rows[i]["learner"], "baseline");
+    EXPECT_EQ(rows[i]["episodes"], 2);
+  }
+}
+
 }  // namespace
 }  // namespace dicestack
 
