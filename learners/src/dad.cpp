@@ -6,7 +6,6 @@
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/parallel.hpp>
-#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/corrector.hpp>
 #include <dicestack/learners/learner.hpp>
 

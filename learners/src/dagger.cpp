@@ -6,15 +6,12 @@
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
-#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/learner.hpp>
 
 #include "checkpoint.hpp"
 
 namespace dicestack {
 namespace {
-
-namespace fs = std::filesystem;
 
 // DAgger (Ross et al.): roll out the mixture beta_i * expert + (1 - beta_i) * learner from
 // random starts, label every visited state with the expert's action, aggregate, refit.
