@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages dicestack builds and tests with. Idempotent: when every
 # package is already installed it changes nothing and does not touch the network.
+# `--python` adds scikit-learn and XGBoost's Python package, for bench/compare_python.py.
 set -euo pipefail
 
 packages=(
@@ -22,6 +23,13 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xdotool            # the headless test of `dicestack play`
 )
+
+if [ "${1:-}" = "--python" ]; then
+  packages+=(python3-sklearn python3-xgboost)
+elif [ $# -gt 0 ]; then
+  echo "install-deps: unknown argument '$1' (the only option is --python)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/atomic_file.hpp>
+
 #include <dicestack/datasets/builtin.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/metrics.hpp>
@@ -76,7 +78,7 @@ int run_list(const ListOptions& opt) {
 
 struct BenchOptions {
   WorldOption world;
-  std::filesystem::path demos;
+  std::filesystem::path demos, export_dir;
   std::string split = "episodes";
   std::vector<std::string> regressors;
   std::vector<std::string> sets;
@@ -89,12 +91,35 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Writes X and Y of one side of the split as CSV with a header (17 significant digits, so
+// another tool reads back exactly these doubles).
+template <std::size_t N>
+void write_matrix_csv(const std::filesystem::path& path, const Matrix& m, const std::array<std::string_view, N>& names) {
+  AtomicFile file(path);
+  auto& out = file.stream();
+  out.precision(17);
+  for (std::size_t j = 0; j < N; ++j) out << (j ? "," : "") << names[j];
+  out << '\n';
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out << m(i, j) << (j + 1 < m.cols() ? ',' : '\n');
+  file.commit();
+}
+
+void export_split(const Split& split, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  write_matrix_csv(dir / "train_x.csv", split.train.x, state_names());
+  write_matrix_csv(dir / "train_y.csv", split.train.y, action_names());
+  write_matrix_csv(dir / "test_x.csv", split.test.x, state_names());
+  write_matrix_csv(dir / "test_y.csv", split.test.y, action_names());
+}
+
 int run_bench(const BenchOptions& opt) {
   const WorldConfig world = opt.world.load();
   const auto dir = opt.demos.empty() ? human_demo_set(world) : opt.demos;
   const DemoSet set = read_demo_set(dir);
   const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
   const auto sigma = column_sigma(split.train.y);
+  if (!opt.export_dir.empty()) export_split(split, opt.export_dir);
   auto& reg = RegressorRegistry::global();
   const auto names = opt.regressors.empty() ? reg.names() : opt.regressors;
   nlohmann::json rows = nlohmann::json::array();
@@ -173,6 +198,9 @@ void add_bench_regressors_command(CLI::App& bench) {
   cmd->add_option("--seed", opt->seed, "Training seed")->capture_default_str();
   cmd->add_option("--calls", opt->calls, "predict_row calls timed")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print a JSON list");
+  cmd->add_option("--export", opt->export_dir,
+                  "Also write the split as train_x.csv, train_y.csv, test_x.csv, test_y.csv to this folder "
+                  "(to fit other tools on the same rows: bench/compare_python.py)");
   cmd->callback([opt] { run_bench(*opt); });
 }
 

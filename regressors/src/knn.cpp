@@ -2,6 +2,7 @@
 #include <cstring>
 #include <variant>
 
+#include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 
 #include <dicestack/core/error.hpp>
@@ -37,6 +38,7 @@ template <int Dim>
 using L1Tree = Tree<nanoflann::L1_Adaptor<float, RowsAdaptor, float, std::size_t>, Dim>;
 
 constexpr int kMaxK = 64;
+constexpr Eigen::Index kMaxDim = 64;  // predict_row's query lives on the stack
 
 // k nearest neighbours over the standardised states; the prediction is the mean of the k
 // labels (uniform weights, as scikit-learn's KNeighborsRegressor by default).
@@ -47,7 +49,8 @@ class Knn final : public Regressor {
   static std::vector<ParamSpec> schema() {
     return {{"k", ParamType::integer, "3", 1, kMaxK, "neighbours averaged (paper VI-E2: 3)", {}},
             {"metric", ParamType::choice, "l2", 0, 0, "distance on standardised states: l2 (Euclidean) or l1", {"l2", "l1"}},
-            {"leaf_size", ParamType::integer, "20", 1, 10000, "k-d tree leaf size (speed only)", {}}};
+            {"leaf_size", ParamType::integer, "20", 1, 10000, "k-d tree leaf size (speed only)", {}},
+            {"rotate", ParamType::boolean, "true", 0, 0, "l2: search along the states' principal axes (speed only; the search is exact either way)", {}}};
   }
 
  private:
@@ -58,22 +61,44 @@ class Knn final : public Regressor {
   }
 
   void build() {
-    xf_ = x_.cast<float>();
+    if (x_.cols() > kMaxDim)
+      throw InputError(name() + ": " + std::to_string(x_.cols()) + " input dimensions; at most " + std::to_string(kMaxDim) +
+                       " are supported");
+    rotate();
+    xf_.resize(x_.rows(), x_.cols());  // row by row: no full-size temporaries (fit time)
+    const Eigen::RowVectorXd centre = centre_.transpose();
+    for (Eigen::Index i = 0; i < x_.rows(); ++i) xf_.row(i) = ((x_.row(i) - centre) * axes_).cast<float>();
     adaptor_ = {&xf_};
     make_tree();
     // Measured: predict_row spent most of its time on cache misses, reading the rows of a leaf
-    // from all over memory. Store the rows in the tree's leaf order and build again: each
-    // leaf's rows then sit together (the same points fall in the same leaves; the search is
-    // exact either way).
-    const std::vector<std::size_t> order = std::visit([](const auto& t) { return t->vAcc; }, tree_);
+    // from all over memory. Store the rows in the tree's leaf order and point the tree at them
+    // in place: each leaf's rows then sit together, the tree is the same (a second build on
+    // the sorted rows would give this tree again, at twice the fit time).
+    std::vector<std::size_t>& order = std::visit([](auto& t) -> std::vector<std::size_t>& { return t->vAcc; }, tree_);
     FloatRows sorted(xf_.rows(), xf_.cols());
     labels_.resize(y_.rows(), y_.cols());
     for (std::size_t i = 0; i < order.size(); ++i) {
       sorted.row(static_cast<Eigen::Index>(i)) = xf_.row(static_cast<Eigen::Index>(order[i]));
       labels_.row(static_cast<Eigen::Index>(i)) = y_.row(static_cast<Eigen::Index>(order[i]));
+      order[i] = i;
     }
-    xf_ = std::move(sorted);
-    make_tree();
+    xf_ = std::move(sorted);  // the adaptor points at xf_, which now holds the sorted rows
+  }
+
+  // A k-d tree splits along coordinate axes; the 24 state dimensions are strongly correlated
+  // (dice in the cup move with it), so the cells are long and thin across the data and the
+  // search visits many leaves. Rotating to the principal axes (largest variance first) keeps
+  // every L2 distance and makes the cells fit the data. L1 distances are not rotation
+  // invariant: that metric searches the states as given.
+  void rotate() {
+    const auto d = x_.cols();
+    centre_ = x_.colwise().mean().transpose();
+    axes_ = Matrix::Identity(d, d);
+    if (params().choice("metric") != "l2" || !params().boolean("rotate") || x_.rows() < 2) return;
+    Matrix scatter = x_.transpose() * x_;  // of the centred rows, without copying them
+    scatter -= static_cast<double>(x_.rows()) * centre_ * centre_.transpose();
+    const Eigen::SelfAdjointEigenSolver<Matrix> eig(scatter);
+    axes_ = eig.eigenvectors().rowwise().reverse();  // descending variance
   }
 
   void make_tree() {
@@ -93,8 +118,15 @@ class Knn final : public Regressor {
   void do_predict_row(std::span<const double> x, std::span<double> y) const override {
     const auto k = std::min<std::size_t>(static_cast<std::size_t>(params().integer("k")), static_cast<std::size_t>(x_.rows()));
     std::size_t idx[kMaxK];
-    float dist[kMaxK], query[64];
-    for (std::size_t i = 0; i < x.size(); ++i) query[i] = static_cast<float>(x[i]);
+    float dist[kMaxK], query[kMaxDim];
+    double centred[kMaxDim];
+    const auto d = static_cast<Eigen::Index>(x.size());
+    for (Eigen::Index i = 0; i < d; ++i) centred[i] = x[static_cast<std::size_t>(i)] - centre_(i);
+    for (Eigen::Index j = 0; j < d; ++j) {
+      double v = 0;
+      for (Eigen::Index i = 0; i < d; ++i) v += centred[i] * axes_(i, j);
+      query[j] = static_cast<float>(v);
+    }
     const std::size_t found = std::visit([&](const auto& t) { return t->knnSearch(query, k, idx, dist); }, tree_);
     std::fill(y.begin(), y.end(), 0.0);
     for (std::size_t n = 0; n < found; ++n)
@@ -117,7 +149,9 @@ class Knn final : public Regressor {
   }
 
   Matrix x_, y_;  // saved as given
-  FloatRows xf_;  // what the tree searches, in its leaf order
+  Eigen::VectorXd centre_;  // column means of x_
+  Matrix axes_;    // principal axes as columns (identity when not rotating)
+  FloatRows xf_;   // (x_ - centre_) * axes_: what the tree searches, in its leaf order
   Matrix labels_; // y_ in the same order
   RowsAdaptor adaptor_{nullptr};
   std::variant<std::unique_ptr<L2Tree<24>>, std::unique_ptr<L1Tree<24>>, std::unique_ptr<L2Tree<-1>>,

@@ -51,6 +51,35 @@ TEST(Knn, MatchesBruteForceSearch) {
   }
 }
 
+TEST(Knn, PrincipalAxesSearchMatchesBruteForceOnCorrelatedStates) {
+  // States on a few correlated directions (as the dice move with the cup): the rotated and the
+  // unrotated tree find the brute-force neighbours.
+  const Matrix mix = random_matrix(4, 24, 8);
+  const Matrix x = random_matrix(1000, 4, 9) * mix + 0.01 * random_matrix(1000, 24, 10);
+  const Matrix q = random_matrix(40, 4, 11) * mix + 0.01 * random_matrix(40, 24, 12);
+  const Matrix y = random_matrix(1000, 3, 13);
+  for (const char* rotate : {"rotate=true", "rotate=false"}) {
+    auto knn = RegressorRegistry::global().create("knn", {"k=3", rotate});
+    knn->fit(x, y, 0);
+    double out[3];
+    for (Eigen::Index i = 0; i < q.rows(); ++i) {
+      knn->predict_row({q.row(i).data(), 24}, out);
+      const auto expected = brute_force(x, y, q.row(i).data(), 3, false);
+      for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << rotate << " row " << i;
+    }
+  }
+}
+
+TEST(Knn, RejectsMoreInputsThanItSearches) {
+  auto knn = RegressorRegistry::global().create("knn");
+  try {
+    knn->fit(random_matrix(10, 65, 14), random_matrix(10, 3, 15), 0);
+    FAIL() << "65 inputs accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("65 input dimensions; at most 64"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Knn, KOfOneReproducesTrainingLabels) {
   const Matrix x = random_matrix(200, 24, 4), y = random_matrix(200, 3, 5);
   auto knn = RegressorRegistry::global().create("knn", {"k=1"});
