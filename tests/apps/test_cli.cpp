@@ -171,6 +171,42 @@ TEST(CliLearning, DadTrainsWithACurveAndRefusesTheRowSplit) {
   EXPECT_THAT(p.output, HasSubstr("use --split episodes"));
 }
 
+// Rows and columns of a CSV file with a header: {rows, columns of every row (or -1 if they differ)}.
+std::pair<int, int> csv_shape(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  int rows = -1, cols = 0;
+  while (std::getline(in, line)) {
+    const int c = static_cast<int>(std::count(line.begin(), line.end(), ',')) + 1;
+    if (rows >= 0 && c != cols) cols = -1;
+    if (rows < 0) cols = c;
+    ++rows;
+  }
+  return {rows, cols};
+}
+
+TEST(CliLearning, BenchRegressorsExportsTheSplitItMeasured) {
+  const auto dir = std::filesystem::temp_directory_path() / "dicestack_cli_export";
+  std::filesystem::remove_all(dir);
+  const Process p = run("bench regressors --demos " + kTinyDemos + " --regressors linear_svr --split rows --calls 50 --json "
+                        "--export " + dir.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output).at(0).at("name"), "linear_svr");
+  const auto [train_x, cx] = csv_shape(dir / "train_x.csv");
+  const auto [train_y, cy] = csv_shape(dir / "train_y.csv");
+  const auto [test_x, tx] = csv_shape(dir / "test_x.csv");
+  const auto [test_y, ty] = csv_shape(dir / "test_y.csv");
+  EXPECT_EQ(cx, 24);
+  EXPECT_EQ(tx, 24);
+  EXPECT_EQ(cy, 3);
+  EXPECT_EQ(ty, 3);
+  EXPECT_EQ(train_x, train_y);
+  EXPECT_EQ(test_x, test_y);
+  EXPECT_GT(test_x, 0);
+  EXPECT_EQ(test_x, (train_x + test_x + 3) / 4);  // ceil(25 %) of the rows
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliBaselines, OptimiseWritesTheBestSequenceAndItsOutcome) {
   const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_optimise";
   std::filesystem::remove_all(out);
