@@ -1,0 +1,162 @@
+#include "regression_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <dicestack/core/error.hpp>
+
+namespace dicestack::forest {
+
+SortedColumns::SortedColumns(const Matrix& x) : order_(static_cast<std::size_t>(x.size())), rows_(x.rows()) {
+  const auto n = static_cast<std::size_t>(rows_);
+  for (Eigen::Index f = 0; f < x.cols(); ++f) {
+    const auto first = order_.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(f) * n);
+    std::iota(first, first + static_cast<std::ptrdiff_t>(n), 0);
+    std::stable_sort(first, first + static_cast<std::ptrdiff_t>(n), [&](int a, int b) { return x(a, f) < x(b, f); });
+  }
+}
+
+std::span<const int> SortedColumns::order(Eigen::Index feature) const {
+  return {order_.data() + static_cast<std::size_t>(feature * rows_), static_cast<std::size_t>(rows_)};
+}
+
+namespace {
+
+// A node waiting to be grown: its rows are [begin, end) of every feature's segment.
+struct Pending {
+  int node, begin, end, depth;
+};
+
+struct Split {
+  int feature = -1, last_left = -1;  // position (in the feature's segment) of the last row going left
+  double score = 0.0;                // sum_left^2 / w_left + sum_right^2 / w_right
+};
+
+}  // namespace
+
+Tree grow_tree(const Matrix& x, std::span<const double> y, const SortedColumns& sorted, std::span<const int> weights,
+               const TreeOptions& options, Rng& rng) {
+  const int d = static_cast<int>(x.cols());
+  // In-bag rows of each feature in that feature's order; splitting a node partitions every
+  // feature's segment stably, so each child's rows stay sorted without sorting again.
+  std::vector<int> rows;
+  for (int f = 0; f < d; ++f)
+    for (const int r : sorted.order(f))
+      if (weights[static_cast<std::size_t>(r)] > 0) rows.push_back(r);
+  const int m = d > 0 ? static_cast<int>(rows.size()) / d : 0;
+  Tree tree(1);
+  if (m == 0) return tree;  // nothing in the bag: a single leaf predicting 0
+
+  std::vector<char> goes_left(static_cast<std::size_t>(x.rows()), 0);
+  std::vector<int> scratch(static_cast<std::size_t>(m));
+  std::vector<int> candidates(static_cast<std::size_t>(d));
+  std::iota(candidates.begin(), candidates.end(), 0);
+  const int tries = options.features > 0 ? std::min(options.features, d) : d;
+  auto segment = [&](int f) { return rows.data() + static_cast<std::size_t>(f) * static_cast<std::size_t>(m); };
+
+  std::vector<Pending> stack{{0, 0, m, 0}};
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    double w = 0.0, s = 0.0, q = 0.0;
+    for (int k = p.begin; k < p.end; ++k) {
+      const int r = segment(0)[k];
+      const double c = weights[static_cast<std::size_t>(r)], v = y[static_cast<std::size_t>(r)];
+      w += c;
+      s += c * v;
+      q += c * v * v;
+    }
+    tree[static_cast<std::size_t>(p.node)].value = s / w;
+    const double parent = s * s / w;
+    if (p.depth >= options.max_depth || p.end - p.begin < std::max(2, options.min_samples) || q - parent <= 1e-12 * q)
+      continue;  // a leaf: deep enough, too few rows, or every label equal
+
+    if (tries < d)  // draw the features this node tries (partial Fisher-Yates)
+      for (int i = 0; i < tries; ++i)
+        std::swap(candidates[static_cast<std::size_t>(i)],
+                  candidates[static_cast<std::size_t>(i) + rng.below(static_cast<std::uint64_t>(d - i))]);
+    Split best{-1, -1, parent};
+    for (int t = 0; t < tries; ++t) {
+      const int f = candidates[static_cast<std::size_t>(t)];
+      const int* seg = segment(f);
+      double wl = 0.0, sl = 0.0;
+      for (int k = p.begin; k + 1 < p.end; ++k) {
+        const int r = seg[k];
+        const double c = weights[static_cast<std::size_t>(r)];
+        wl += c;
+        sl += c * y[static_cast<std::size_t>(r)];
+        if (!(x(seg[k + 1], f) > x(r, f))) continue;  // no threshold between equal values
+        const double sr = s - sl, score = sl * sl / wl + sr * sr / (w - wl);
+        if (score > best.score) best = {f, k, score};
+      }
+    }
+    if (best.feature < 0 || best.score - parent <= 1e-12 * q) continue;
+
+    const int* seg = segment(best.feature);
+    const double lo = x(seg[best.last_left], best.feature), hi = x(seg[best.last_left + 1], best.feature);
+    double threshold = lo + 0.5 * (hi - lo);
+    if (!(threshold < hi)) threshold = lo;  // adjacent doubles: the midpoint rounds up to hi
+    for (int k = p.begin; k < p.end; ++k) goes_left[static_cast<std::size_t>(seg[k])] = k <= best.last_left;
+    const int left_rows = best.last_left - p.begin + 1;
+    for (int f = 0; f < d; ++f) {  // stable partition of every feature's segment
+      int* g = segment(f);
+      int l = p.begin, spilled = 0;
+      for (int k = p.begin; k < p.end; ++k)
+        if (goes_left[static_cast<std::size_t>(g[k])]) g[l++] = g[k];
+        else scratch[static_cast<std::size_t>(spilled++)] = g[k];
+      std::copy(scratch.begin(), scratch.begin() + spilled, g + l);
+    }
+    const int left = static_cast<int>(tree.size());
+    tree.resize(tree.size() + 2);
+    Node& n = tree[static_cast<std::size_t>(p.node)];
+    n.feature = best.feature;
+    n.threshold = threshold;
+    n.left = left;
+    n.right = left + 1;
+    stack.push_back({left + 1, p.begin + left_rows, p.end, p.depth + 1});
+    stack.push_back({left, p.begin, p.begin + left_rows, p.depth + 1});
+  }
+  return tree;
+}
+
+Matrix to_matrix(const std::vector<Tree>& trees) {
+  std::size_t total = 0;
+  for (const auto& t : trees) total += t.size();
+  Matrix m(static_cast<Eigen::Index>(total), 5);
+  Eigen::Index i = 0;
+  for (const auto& t : trees)
+    for (const Node& n : t) m.row(i++) << n.feature, n.threshold, n.left, n.right, n.value;
+  return m;
+}
+
+std::vector<Tree> from_matrix(const Matrix& nodes, std::span<const double> sizes, std::size_t inputs, const std::string& who) {
+  auto integer = [&](double v, double lo, double hi, Eigen::Index row) {
+    if (!(v >= lo && v <= hi && v == std::floor(v)))
+      throw InputError(who + ": model payload node " + std::to_string(row) + " holds " + std::to_string(v) +
+                       " where an index in [" + std::to_string(static_cast<long long>(lo)) + ", " +
+                       std::to_string(static_cast<long long>(hi)) + "] belongs");
+    return static_cast<int>(v);
+  };
+  std::vector<Tree> trees;
+  Eigen::Index at = 0;
+  for (const double size_value : sizes) {
+    const int size = integer(size_value, 1, static_cast<double>(nodes.rows() - at), at);
+    Tree t(static_cast<std::size_t>(size));
+    for (int i = 0; i < size; ++i, ++at) {
+      Node& n = t[static_cast<std::size_t>(i)];
+      n.feature = integer(nodes(at, 0), -1, static_cast<double>(inputs) - 1, at);
+      n.threshold = nodes(at, 1);
+      n.value = nodes(at, 4);
+      if (n.feature < 0) continue;
+      n.left = integer(nodes(at, 2), i + 1, size - 1, at);  // children after the parent: no loops
+      n.right = integer(nodes(at, 3), i + 1, size - 1, at);
+    }
+    trees.push_back(std::move(t));
+  }
+  if (at != nodes.rows())
+    throw InputError(who + ": model payload holds " + std::to_string(nodes.rows()) + " nodes, its trees " + std::to_string(at));
+  return trees;
+}
+
+}  // namespace dicestack::forest
