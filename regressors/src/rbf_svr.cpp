@@ -1,3 +1,4 @@
+#include <dicestack/core/parallel.hpp>
 #include <dicestack/regressors/registry.hpp>
 
 #include "opencv_models.hpp"
@@ -13,7 +14,8 @@ class RbfSvr final : public Regressor {
     return {{"c", ParamType::real, "1", 1e-12, 1e12, "box constraint (paper VI-C: 1.0)", {}},
             {"epsilon", ParamType::real, "0.1", 0, 1e6, "insensitive-tube half-width, standardised label units", {}},
             {"gamma", ParamType::real, "0", 0, 1e6, "RBF width; 0 means 1 / (d * var(X)) at fit time", {}},
-            {"tol", ParamType::real, "0.001", 1e-12, 1, "solver stopping tolerance", {}}};
+            {"tol", ParamType::real, "0.001", 1e-12, 1, "solver stopping tolerance", {}},
+            {"threads", ParamType::integer, "0", 0, 1024, "training threads (one SVR per action), 0 = all cores; the model is the same for any", {}}};
   }
 
  private:
@@ -25,9 +27,10 @@ class RbfSvr final : public Regressor {
       gamma = 1.0 / (static_cast<double>(x.cols()) * (var > 0.0 ? var : 1.0));
     }
     const cv::Mat samples = opencv::to_float(x);
-    models_.clear();
-    for (Eigen::Index j = 0; j < y.cols(); ++j) {
-      models_.push_back(opencv::guarded(name(), [&] {
+    // The per-action SVRs are independent and their solver is deterministic: fit them at once.
+    std::vector<cv::Ptr<cv::ml::SVM>> models(static_cast<std::size_t>(y.cols()));
+    parallel_for(models.size(), static_cast<int>(params().integer("threads")), [&](std::size_t j, int) {
+      models[j] = opencv::guarded(name(), [&] {
         auto svm = cv::ml::SVM::create();
         svm->setType(cv::ml::SVM::EPS_SVR);
         svm->setKernel(cv::ml::SVM::RBF);
@@ -35,10 +38,11 @@ class RbfSvr final : public Regressor {
         svm->setP(params().real("epsilon"));
         svm->setGamma(gamma);
         svm->setTermCriteria(cv::TermCriteria(cv::TermCriteria::EPS, 0, params().real("tol")));
-        svm->train(samples, cv::ml::ROW_SAMPLE, opencv::to_float(y.col(j)));
+        svm->train(samples, cv::ml::ROW_SAMPLE, opencv::to_float(y.col(static_cast<Eigen::Index>(j))));
         return svm;
-      }));
-    }
+      });
+    });
+    models_ = std::move(models);
     prepare();
   }
 
