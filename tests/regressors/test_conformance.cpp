@@ -2,6 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -146,6 +147,23 @@ TEST_P(Conformance, LearnsAKnownFunction) {
 
 INSTANTIATE_TEST_SUITE_P(AllRegistered, Conformance, ::testing::ValuesIn(registered_with_plugin()),
                          [](const auto& param_info) { return param_info.param; });
+
+TEST(Registry, EveryThreadsParameterGivesTheSameModelOnAnyCount) {
+  const Matrix x = inputs(300, 24, 7), probe = inputs(10, 24, 8);
+  int with_threads = 0;
+  for (const auto& name : registered_with_plugin()) {
+    const auto& params = RegressorRegistry::global().info(name).params;
+    if (std::none_of(params.begin(), params.end(), [](const ParamSpec& p) { return p.name == "threads"; })) continue;
+    ++with_threads;
+    auto one = RegressorRegistry::global().create(name, {"threads=1"});
+    auto two = RegressorRegistry::global().create(name, {"threads=2"});
+    one->fit(x, target(x, false), 42);
+    two->fit(x, target(x, false), 42);
+    EXPECT_EQ(one->predict(probe), two->predict(probe)) << name;
+    EXPECT_EQ(one->save_payload(), two->save_payload()) << name;
+  }
+  EXPECT_EQ(with_threads, 3);  // gbt, random_forest, rbf_svr
+}
 
 TEST(Registry, ListsBuiltinsAndPluginWithSources) {
   const auto& reg = RegressorRegistry::global();

@@ -23,17 +23,6 @@ Matrix noisy_sine(Eigen::Index n, Matrix* y, std::uint64_t seed) {
   return x;
 }
 
-TEST(RandomForest, SameForestOnAnyNumberOfThreads) {
-  Matrix y;
-  const Matrix x = noisy_sine(500, &y, 1);
-  auto one = RegressorRegistry::global().create("random_forest", {"threads=1"});
-  auto two = RegressorRegistry::global().create("random_forest", {"threads=2"});
-  one->fit(x, y, 7);
-  two->fit(x, y, 7);
-  EXPECT_EQ(one->save_payload(), two->save_payload());
-  EXPECT_EQ(one->predict(x), two->predict(x));
-}
-
 TEST(RandomForest, OneSplitSeparatesAStepBetweenDistinctValues) {
   // Labels step from 0 to 1 between x = 4 and x = 5: a depth-1 tree splits there (wherever the
   // bootstrap left the neighbouring rows) and predicts each side's label exactly.
