@@ -1,6 +1,6 @@
 #pragma once
-// Shared plumbing for the OpenCV ml regressors: one model per action dimension (OpenCV's SVR
-// and random forest take a single response column), cv::Exception turned into InputError at
+// Plumbing for the OpenCV ml regressor (rbf_svr): one model per action dimension (OpenCV's SVR
+// takes a single response column), cv::Exception turned into InputError at
 // this edge with the regressor's name, and models saved as OpenCV YAML inside one JSON payload.
 #include <functional>
 #include <string>
@@ -68,15 +68,6 @@ std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, 
     }));
   }
   return models;
-}
-
-/// predict_row for per-output models: doubles to a stack float row, one predict per model.
-template <class T>
-void predict_each(const std::vector<cv::Ptr<T>>& models, std::span<const double> x, std::span<double> y) {
-  float row[64];
-  for (std::size_t i = 0; i < x.size(); ++i) row[i] = static_cast<float>(x[i]);
-  const cv::Mat sample(1, static_cast<int>(x.size()), CV_32F, row);
-  for (std::size_t j = 0; j < y.size(); ++j) y[j] = models[j]->predict(sample);
 }
 
 }  // namespace dicestack::opencv
