@@ -80,9 +80,9 @@ class Gbt final : public Regressor {
   }
 
   void do_predict_row(std::span<const double> x, std::span<double> y) const override {
-    float row[64];
-    for (std::size_t i = 0; i < x.size(); ++i) row[i] = static_cast<float>(x[i]);
-    predict_rows(row, 1, x.size(), y.data(), y.size());
+    thread_local std::vector<float> row;  // sized once per thread (any input width), then reused
+    row.assign(x.begin(), x.end());
+    predict_rows(row.data(), 1, x.size(), y.data(), y.size());
   }
 
   void do_predict(const Matrix& x, Matrix& y) const override {

@@ -77,9 +77,9 @@ class RbfSvr final : public Regressor {
 
   void do_predict_row(std::span<const double> x, std::span<double> y) const override {
     thread_local Eigen::VectorXf scratch;  // grows once per thread, then reused
-    float row[64];
-    for (std::size_t i = 0; i < x.size(); ++i) row[i] = static_cast<float>(x[i]);
-    const Eigen::Map<const Eigen::VectorXf> v(row, static_cast<Eigen::Index>(x.size()));
+    thread_local std::vector<float> row;  // sized once per thread (any input width), then reused
+    row.assign(x.begin(), x.end());
+    const Eigen::Map<const Eigen::VectorXf> v(row.data(), static_cast<Eigen::Index>(x.size()));
     const float norm2 = v.squaredNorm();
     for (std::size_t j = 0; j < y.size(); ++j) {
       const Kernel& k = kernels_[j];

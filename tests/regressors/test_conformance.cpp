@@ -70,6 +70,24 @@ TEST_P(Conformance, ShapesAndRowEqualsBatch) {
   }
 }
 
+TEST_P(Conformance, WideInputsArePredictedOrRefusedByName) {
+  // 80 input columns: more than any fixed-size scratch row a hot path might keep.
+  const Matrix x = inputs(200, 80, 11), probe = inputs(5, 80, 12);
+  auto r = make();
+  try {
+    r->fit(x, target(x, false), 3);
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(GetParam() + ": 80 input dimensions"));
+    return;
+  }
+  const Matrix batch = r->predict(probe);
+  double row[3];
+  for (Eigen::Index i = 0; i < probe.rows(); ++i) {
+    r->predict_row({probe.row(i).data(), 80}, row);
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(row[j], batch(i, j), 1e-9 * (1.0 + std::abs(row[j]))) << "row " << i;
+  }
+}
+
 TEST_P(Conformance, SaveThenLoadPredictsIdentically) {
   const Matrix x = inputs(300, 24, 4), probe = inputs(15, 24, 5);
   auto r = make();
