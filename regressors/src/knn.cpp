@@ -119,14 +119,13 @@ class Knn final : public Regressor {
     const auto k = std::min<std::size_t>(static_cast<std::size_t>(params().integer("k")), static_cast<std::size_t>(x_.rows()));
     std::size_t idx[kMaxK];
     float dist[kMaxK], query[kMaxDim];
-    double centred[kMaxDim];
+    double rotated[kMaxDim] = {};
     const auto d = static_cast<Eigen::Index>(x.size());
-    for (Eigen::Index i = 0; i < d; ++i) centred[i] = x[static_cast<std::size_t>(i)] - centre_(i);
-    for (Eigen::Index j = 0; j < d; ++j) {
-      double v = 0;
-      for (Eigen::Index i = 0; i < d; ++i) v += centred[i] * axes_(i, j);
-      query[j] = static_cast<float>(v);
+    for (Eigen::Index i = 0; i < d; ++i) {  // (x - centre) * axes, one row of axes at a time
+      const double c = x[static_cast<std::size_t>(i)] - centre_(i);
+      for (Eigen::Index j = 0; j < d; ++j) rotated[j] += c * axes_(i, j);
     }
+    for (Eigen::Index j = 0; j < d; ++j) query[j] = static_cast<float>(rotated[j]);
     const std::size_t found = std::visit([&](const auto& t) { return t->knnSearch(query, k, idx, dist); }, tree_);
     std::fill(y.begin(), y.end(), 0.0);
     for (std::size_t n = 0; n < found; ++n)
