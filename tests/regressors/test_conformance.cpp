@@ -196,7 +196,7 @@ TEST(Registry, ListsBuiltinsAndPluginWithSources) {
   EXPECT_THAT(test::error_of([&] { reg.create("rbf_svr", {"gamma=-1"}); }),
               HasSubstr("rbf_svr: parameter \"gamma\" must be >= 0, got -1"));
   EXPECT_THAT(test::error_of([&] { reg.create("rbf_svr", {"gama=1"}); }),
-              HasSubstr("rbf_svr: unknown parameter \"gama\" (parameters: c, epsilon, gamma, tol)"));
+              HasSubstr("rbf_svr: unknown parameter \"gama\" (parameters: c, epsilon, gamma, tol, threads)"));
   EXPECT_THAT(test::error_of([&] { reg.create("knn", {"k"}); }), HasSubstr("knn: \"k\" is not key=value"));
 }
 
