@@ -107,7 +107,10 @@ def main():
                "--seed", str(args.seed), "--calls", str(args.calls), "--export", tmp]
         if args.demos:
             cmd += ["--demos", args.demos]
-        run = subprocess.run(cmd, capture_output=True, text=True)
+        try:
+            run = subprocess.run(cmd, capture_output=True, text=True)
+        except OSError as e:
+            sys.exit(f"compare_python: cannot run {args.dicestack}: {e.strerror} (build first, or pass --dicestack PATH)")
         if run.returncode != 0:
             sys.exit(f"compare_python: {' '.join(cmd)} failed ({run.returncode}): {run.stderr.strip()}")
         ours = {r["name"]: r for r in json.loads(run.stdout)}
