@@ -131,26 +131,29 @@ Matrix to_matrix(const std::vector<Tree>& trees) {
 }
 
 std::vector<Tree> from_matrix(const Matrix& nodes, std::span<const double> sizes, std::size_t inputs, const std::string& who) {
-  auto integer = [&](double v, double lo, double hi, Eigen::Index row) {
+  // `where()` names the value ("node 12", "tree 3's size"), built only for the message.
+  auto integer = [&](double v, double lo, double hi, const auto& where) {
     if (!(v >= lo && v <= hi && v == std::floor(v)))
-      throw InputError(who + ": model payload node " + std::to_string(row) + " holds " + std::to_string(v) +
-                       " where an index in [" + std::to_string(static_cast<long long>(lo)) + ", " +
+      throw InputError(who + ": model payload " + where() + " holds " + std::to_string(v) +
+                       " where an integer in [" + std::to_string(static_cast<long long>(lo)) + ", " +
                        std::to_string(static_cast<long long>(hi)) + "] belongs");
     return static_cast<int>(v);
   };
   std::vector<Tree> trees;
   Eigen::Index at = 0;
   for (const double size_value : sizes) {
-    const int size = integer(size_value, 1, static_cast<double>(nodes.rows() - at), at);
+    const int size = integer(size_value, 1, static_cast<double>(nodes.rows() - at),
+                             [&] { return "tree " + std::to_string(trees.size()) + "'s size"; });
     Tree t(static_cast<std::size_t>(size));
     for (int i = 0; i < size; ++i, ++at) {
       Node& n = t[static_cast<std::size_t>(i)];
-      n.feature = integer(nodes(at, 0), -1, static_cast<double>(inputs) - 1, at);
+      const auto node = [&] { return "node " + std::to_string(at); };
+      n.feature = integer(nodes(at, 0), -1, static_cast<double>(inputs) - 1, node);
       n.threshold = nodes(at, 1);
       n.value = nodes(at, 4);
       if (n.feature < 0) continue;
-      n.left = integer(nodes(at, 2), i + 1, size - 1, at);  // children after the parent: no loops
-      n.right = integer(nodes(at, 3), i + 1, size - 1, at);
+      n.left = integer(nodes(at, 2), i + 1, size - 1, node);  // children after the parent: no loops
+      n.right = integer(nodes(at, 3), i + 1, size - 1, node);
     }
     trees.push_back(std::move(t));
   }
