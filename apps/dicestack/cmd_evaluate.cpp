@@ -33,6 +33,7 @@ int run_evaluate(const EvaluateOptions& opt) {
                                opt.threads, initial_push_from(opt.push));
   nlohmann::json j{{"model", opt.model.string()},
                    {"regressor", model->regressor().name()},
+                   {"features", model->features().name()},
                    {"episodes", s.episodes},
                    {"seed", opt.seed},
                    {"initial_push", opt.push},
@@ -49,7 +50,7 @@ int run_evaluate(const EvaluateOptions& opt) {
                    {"seconds", s.seconds}};
   if (!opt.demos.empty()) {
     const DemoSet set = read_demo_set(opt.demos);
-    const Split split = split_by_episode(set.episodes);
+    const Split split = split_by_episode(set.episodes, model->features());
     const auto sigma = column_sigma(split.train.y);
     j["train_error"] = scaled_l1_error(split.train.y, model->predict(split.train.x), sigma);
     if (split.test.rows() > 0) j["test_error"] = scaled_l1_error(split.test.y, model->predict(split.test.x), sigma);

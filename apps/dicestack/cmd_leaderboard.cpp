@@ -68,7 +68,7 @@ void add_outcomes(Row& row, const EvalStats& st, int seeds) {
 class NetworkPolicy final : public Policy {
  public:
   NetworkPolicy(std::shared_ptr<const PolicyNetwork> net, const WorldConfig& world) : net_(std::move(net)), world_(world) {}
-  Action act(const State& s) override { return net_->act(s, world_); }
+  Action act(const History& h) override { return net_->act(h.current(), world_); }
   std::string name() const override { return "reinforce"; }
 
  private:

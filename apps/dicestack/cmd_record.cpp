@@ -19,6 +19,7 @@ struct RecordOptions {
   std::uint64_t seed = 0;
   std::filesystem::path out;
   int threads = 0;
+  double noise = 0.0;
   bool successes_only = false;
   bool json = false;
 };
@@ -26,7 +27,8 @@ struct RecordOptions {
 int run_record(const RecordOptions& opt) {
   const WorldConfig world = opt.world.load();
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Episode> eps = record_expert(opt.expert, {}, world, opt.episodes, opt.seed, opt.threads);
+  std::vector<Episode> eps = record_expert(opt.expert, {}, world, opt.episodes, opt.seed, opt.threads,
+                                         {opt.noise, opt.noise, opt.noise});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int success = 0, stacked = 0, walls = 0;
   double cup = 0.0;
@@ -41,7 +43,12 @@ int run_record(const RecordOptions& opt) {
   set.description = "dicestack record --expert " + opt.expert;
   set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
                    std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
-                   "; episode i starts from random_start_state(world, derive_seed(seed, i))";
+                   (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
+                   "; episode i starts from random_start_state(world, training_start_seed(seed, i))" +
+                   (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
+                                          std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
+                                          "actions recorded"
+                                    : "");
   for (auto& e : eps)
     if (!opt.successes_only || e.outcome.realistic_success()) set.episodes.push_back(std::move(e));
   write_demo_set(set, opt.out);
@@ -84,6 +91,11 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->capture_default_str();
   cmd->add_option("--out", opt->out, "Demonstration folder to write (replaced whole)")->required();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--noise", opt->noise,
+                  "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "
+                  "expert's clean actions are recorded")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   cmd->add_flag("--successes-only", opt->successes_only, "Keep only realistic successes");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt] { run_record(*opt); });

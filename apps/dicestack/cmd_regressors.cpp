@@ -46,10 +46,18 @@ int run_learners() {
   const auto& reg = LearnerRegistry::global();
   for (const auto& name : reg.names()) {
     const auto& i = reg.info(name);
-    print_line(name + "\n    " + i.description);
+    print_line(name + "\n    " + i.description + "\n    default --features " + i.default_features);
     print_params(i.params, "--option");
   }
   print_line("(playback is an evaluation: the leaderboard's last row replays the demonstrations)");
+  print_line("\nfeature maps (--features NAME): what a learned policy's regressor reads");
+  for (const auto& name : feature_map_names()) {
+    const FeatureMap& m = feature_map(name);
+    char line[256];
+    std::snprintf(line, sizeof line, "  %-18s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
+                  m.description().c_str());
+    print_line(line);
+  }
   return 0;
 }
 

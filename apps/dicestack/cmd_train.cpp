@@ -17,7 +17,7 @@ namespace {
 struct TrainOptions {
   WorldOption world;
   DemosOption demos;
-  std::string regressor, learner = "bc", split = "episodes";
+  std::string regressor, learner = "bc", split = "episodes", features;
   std::vector<std::string> sets, options;
   std::filesystem::path out, checkpoint;
   std::uint64_t seed = 0;
@@ -31,6 +31,8 @@ int run_train(const TrainOptions& opt) {
   const DemoSet set = read_demo_set(dir);
   const auto learner = LearnerRegistry::global().create(opt.learner, opt.options);
   RegressorRegistry::global().info(opt.regressor);  // unknown names fail before any work
+  const FeatureMap& features =
+      feature_map(opt.features.empty() ? LearnerRegistry::global().info(opt.learner).default_features : opt.features);
   std::vector<Episode> train = set.episodes, test;
   if (opt.split == "episodes") {
     train.clear();
@@ -42,6 +44,7 @@ int run_train(const TrainOptions& opt) {
   c.world = world;
   c.regressor = opt.regressor;
   c.regressor_sets = opt.sets;
+  c.features = features.name();
   c.seed = opt.seed;
   c.threads = opt.threads;
   c.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
@@ -63,20 +66,21 @@ int run_train(const TrainOptions& opt) {
   r.model->record["learner_options"] = learner->params().summary();
   r.model->record["demos"] = dir.string();
   r.model->record["split"] = opt.split;
+  r.model->record["seed"] = std::to_string(opt.seed);
   save_model(*r.model, opt.out);
   const std::filesystem::path curve_path = opt.out.string() + ".curve.csv";
   if (!r.curve.empty()) write_curve_csv(r.curve, curve_path);
-  const Dataset train_d = make_dataset(train);
+  const Dataset train_d = make_dataset(train, features);
   const auto sigma = column_sigma(train_d.y);
   const double train_error = scaled_l1_error(train_d.y, r.model->predict(train_d.x), sigma);
   double test_error = -1.0;
   if (!test.empty()) {
-    const Dataset test_d = make_dataset(test);
+    const Dataset test_d = make_dataset(test, features);
     test_error = scaled_l1_error(test_d.y, r.model->predict(test_d.x), sigma);
   }
   if (opt.json) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
-                     {"seconds", seconds},        {"train_error", train_error}};
+                     {"features", features.name()}, {"seconds", seconds},        {"train_error", train_error}};
     if (test_error >= 0) j["test_error"] = test_error;
     if (!r.curve.empty()) j["curve"] = curve_path.string();
     print_line(j.dump());
@@ -100,8 +104,11 @@ void add_train_command(CLI::App& app) {
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressor", opt->regressor, "Regressor name (see `dicestack regressors`)")->required();
   cmd->add_option("--set", opt->sets, "key=value parameter of the regressor; repeatable");
-  cmd->add_option("--learner", opt->learner, "Learner: bc, dagger, dad (see `dicestack learners`)")->capture_default_str();
+  cmd->add_option("--learner", opt->learner, "Learner: bc, dagger, dad, dart (see `dicestack learners`)")->capture_default_str();
   cmd->add_option("--option", opt->options, "key=value option of the learner; repeatable");
+  cmd->add_option("--features", opt->features,
+                  "Feature map the policy reads: state, state+clock, state+clock+start, state+history (default: the "
+                  "learner's, see `dicestack learners`)");
   cmd->add_option("--split", opt->split,
                   "episodes: train on episodes i % 5 != 4, report test error and give the rest to learners as "
                   "held-out demonstrations; none: all")

@@ -30,7 +30,9 @@ StepResult DiceEnv::step(const Action& action) {
     if (c.physics.action_noise > 0.0) a[k] += c.physics.action_noise * c.action.scale[k] * noise_.normal();
     a[k] = std::clamp(a[k], -c.action.limit[k], c.action.limit[k]);
   }
-  return finish_step(world_.step(a));
+  StepResult r = finish_step(world_.step(a));
+  r.applied = a;
+  return r;
 }
 
 StepResult DiceEnv::finish_step(bool wall) {

@@ -25,6 +25,12 @@ State paper_start_state(const WorldConfig& config) {
   return s;
 }
 
+std::uint64_t evaluation_start_seed(std::uint64_t seed, std::uint64_t index) { return derive_seed(seed, index); }
+
+std::uint64_t training_start_seed(std::uint64_t seed, std::uint64_t index) {
+  return derive_seed(derive_seed(seed, kTrainingStream), index);
+}
+
 State random_start_state(const WorldConfig& config, std::uint64_t seed) {
   const auto& r = config.randomization;
   Rng rng(seed);

@@ -8,11 +8,12 @@
 namespace dicestack {
 namespace {
 
-Dataset stack(const std::vector<const Episode*>& episodes) {
+Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features) {
   std::size_t n = 0;
   for (const Episode* e : episodes) n += e->size();
+  const auto width = static_cast<Eigen::Index>(features.width());
   Dataset d;
-  d.x.resize(static_cast<Eigen::Index>(n), kStateDim);
+  d.x.resize(static_cast<Eigen::Index>(n), width);
   d.y.resize(static_cast<Eigen::Index>(n), kActionDim);
   Eigen::Index row = 0;
   for (const Episode* e : episodes) {
@@ -20,7 +21,8 @@ Dataset stack(const std::vector<const Episode*>& episodes) {
     d.episode_begin.push_back(static_cast<std::size_t>(row));
     d.episode_names.push_back(e->name);
     for (std::size_t t = 0; t < e->size(); ++t, ++row) {
-      for (std::size_t j = 0; j < kStateDim; ++j) d.x(row, static_cast<Eigen::Index>(j)) = e->states[t][j];
+      const History h{std::span<const State>(e->states.data(), t + 1), std::span<const Action>(e->actions.data(), t)};
+      features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
       for (std::size_t j = 0; j < kActionDim; ++j) d.y(row, static_cast<Eigen::Index>(j)) = e->actions[t][j];
     }
   }
@@ -29,7 +31,7 @@ Dataset stack(const std::vector<const Episode*>& episodes) {
 
 Dataset take_rows(const Dataset& all, const std::vector<std::size_t>& rows) {
   Dataset d;
-  d.x.resize(static_cast<Eigen::Index>(rows.size()), kStateDim);
+  d.x.resize(static_cast<Eigen::Index>(rows.size()), all.x.cols());
   d.y.resize(static_cast<Eigen::Index>(rows.size()), kActionDim);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     d.x.row(static_cast<Eigen::Index>(i)) = all.x.row(static_cast<Eigen::Index>(rows[i]));
@@ -40,19 +42,19 @@ Dataset take_rows(const Dataset& all, const std::vector<std::size_t>& rows) {
 
 }  // namespace
 
-Dataset make_dataset(const std::vector<Episode>& episodes) {
+Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features) {
   std::vector<const Episode*> all;
   for (const auto& e : episodes) all.push_back(&e);
-  return stack(all);
+  return stack(all, features);
 }
 
 bool is_test_episode(std::size_t index) { return index % 5 == 4; }
 
-Split split_by_episode(const std::vector<Episode>& episodes) {
+Split split_by_episode(const std::vector<Episode>& episodes, const FeatureMap& features) {
   std::vector<const Episode*> train, test;
   for (std::size_t i = 0; i < episodes.size(); ++i) (is_test_episode(i) ? test : train).push_back(&episodes[i]);
   if (train.empty()) throw InputError("episode split: no training episode among " + std::to_string(episodes.size()));
-  Split s{stack(train), stack(test),
+  Split s{stack(train, features), stack(test, features),
           "episodes: i % 5 == 4 is test (" + std::to_string(test.size()) + " of " + std::to_string(episodes.size()) +
               " episodes)"};
   return s;
@@ -79,10 +81,11 @@ std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t s
   return perm;
 }
 
-Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction, std::uint32_t seed) {
+Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction, std::uint32_t seed,
+                    const FeatureMap& features) {
   if (!(test_fraction > 0.0 && test_fraction < 1.0))
     throw ConfigError("row split: test fraction must be in (0, 1), got " + std::to_string(test_fraction));
-  const Dataset all = make_dataset(episodes);
+  const Dataset all = make_dataset(episodes, features);
   const std::size_t n = all.rows();
   // scikit-learn: n_test = ceil(fraction * n), test = perm[:n_test], train = perm[n_test:].
   const auto n_test = static_cast<std::size_t>(std::ceil(test_fraction * static_cast<double>(n)));

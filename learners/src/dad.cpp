@@ -33,6 +33,11 @@ class Dad final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
+    // Corrections are windows cut from the middle of a drifted episode: a map that reads the
+    // step index, the start or the previous state would see them out of their episode.
+    if (c.features != "state")
+      throw ConfigError("dad: feature map \"" + c.features + "\" reads more than the current state, and DaD's "
+                        "corrections are windows without their episode; use --features state");
     const int windows = static_cast<int>(params().integer("windows"));
     const int per_window = static_cast<int>(params().integer("iterations"));
     const int total = windows * per_window;

@@ -46,7 +46,8 @@ class Dagger final : public Learner {
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!env) env.emplace(c.world);
         if (!expert) expert = make_expert(expert_name);
-        fresh[k] = mixture_rollout(*env, *expert, model.get(), beta, derive_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
+        fresh[k] = mixture_rollout(*env, *expert, model.get(), beta,
+                                   training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
         const int done = ++finished;
         if (c.progress && w == 0)  // one thread reports
           c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
@@ -92,19 +93,20 @@ class Dagger final : public Learner {
     Episode e;
     e.seed = seed;
     e.origin = "dagger";
-    env.reset_to(random_start_state(env.config(), seed), seed);
+    std::vector<Action> applied;
+    e.states.push_back(env.reset_to(random_start_state(env.config(), seed), seed));
     expert.reset(seed);
     Rng coin(derive_seed(seed, 7));
     while (true) {
-      const State s = env.get_state();
       const Action label = expert.act(env);
       const bool expert_acts = model == nullptr || coin.uniform() < beta;
-      const Action a = expert_acts ? label : model->act(s);
-      e.states.push_back(s);
+      const Action a = expert_acts ? label : model->act(History{e.states, applied});
       e.actions.push_back(label);
       e.sources.push_back(expert_acts ? StepSource::expert : StepSource::policy);
       const StepResult r = env.step(a);
+      applied.push_back(r.applied);
       if (r.terminated || r.truncated) break;
+      e.states.push_back(r.observation);
     }
     e.outcome = env.outcome();
     return e;

@@ -9,6 +9,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/core/rng.hpp>
 
 namespace dicestack {
 
@@ -20,23 +21,29 @@ InitialPush initial_push_from(std::string_view text) {
 }
 
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
-                InitialPush push) {
+                const RolloutOptions& options) {
   Episode e;
   e.seed = seed;
   e.origin = policy.name();
-  State s = env.reset_to(start, seed);
+  const auto& limit = env.config().action.limit;
+  const bool noisy = options.noise[0] > 0.0 || options.noise[1] > 0.0 || options.noise[2] > 0.0;
+  Rng noise(options.noise_seed);
+  std::vector<Action> applied;
+  e.states.push_back(env.reset_to(start, seed));
   policy.reset(seed);
   while (true) {
-    Action a = policy.act(s);
-    if (e.states.empty() && push != InitialPush::none) a[0] += push == InitialPush::left ? -1.0 : 1.0;
-    for (std::size_t k = 0; k < kActionDim; ++k)  // record what the world applies
-      a[k] = std::clamp(a[k], -env.config().action.limit[k], env.config().action.limit[k]);
-    e.states.push_back(s);
+    Action a = policy.act(History{e.states, applied});
+    if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
+    for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
+    Action executed = a;
+    if (noisy)
+      for (std::size_t k = 0; k < kActionDim; ++k) executed[k] += options.noise[k] * noise.normal();
     e.actions.push_back(a);
     e.sources.push_back(source);
-    const StepResult r = env.step(a);
-    s = r.observation;
+    const StepResult r = env.step(executed);
+    applied.push_back(r.applied);
     if (r.terminated || r.truncated) break;
+    e.states.push_back(r.observation);
   }
   e.outcome = env.outcome();
   return e;
@@ -58,9 +65,9 @@ class TimedPolicy final : public Policy {
  public:
   TimedPolicy(Policy& inner, double& seconds) : inner_(inner), seconds_(seconds) {}
   void reset(std::uint64_t seed) override { inner_.reset(seed); }
-  Action act(const State& s) override {
+  Action act(const History& h) override {
     const auto t0 = std::chrono::steady_clock::now();
-    const Action a = inner_.act(s);
+    const Action a = inner_.act(h);
     seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return a;
   }
@@ -100,6 +107,7 @@ EvalStats summarise(const std::vector<Episode>& eps, double policy_seconds, doub
 
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
                    int threads, InitialPush push, std::vector<Episode>* rollouts) {
+  const RolloutOptions options{push};
   const int workers = resolve_threads(threads);
   std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
@@ -111,9 +119,9 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
     if (!envs[slot]) envs[slot].emplace(world);
     if (!policies[slot]) policies[slot] = make_policy();
     TimedPolicy timed(*policies[slot], policy_seconds[slot]);
-    const std::uint64_t episode_seed = derive_seed(seed, i);
+    const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
     const State start = random_start_state(world, episode_seed);
-    eps[i] = rollout(*envs[slot], timed, start, episode_seed, StepSource::policy, push);
+    eps[i] = rollout(*envs[slot], timed, start, episode_seed, StepSource::policy, options);
   });
   double total_policy = 0.0;
   for (double s : policy_seconds) total_policy += s;

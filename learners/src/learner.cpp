@@ -15,6 +15,7 @@ namespace dicestack {
 void register_bc(LearnerRegistry&);
 void register_dagger(LearnerRegistry&);
 void register_dad(LearnerRegistry&);
+void register_dart(LearnerRegistry&);
 
 LearnerRegistry& LearnerRegistry::global() {
   static LearnerRegistry* registry = [] {
@@ -22,6 +23,7 @@ LearnerRegistry& LearnerRegistry::global() {
     register_bc(*r);
     register_dagger(*r);
     register_dad(*r);
+    register_dart(*r);
     return r;
   }();
   return *registry;
@@ -44,8 +46,10 @@ std::vector<std::string> LearnerRegistry::names() const { return registered_name
 
 std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
   if (data.empty()) throw InputError("no demonstrations to learn from");
-  const Dataset d = make_dataset(data);
-  auto model = std::make_shared<Model>(Model::train(c.registry->create(c.regressor, c.regressor_sets), d.x, d.y, seed));
+  const FeatureMap& features = feature_map(c.features);
+  const Dataset d = make_dataset(data, features);
+  auto model = std::make_shared<Model>(
+      Model::train(c.registry->create(c.regressor, c.regressor_sets), d.x, d.y, seed, nullptr, features));
   model->record["regressor_params"] = model->regressor().params().summary();
   model->record["rows"] = std::to_string(d.rows());
   model->record["episodes"] = std::to_string(d.episodes());

@@ -1,5 +1,6 @@
 #include <dicestack/learners/record.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -7,12 +8,21 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/builtin.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/policy.hpp>
 
 namespace dicestack {
 
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads) {
+                                   int episodes, std::uint64_t seed, int threads, const Action& noise) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
+  RolloutOptions options;
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    if (!(noise[k] >= 0.0) || !std::isfinite(noise[k]))
+      throw ConfigError("noise for " + std::string(action_names()[k]) + " must be a finite fraction >= 0, got " +
+                        std::to_string(noise[k]));
+    options.noise[k] = noise[k] * world.action.scale[k];
+  }
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
   std::vector<std::optional<DiceEnv>> envs(workers);
   std::vector<std::unique_ptr<Expert>> experts(workers);
@@ -22,17 +32,12 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
     auto& expert = experts[static_cast<std::size_t>(w)];
     if (!env) env.emplace(world);
     if (!expert) expert = make_expert(name, config);
-    const std::uint64_t s = derive_seed(seed, i);
-    env->reset_to(random_start_state(world, s), s);
-    expert->reset(s);
-    const ExpertEpisode run = run_expert_episode(*expert, *env, true);
-    Episode& e = out[i];
-    e.seed = s;
-    e.origin = "expert " + name;
-    e.states = run.states;
-    e.actions = run.actions;
-    e.sources.assign(e.states.size(), StepSource::expert);
-    e.outcome = run.outcome;
+    const std::uint64_t s = training_start_seed(seed, i);
+    ExpertPolicy policy(*expert, *env);
+    RolloutOptions o = options;
+    o.noise_seed = derive_seed(s, 2);
+    out[i] = rollout(*env, policy, random_start_state(world, s), s, StepSource::expert, o);
+    out[i].origin = "expert " + name;
   });
   return out;
 }
@@ -40,7 +45,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
   const std::uint64_t h = fnv1a(to_json(world));
   char name[40];
-  std::snprintf(name, sizeof name, "expert-v1-%08llx", static_cast<unsigned long long>(h >> 32));
+  std::snprintf(name, sizeof name, "expert-v2-%08llx", static_cast<unsigned long long>(h >> 32));
   const auto dir = cache_dir() / name;
   if (std::filesystem::exists(dir / "meta.json")) return dir;
 
@@ -62,7 +67,7 @@ std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
     batch_start += kBuiltinSuccesses;
   }
   set.provenance = "dicestack builtin_demo_set: expert mpc (default ExpertConfig), random starts with seeds "
-                   "derive_seed(derive_seed(" + std::to_string(kBuiltinSeed) + ", batch), i); " +
+                   "training_start_seed(derive_seed(" + std::to_string(kBuiltinSeed) + ", batch), i); " +
                    std::to_string(set.episodes.size()) + " successes kept of " + std::to_string(tried) + " episodes";
   write_demo_set(set, dir);
   return dir;

@@ -26,38 +26,42 @@ json scaler_json(const Standardizer& s) { return {{"mean", s.mean}, {"sigma", s.
 
 }  // namespace
 
-Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y)
-    : regressor_(std::move(regressor)), x_(std::move(x)), y_(std::move(y)) {
+Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y, const FeatureMap& features)
+    : regressor_(std::move(regressor)), features_(&features), x_(std::move(x)), y_(std::move(y)) {
   if (!regressor_) throw std::logic_error("Model needs a regressor");
 }
 
 Model Model::train(std::unique_ptr<Regressor> regressor, const Matrix& x, const Matrix& y, std::uint64_t seed,
-                   std::vector<std::string>* warnings) {
-  if (x.cols() != static_cast<Eigen::Index>(kStateDim) || y.cols() != static_cast<Eigen::Index>(kActionDim))
+                   std::vector<std::string>* warnings, const FeatureMap& features) {
+  if (x.cols() != static_cast<Eigen::Index>(features.width()) || y.cols() != static_cast<Eigen::Index>(kActionDim))
     throw InputError("training data is " + std::to_string(x.cols()) + " -> " + std::to_string(y.cols()) +
-                     " columns; a policy maps 24 state values to 3 action values");
-  std::vector<std::string> names;
-  for (auto n : state_names()) names.emplace_back(n);
+                     " columns; a policy on features \"" + features.name() + "\" maps " +
+                     std::to_string(features.width()) + " inputs to 3 action values");
+  std::vector<std::string> names = features.column_names();
   Standardizer xs = Standardizer::fit(x, warnings, &names);
   names.clear();
   for (auto n : action_names()) names.emplace_back(n);
   Standardizer ys = Standardizer::fit(y, warnings, &names);
   regressor->fit(xs.apply(x), ys.apply(y), seed);
-  return Model(std::move(regressor), std::move(xs), std::move(ys));
+  return Model(std::move(regressor), std::move(xs), std::move(ys), features);
 }
 
-Action Model::act(const State& state) const {
-  std::array<double, kStateDim> z;
-  x_.apply_row(state, z);
+Action Model::act(const History& history) const {
+  const std::size_t width = features_->width();
+  std::array<double, kMaxFeatureWidth> row, z;
+  features_->compute(history, {row.data(), width});
+  x_.apply_row({row.data(), width}, {z.data(), width});
   std::array<double, kActionDim> out;
-  regressor_->predict_row(z, out);
+  regressor_->predict_row({z.data(), width}, out);
   Action a;
   y_.invert_row(out, a);
   return a;
 }
 
-Matrix Model::predict(const Matrix& states) const {
-  const Matrix z = regressor_->predict(x_.apply(states));
+Action Model::act(const State& state) const { return act(History{{&state, 1}, {}}); }
+
+Matrix Model::predict(const Matrix& rows) const {
+  const Matrix z = regressor_->predict(x_.apply(rows));
   Matrix out(z.rows(), z.cols());
   for (Eigen::Index i = 0; i < z.rows(); ++i)
     y_.invert_row({z.row(i).data(), static_cast<std::size_t>(z.cols())}, {out.row(i).data(), static_cast<std::size_t>(z.cols())});
@@ -74,7 +78,11 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                     {"dicestack_version", DICESTACK_VERSION},
                     {"regressor", r.name()},
                     {"params", params},
-                    {"state_dim", r.input_dim()},
+                    {"features", model.features().name()},
+                    {"features_version", model.features().version()},
+                    {"input_dim", r.input_dim()},
+                    {"input_names", model.features().column_names()},
+                    {"state_dim", kStateDim},
                     {"action_dim", r.output_dim()},
                     {"state_names", state_names()},
                     {"action_names", action_names()},
@@ -108,6 +116,24 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
                        std::to_string(kModelFormatVersion) + "); upgrade dicestack");
     const auto state_dim = h.at("state_dim").get<std::size_t>();
     const auto action_dim = h.at("action_dim").get<std::size_t>();
+    // Version 1 had no feature map: its regressors read the 24 state numbers.
+    const FeatureMap& features = [&]() -> const FeatureMap& {
+      try {
+        return feature_map(version >= 2 ? h.at("features").get<std::string>() : "state");
+      } catch (const ConfigError& e) {
+        throw InputError(where + e.what() + " (upgrade dicestack?)");
+      }
+    }();
+    if (version >= 2) {
+      const int fv = h.at("features_version").get<int>();
+      if (fv != features.version())
+        throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
+                         " differs from this dicestack's (" + std::to_string(features.version()) + ")");
+    }
+    const std::size_t input_dim = version >= 2 ? h.at("input_dim").get<std::size_t>() : state_dim;
+    if (input_dim != features.width())
+      throw InputError(where + "the regressor reads " + std::to_string(input_dim) + " inputs, but feature map \"" +
+                       features.name() + "\" produces " + std::to_string(features.width()));
     if (state_dim != kStateDim)
       throw InputError(where + "trained on " + std::to_string(state_dim) + "-d states, this world produces " +
                        std::to_string(kStateDim) + "-d");
@@ -131,7 +157,7 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
         if (!(v > 0.0) || !std::isfinite(v)) throw InputError(where + key + " has a sigma that is not positive");
       return s;
     };
-    Standardizer xs = scaler("x_standardizer", state_dim), ys = scaler("y_standardizer", action_dim);
+    Standardizer xs = scaler("x_standardizer", input_dim), ys = scaler("y_standardizer", action_dim);
     const auto bytes = h.at("payload_bytes").get<std::size_t>();
     std::string payload(bytes, '\0');
     in.read(payload.data(), static_cast<std::streamsize>(bytes));
@@ -143,11 +169,11 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
     if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
       throw InputError(where + "corrupted: the payload's checksum does not match the header");
     try {
-      regressor->load_payload(payload, state_dim, action_dim);
+      regressor->load_payload(payload, input_dim, action_dim);
     } catch (const Error& e) {
       throw InputError(where + e.what());
     }
-    Model model(std::move(regressor), std::move(xs), std::move(ys));
+    Model model(std::move(regressor), std::move(xs), std::move(ys), features);
     if (h.contains("record"))
       for (const auto& [k, v] : h["record"].items()) model.record[k] = v.is_string() ? v.get<std::string>() : v.dump();
     return model;

@@ -20,7 +20,8 @@ namespace {
 class Swing final : public Policy {
  public:
   void reset(std::uint64_t seed) override { phase_ = static_cast<int>(seed % 7); }
-  Action act(const State& s) override {
+  Action act(const History& h) override {
+    const State& s = h.current();
     ++phase_;
     return {(phase_ / 10) % 2 ? 0.4 : -0.4, 4.0 / 30.0 - s[state_index::kCupVy] * 0.5, -0.1 * s[state_index::kCupW]};
   }
@@ -67,7 +68,7 @@ TEST(Evaluate, RatesAgreeWithRollingOutByHand) {
   for (std::size_t i = 0; i < 5; ++i) {
     Swing p;
     const std::uint64_t seed = derive_seed(9, i);
-    const Episode e = rollout(env, p, random_start_state(c, seed), seed, StepSource::policy, InitialPush::left);
+    const Episode e = rollout(env, p, random_start_state(c, seed), seed, StepSource::policy, {InitialPush::left});
     EXPECT_EQ(e.states, eps[i].states);
     walls += e.outcome.wall_contact;
     cup += e.outcome.dice_in_cup;
@@ -156,7 +157,7 @@ TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {
   // The expert's own episodes from the same starts: the labels are exactly its actions.
   DiceEnv env(c.world);
   auto expert = make_expert("scripted");
-  const std::uint64_t seed = derive_seed(derive_seed(c.seed, 1), 0);
+  const std::uint64_t seed = training_start_seed(derive_seed(c.seed, 1), 0);
   env.reset_to(random_start_state(c.world, seed), seed);
   expert->reset(seed);
   const ExpertEpisode run = run_expert_episode(*expert, env, true);

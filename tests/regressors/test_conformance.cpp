@@ -238,10 +238,10 @@ TEST(ModelFile, TruncatedCorruptedOrForeignFilesAreRejected) {
   rewrite("hello\n");
   EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("not a dicestack model"));
   std::string newer = bytes;
-  newer.replace(newer.find("\"version\":1"), 11, "\"version\":7");
+  newer.replace(newer.find("\"version\":2"), 11, "\"version\":7");
   rewrite(newer);
   EXPECT_THAT(test::error_of([&] { load_model(path); }),
-              HasSubstr("format version 7 is newer than this dicestack reads (1); upgrade dicestack"));
+              HasSubstr("format version 7 is newer than this dicestack reads (2); upgrade dicestack"));
   std::string dims = bytes;
   dims.replace(dims.find("\"state_dim\":24"), 14, "\"state_dim\":26");
   rewrite(dims);

@@ -19,6 +19,7 @@ struct StepInfo {
 
 struct StepResult {
   State observation{};
+  Action applied{};        ///< the action the world applied: noise added (if configured), clipped to the limits
   double reward = 0.0;     ///< -gamma^(T - t) * distance: summed over T steps, minus eq. 6
   bool terminated = false; ///< realistic success held for judge.success_hold_steps steps
   bool truncated = false;  ///< the time limit episode.max_steps was reached

@@ -15,6 +15,16 @@ State paper_start_state(const WorldConfig& config);
 /// (deterministically) while shapes overlap. Throws ConfigError if no valid start is found.
 State random_start_state(const WorldConfig& config, std::uint64_t seed);
 
+/// Seed of evaluation start `index` of a run seeded with `seed` (`evaluate --seed`, the
+/// leaderboard's rollouts): derive_seed(seed, index).
+std::uint64_t evaluation_start_seed(std::uint64_t seed, std::uint64_t index);
+
+/// Seed of training start `index`: every start training sees (record, the built-in set, DART,
+/// DAgger's rollouts) comes from this stream, apart from evaluation's, so that `record --seed 0`
+/// and `evaluate --seed 0` share no start: derive_seed(derive_seed(seed, kTrainingStream), index).
+inline constexpr std::uint64_t kTrainingStream = 0x747261696e696e67ULL;  // "training"
+std::uint64_t training_start_seed(std::uint64_t seed, std::uint64_t index);
+
 /// The paper's goal: the three dice at rest in one column at cost.goal_x on the table, die 0
 /// at the bottom, unrotated; the cup at its start pose and at rest.
 State goal_state(const WorldConfig& config);

@@ -1,6 +1,6 @@
 #pragma once
-// Demonstrations as matrices a regressor can fit: X (N x 24 states), Y (N x 3 actions), with
-// episode boundaries, and the train/test splits of DESIGN.
+// Demonstrations as matrices a regressor can fit: X (N x a feature map's width; the 24 state
+// numbers by default), Y (N x 3 actions), with episode boundaries, and the train/test splits of DESIGN.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <dicestack/datasets/episode.hpp>
+#include <dicestack/datasets/features.hpp>
 
 namespace dicestack {
 
@@ -16,7 +17,7 @@ using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowM
 
 /// Stacked (state, action) pairs of some episodes.
 struct Dataset {
-  Matrix x;                              ///< N x 24
+  Matrix x;                              ///< N x features.width() (24 for "state")
   Matrix y;                              ///< N x 3
   std::vector<std::size_t> episode_begin;  ///< first row of each episode, ascending
   std::vector<std::string> episode_names;
@@ -25,8 +26,9 @@ struct Dataset {
   std::size_t episodes() const { return episode_begin.size(); }
 };
 
-/// Stacks the episodes in the given order. Throws InputError if an episode is malformed.
-Dataset make_dataset(const std::vector<Episode>& episodes);
+/// Stacks the episodes in the given order; row t of an episode is `features` of its history up
+/// to step t. Throws InputError if an episode is malformed.
+Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features = state_features());
 
 /// A train/test partition and how it was made (for reports).
 struct Split {
@@ -40,12 +42,13 @@ bool is_test_episode(std::size_t index);
 
 /// DESIGN's default: episode i (in file-name order) is a test episode when i % 5 == 4.
 /// Throws InputError if that leaves no training episode.
-Split split_by_episode(const std::vector<Episode>& episodes);
+Split split_by_episode(const std::vector<Episode>& episodes, const FeatureMap& features = state_features());
 
 /// The paper's Table I protocol: a random `test_fraction` of rows is test, drawn as
 /// scikit-learn's train_test_split(random_state=seed) draws it (numpy's legacy Mersenne
 /// Twister permutation), so neighbouring frames of one episode can sit on both sides.
-Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction = 0.25, std::uint32_t seed = 42);
+Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction = 0.25, std::uint32_t seed = 42,
+                    const FeatureMap& features = state_features());
 
 /// numpy.random.RandomState(seed).permutation(n), reproduced exactly.
 std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t seed);

@@ -16,10 +16,22 @@ enum class InitialPush { none, left, right };
 /// Parses "none", "left" or "right"; throws ConfigError otherwise.
 InitialPush initial_push_from(std::string_view text);
 
-/// Runs `policy` from `start` until termination or the time limit and records the episode
-/// (states before each action, the actions as applied, the outcome). `source` tags each step.
+/// How a rollout perturbs what its policy chooses.
+struct RolloutOptions {
+  InitialPush push = InitialPush::none;  ///< the paper's jump-start at the first step
+  /// DART (Laskey et al. 2017): std of Gaussian noise added to each executed action, world units
+  /// (all zero: none). Drawn from the rollout's own stream (noise_seed), outside the environment,
+  /// so an expert that simulates cannot foresee it.
+  Action noise{0.0, 0.0, 0.0};
+  std::uint64_t noise_seed = 0;
+};
+
+/// Runs `policy` from `start` until termination or the time limit and records the episode: the
+/// state before each action, the outcome, and per step the policy's action clipped to the
+/// world's limits (its clean label; without noise, exactly what the world applied). The policy's
+/// History holds the actions the world applied. `source` tags each step.
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
-                InitialPush push = InitialPush::none);
+                const RolloutOptions& options = {});
 
 /// A proportion with its 95% Wilson score interval.
 struct Rate {
@@ -45,7 +57,7 @@ struct EvalStats {
 /// Makes one policy per worker thread (policies may keep per-episode state).
 using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
 
-/// Rolls a policy out from `episodes` random starts (seeds derived from `seed`), in parallel
+/// Rolls a policy out from `episodes` random starts (evaluation_start_seed(seed, i)), in parallel
 /// on `threads` threads with one world each; the result does not depend on the thread count.
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
                    int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr);

@@ -48,6 +48,7 @@ struct LearnContext {
   WorldConfig world;
   std::string regressor = "knn";
   std::vector<std::string> regressor_sets;  ///< "key=value" for the regressor
+  std::string features = "state";           ///< the feature map every fitted model reads (features.hpp)
   std::uint64_t seed = 0;
   int threads = 0;                           ///< 0 = all cores
   const RegressorRegistry* registry = &RegressorRegistry::global();
@@ -81,9 +82,10 @@ struct LearnerInfo {
   std::vector<ParamSpec> params;
   std::function<std::unique_ptr<Learner>(std::string, Params)> factory;
   bool needs_trajectories = false;  ///< learns from whole episodes, so not from shuffled rows
+  std::string default_features = "state";  ///< the feature map used when none is named (docs/learners.md)
 };
 
-/// Learners by name ("bc", "dagger", "dad"); built-ins registered on first use.
+/// Learners by name ("bc", "dagger", "dad", "dart"); built-ins registered on first use.
 class LearnerRegistry {
  public:
   static LearnerRegistry& global();
@@ -98,8 +100,8 @@ class LearnerRegistry {
   std::map<std::string, LearnerInfo, std::less<>> entries_;
 };
 
-/// Fits `context.regressor` on every (state, action) pair of `context.demos` (the training
-/// half of the learner's data): behaviour cloning's one step.
+/// Fits `context.regressor` on every step of `data`, each seen through `context.features`:
+/// behaviour cloning's one step.
 std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed);
 
 }  // namespace dicestack

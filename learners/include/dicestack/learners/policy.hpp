@@ -1,22 +1,28 @@
 #pragma once
-// Policies: what acts in the world. A learned policy is a Model (regressor + standardisers);
-// the environment clips every action to the world's limits.
+// Policies: what acts in the world. Every policy acts on what its episode has shown it (the
+// states so far, the actions the world applied, the step index: a History); a learned policy
+// is a Model (feature map + regressor + standardisers); an automatic expert may in addition
+// read the environment it acts in (mpc simulates from its snapshot), a learned policy never does.
+// The environment clips every action to the world's limits.
 #include <memory>
 #include <string>
 
+#include <dicestack/core/env.hpp>
+#include <dicestack/core/expert.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/datasets/episode.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/regressors/model.hpp>
 
 namespace dicestack {
 
-/// Chooses an action for a state. `act` is called once per control step, in order, from one
-/// thread per policy object; `reset` starts an episode.
+/// Chooses an action after a history. `act` is called once per control step, in order, from
+/// one thread per policy object; `reset` starts an episode.
 class Policy {
  public:
   virtual ~Policy() = default;
   virtual void reset(std::uint64_t seed) { (void)seed; }
-  virtual Action act(const State& state) = 0;
+  virtual Action act(const History& history) = 0;
   virtual std::string name() const = 0;
 };
 
@@ -24,7 +30,7 @@ class Policy {
 class ModelPolicy final : public Policy {
  public:
   explicit ModelPolicy(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
-  Action act(const State& state) override { return model_->act(state); }
+  Action act(const History& history) override { return model_->act(history); }
   std::string name() const override { return model_->regressor().name(); }
   const Model& model() const { return *model_; }
 
@@ -32,17 +38,30 @@ class ModelPolicy final : public Policy {
   std::shared_ptr<const Model> model_;
 };
 
-/// Replays a demonstration's actions in order (paper VI-A), then does nothing.
+/// Replays a demonstration's actions by step index (paper VI-A), then does nothing.
 class PlaybackPolicy final : public Policy {
  public:
   explicit PlaybackPolicy(const Episode& episode) : actions_(episode.actions) {}
-  void reset(std::uint64_t) override { t_ = 0; }
-  Action act(const State&) override { return t_ < actions_.size() ? actions_[t_++] : Action{0.0, 0.0, 0.0}; }
+  Action act(const History& history) override {
+    return history.t() < actions_.size() ? actions_[history.t()] : Action{0.0, 0.0, 0.0};
+  }
   std::string name() const override { return "playback"; }
 
  private:
   std::vector<Action> actions_;
-  std::size_t t_ = 0;
+};
+
+/// An automatic expert acting in `env` (which must be the environment the rollout steps).
+class ExpertPolicy final : public Policy {
+ public:
+  ExpertPolicy(Expert& expert, const DiceEnv& env) : expert_(expert), env_(env) {}
+  void reset(std::uint64_t seed) override { expert_.reset(seed); }
+  Action act(const History&) override { return expert_.act(env_); }
+  std::string name() const override { return "expert " + expert_.name(); }
+
+ private:
+  Expert& expert_;
+  const DiceEnv& env_;
 };
 
 }  // namespace dicestack

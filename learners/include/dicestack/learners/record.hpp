@@ -10,11 +10,13 @@
 namespace dicestack {
 
 /// Runs expert `name` from `episodes` random starts (episode i from
-/// random_start_state(world, derive_seed(seed, i))), in parallel with one world and one expert
-/// per thread. Returns every episode, successes and failures, each with its outcome; the
-/// result does not depend on the thread count. Throws ConfigError for an unknown expert.
+/// random_start_state(world, training_start_seed(seed, i))), in parallel with one world and one
+/// expert per thread. With `noise` (per action dimension, a fraction of world.action.scale) the
+/// executed actions are perturbed as DART does and the expert's clean actions are recorded.
+/// Returns every episode, successes and failures, each with its outcome; the result does not
+/// depend on the thread count. Throws ConfigError for an unknown expert or a negative noise.
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads);
+                                   int episodes, std::uint64_t seed, int threads, const Action& noise = {0.0, 0.0, 0.0});
 
 /// Seed and size of the built-in set.
 inline constexpr std::uint64_t kBuiltinSeed = 2026;

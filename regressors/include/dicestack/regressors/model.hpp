@@ -1,36 +1,46 @@
 #pragma once
-// A trained model: a regressor with the standardisers of its inputs and labels, and the file
-// format that stores it (STYLE 10): a one-line JSON header (format, version, dicestack version,
-// regressor, parameters, standardisers, dimensions, payload size and checksum, training
-// record) followed by the backend's payload.
+// A trained model: a feature map, a regressor with the standardisers of its inputs and labels,
+// and the file format that stores it (STYLE 10, docs/formats.md): a one-line JSON header (format,
+// version, dicestack version, regressor, parameters, feature map, standardisers, dimensions,
+// payload size and checksum, training record) followed by the backend's payload.
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
 
 #include <dicestack/core/types.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/datasets/standardizer.hpp>
 #include <dicestack/regressors/registry.hpp>
 
 namespace dicestack {
 
 inline constexpr const char* kModelFormat = "dicestack-model";
-inline constexpr int kModelFormatVersion = 1;
+/// 2 added the feature map ("features", "features_version", "input_dim", "input_names");
+/// version 1 files are read as the "state" map.
+inline constexpr int kModelFormatVersion = 2;
 
-/// Regressor + standardisers: maps a raw state to a raw action.
+/// Feature map + regressor + standardisers: maps what an episode has shown to a raw action.
 class Model {
  public:
-  Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y);
+  Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y,
+        const FeatureMap& features = state_features());
 
-  /// Fits the standardisers on `train`'s rows and the regressor on the standardised rows.
-  /// Constant columns are reported in `warnings` (if given).
+  /// Fits the standardisers on the feature rows `x` (N x features.width(), e.g. from
+  /// make_dataset(episodes, features)) and the regressor on the standardised rows. Constant
+  /// columns are reported in `warnings` (if given). Throws InputError on a width mismatch.
   static Model train(std::unique_ptr<Regressor> regressor, const Matrix& x, const Matrix& y, std::uint64_t seed,
-                     std::vector<std::string>* warnings = nullptr);
+                     std::vector<std::string>* warnings = nullptr, const FeatureMap& features = state_features());
 
-  /// Hot path: the action for one state (standardise, predict_row, unstandardise); no allocation.
+  /// Hot path: the action after `history` (features, standardise, predict_row, unstandardise);
+  /// no allocation.
+  Action act(const History& history) const;
+  /// The action for a lone state, seen as the first of an episode (t = 0, its own start).
   Action act(const State& state) const;
-  /// Actions for every row of `states` (N x 24).
-  Matrix predict(const Matrix& states) const;
+  /// Actions for every row of `rows` (N x features().width(), feature rows).
+  Matrix predict(const Matrix& rows) const;
+
+  const FeatureMap& features() const { return *features_; }
 
   const Regressor& regressor() const { return *regressor_; }
   const Standardizer& x_scaler() const { return x_; }
@@ -41,6 +51,7 @@ class Model {
 
  private:
   std::unique_ptr<Regressor> regressor_;
+  const FeatureMap* features_;
   Standardizer x_;
   Standardizer y_;
 };
@@ -48,8 +59,9 @@ class Model {
 /// Writes a model file atomically. Throws InputError.
 void save_model(const Model& model, const std::filesystem::path& path);
 
-/// Reads a model file, checking format, version, regressor (registered?), parameters,
-/// dimensions (24 state, 3 action values), standardisers, payload size and checksum.
+/// Reads a model file (any version up to kModelFormatVersion), checking format, version,
+/// regressor (registered?), parameters, feature map (known, same version, same width as the
+/// regressor's input), dimensions, standardisers, payload size and checksum.
 /// Throws InputError naming the file and what is wrong (or ConfigError for an unknown regressor).
 Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry = RegressorRegistry::global());
 

@@ -1,0 +1,64 @@
+#pragma once
+// Observations: what a learned policy's regressor sees. A feature map turns what an episode has
+// shown the policy so far (its states, the step index, its start) into the regressor's input
+// row. Maps are named and versioned; a model file stores its map, so training, evaluation,
+// DAgger, DaD, the leaderboard and render all compute the same row. A map never reads anything
+// computed inside an expert (a plan, its clock, its parameters): only what the world showed.
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/core/types.hpp>
+
+namespace dicestack {
+
+/// What an episode has shown a policy when it acts at step t: the states before each action,
+/// states[0] (the start) .. states[t] (the current one), and the t actions the world applied.
+struct History {
+  std::span<const State> states;   ///< t + 1 states; never empty
+  std::span<const Action> actions; ///< t actions (may be empty when the caller does not track them)
+  /// Step index of the current state (0 at the start).
+  std::size_t t() const { return states.size() - 1; }
+  const State& current() const { return states.back(); }
+  const State& start() const { return states.front(); }
+};
+
+/// The widest row any built-in map produces (a stack buffer on the hot path).
+inline constexpr std::size_t kMaxFeatureWidth = 64;
+
+/// A named, versioned map from a History to one input row. Immutable; thread-safe.
+class FeatureMap {
+ public:
+  virtual ~FeatureMap() = default;
+  /// The name `train --features` and model files use, e.g. "state+clock+start".
+  virtual std::string name() const = 0;
+  /// Bumped whenever the map's output for a history changes; stored in model files.
+  virtual int version() const = 0;
+  /// Inputs per row (<= kMaxFeatureWidth).
+  virtual std::size_t width() const = 0;
+  /// One name per input column (the state names first).
+  virtual std::vector<std::string> column_names() const = 0;
+  /// One line for listings.
+  virtual std::string description() const = 0;
+  /// Writes the row for `history` into `out` (width() values). Hot path: never allocates.
+  virtual void compute(const History& history, std::span<double> out) const = 0;
+};
+
+/// The built-in maps, by name:
+///  - "state": the 24 state numbers (the paper's input; what every model before format 2 used)
+///  - "state+clock": + the step index t (control steps since the start)
+///  - "state+clock+start": + t, the start's cup x and the start's mean die x
+///  - "state+history": + the previous state (the start repeated at t = 0): the last step's
+///    velocity changes, which carry the previous action
+/// Throws ConfigError for another name, listing these.
+const FeatureMap& feature_map(std::string_view name);
+
+/// Names feature_map() accepts, in listing order.
+std::vector<std::string> feature_map_names();
+
+/// The "state" map: the default of every learner that does not name one.
+const FeatureMap& state_features();
+
+}  // namespace dicestack

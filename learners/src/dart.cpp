@@ -1,0 +1,69 @@
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/record.hpp>
+
+namespace dicestack {
+namespace {
+
+// DART (Laskey et al., CoRL 2017): the expert demonstrates from random training starts while
+// Gaussian noise perturbs what it executes, so the demonstrations visit the states a learner's
+// own errors lead to; the expert's clean actions are the labels; the regressor is fitted once.
+class Dart final : public Learner {
+ public:
+  using Learner::Learner;
+
+  LearnResult learn(const LearnContext& c) const override {
+    const int episodes = static_cast<int>(params().integer("episodes"));
+    const double noise = params().real("noise");
+    Action fraction{noise, noise, noise};
+    const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
+    for (std::size_t k = 0; k < kActionDim; ++k)
+      if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
+    if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
+    std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
+    auto recorded = record_expert(params().choice("expert"), {}, c.world, episodes, c.seed, c.threads, fraction);
+    int successes = 0;
+    const bool successes_only = params().boolean("successes_only");
+    for (auto& e : recorded) {
+      successes += e.outcome.realistic_success();
+      if (successes_only && !e.outcome.realistic_success()) continue;
+      e.origin = "dart";
+      data.push_back(std::move(e));
+    }
+    if (data.empty()) throw InputError("dart: no demonstration to fit (the expert succeeded in none of " +
+                                       std::to_string(episodes) + " noisy episodes)");
+    if (c.progress) c.progress({"fit", 1, 1, 0, 0, 0, 1, 0.5});
+    LearnResult r;
+    r.model = fit_model(c, data, c.seed);
+    r.model->record["learner"] = "dart";
+    r.model->record["dart_episodes"] = std::to_string(episodes);
+    r.model->record["dart_expert_successes"] = std::to_string(successes);
+    if (c.progress) c.progress({"fit", 1, 1, 0, 0, 1, 1, 1.0});
+    return r;
+  }
+
+  static std::vector<ParamSpec> schema() {
+    std::vector<std::string> names;
+    for (const auto& e : expert_list()) names.push_back(e.name);
+    return {{"expert", ParamType::choice, "scripted", 0, 0, "the expert that demonstrates and labels", names},
+            {"noise", ParamType::real, "0.2", 0, 10,
+             "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
+            {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
+            {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
+            {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
+            {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
+            {"successes_only", ParamType::boolean, "false", 0, 1, "fit only on the noisy episodes that succeeded", {}},
+            {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
+  }
+};
+
+}  // namespace
+
+void register_dart(LearnerRegistry& r) {
+  r.add({"dart", "DART: the expert demonstrates under injected noise, its clean actions are the labels", Dart::schema(),
+         [](std::string n, Params p) { return std::make_unique<Dart>(std::move(n), std::move(p)); }, false,
+         "state+clock+start"});
+}
+
+}  // namespace dicestack

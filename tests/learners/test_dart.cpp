@@ -1,0 +1,147 @@
+// DART, the training/evaluation start streams, histories in rollouts, and honest evaluation.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <set>
+#include <unistd.h>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/record.hpp>
+
+#include "../core/helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+WorldConfig short_world() {
+  WorldConfig w;
+  w.episode.max_steps = 60;
+  return w;
+}
+
+TEST(Starts, TrainingAndEvaluationStreamsShareNoStart) {
+  // Every seed a user is likely to type, on both sides: no start seed (hence no start) in common.
+  std::set<std::uint64_t> evaluation;
+  for (std::uint64_t s = 0; s < 20; ++s)
+    for (std::uint64_t i = 0; i < 500; ++i) evaluation.insert(evaluation_start_seed(s, i));
+  for (std::uint64_t s = 0; s < 20; ++s)
+    for (std::uint64_t i = 0; i < 500; ++i) ASSERT_FALSE(evaluation.contains(training_start_seed(s, i))) << s << " " << i;
+  // And the starts themselves: record --seed 0 against evaluate --seed 0.
+  const WorldConfig w = short_world();
+  const auto recorded = record_expert("scripted", {}, w, 5, 0, 1);
+  std::vector<Episode> evaluated;
+  evaluate([] { return std::make_unique<PlaybackPolicy>(Episode{}); }, w, 5, 0, 1, InitialPush::none, &evaluated);
+  for (const auto& r : recorded)
+    for (const auto& e : evaluated) EXPECT_NE(r.states.front(), e.states.front());
+}
+
+// Records what it was shown, and acts with a fixed pattern.
+class Probe final : public Policy {
+ public:
+  std::vector<std::size_t> ts, action_counts;
+  std::vector<State> starts;
+  Action act(const History& h) override {
+    ts.push_back(h.t());
+    action_counts.push_back(h.actions.size());
+    starts.push_back(h.start());
+    return {h.t() % 2 ? 5.0 : -0.3, 0.1, 0.0};  // 5 m/s is beyond the limit: the world clips it
+  }
+  std::string name() const override { return "probe"; }
+};
+
+TEST(Rollout, PoliciesSeeTheirHistoryAndTheActionsTheWorldApplied) {
+  const WorldConfig w = short_world();
+  DiceEnv env(w);
+  Probe p;
+  const State start = random_start_state(w, 3);
+  const Episode e = rollout(env, p, start, 3, StepSource::policy);
+  ASSERT_EQ(p.ts.size(), e.size());
+  for (std::size_t t = 0; t < e.size(); ++t) {
+    EXPECT_EQ(p.ts[t], t);
+    EXPECT_EQ(p.action_counts[t], t);
+    EXPECT_EQ(p.starts[t], e.states.front());
+    EXPECT_LE(e.actions[t][0], w.action.limit[0]);  // recorded as applied: clipped
+  }
+}
+
+TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
+  const WorldConfig w = short_world();
+  DiceEnv a(w), b(w);
+  auto expert = make_expert("scripted");
+  ExpertPolicy pa(*expert, a);
+  RolloutOptions noisy;
+  noisy.noise = {0.2, 0.02, 0.1};
+  noisy.noise_seed = 9;
+  const State start = random_start_state(w, 4);
+  const Episode clean = rollout(a, pa, start, 4, StepSource::expert);
+  ExpertPolicy pb(*expert, b);
+  const Episode perturbed = rollout(b, pb, start, 4, StepSource::expert, noisy);
+  EXPECT_NE(clean.states[10], perturbed.states[10]);
+  // The recorded labels are what the expert chose in the states it was in, not what ran.
+  DiceEnv replay(w);
+  replay.reset_to(start, 4);
+  expert->reset(4);
+  EXPECT_EQ(perturbed.actions[0], expert->act(replay));
+  const StepResult r = replay.step(perturbed.actions[0]);
+  EXPECT_NE(r.observation, perturbed.states[1]);  // the executed action differed
+}
+
+TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
+  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2"});
+  LearnContext c;
+  c.world = short_world();
+  c.regressor = "knn";
+  c.features = "state+clock+start";
+  c.seed = 5;
+  c.threads = 1;
+  const LearnResult one = learner->learn(c);
+  c.threads = 2;
+  const LearnResult two = learner->learn(c);
+  EXPECT_EQ(one.model->regressor().save_payload(), two.model->regressor().save_payload());
+  EXPECT_EQ(one.model->features().name(), "state+clock+start");
+  EXPECT_EQ(one.model->record.at("learner"), "dart");
+  // Without noise the data are the expert's own clean episodes: a different model.
+  const auto quiet = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0"})->learn(c);
+  EXPECT_NE(quiet.model->regressor().save_payload(), one.model->regressor().save_payload());
+  EXPECT_EQ(LearnerRegistry::global().info("dart").default_features, "state+clock+start");
+}
+
+TEST(Dart, AModelFileAloneRollsOut) {
+  // At evaluation only the regressor acts: the model is read back from its file, and the
+  // rollout gets no expert, no simulation ahead and no snapshot (ModelPolicy sees a History).
+  LearnContext c;
+  c.world = short_world();
+  c.regressor = "linear_svr";
+  c.features = "state+clock+start";
+  c.seed = 2;
+  const auto learned = LearnerRegistry::global().create("dart", {"episodes=3"})->learn(c);
+  const fs::path path = fs::temp_directory_path() / ("dicestack_dart_alone_" + std::to_string(getpid()) + ".dsm");
+  save_model(*learned.model, path);
+  auto model = std::make_shared<const Model>(load_model(path));
+  fs::remove(path);
+  const EvalStats a = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, c.world, 3, 0, 1);
+  const EvalStats b = evaluate([&] { return std::make_unique<ModelPolicy>(learned.model); }, c.world, 3, 0, 2);
+  EXPECT_EQ(a.episodes, 3);
+  EXPECT_EQ(a.dice_in_cup_mean, b.dice_in_cup_mean);
+  EXPECT_EQ(a.mean_length, b.mean_length);
+}
+
+TEST(Dad, RefusesAFeatureMapBeyondTheState) {
+  LearnContext c;
+  c.world = short_world();
+  c.demos = record_expert("scripted", {}, c.world, 2, 1, 1);
+  c.features = "state+clock";
+  const std::string error =
+      test::error_of([&] { LearnerRegistry::global().create("dad", {"windows=1", "iterations=1"})->learn(c); });
+  EXPECT_THAT(error, HasSubstr("dad: feature map \"state+clock\""));
+}
+
+}  // namespace
+}  // namespace dicestack

@@ -1,0 +1,105 @@
+// Model files carry their feature map (format 2) and still read format 1.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/regressors/model.hpp>
+
+#include "../core/helpers.hpp"
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+Matrix random_rows(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
+  Rng rng(seed);
+  Matrix x(n, d);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < d; ++j) x(i, j) = rng.uniform(-1.0, 1.0);
+  return x;
+}
+
+Matrix labels(const Matrix& x) {
+  Matrix y(x.rows(), 3);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) y.row(i) << x(i, 0) - x(i, x.cols() - 1), 0.5 * x(i, 1), x(i, 2);
+  return y;
+}
+
+fs::path temp_model(const std::string& name) {
+  return fs::temp_directory_path() / ("dicestack_model_" + name + "_" + std::to_string(getpid()) + ".dsm");
+}
+
+// Splits a model file into its JSON header and payload, and writes them back.
+std::pair<nlohmann::json, std::string> read_parts(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string header;
+  std::getline(in, header);
+  std::ostringstream rest;
+  rest << in.rdbuf();
+  return {nlohmann::json::parse(header), rest.str()};
+}
+void write_parts(const fs::path& path, const nlohmann::json& header, const std::string& payload) {
+  std::ofstream(path, std::ios::binary) << header.dump() << '\n' << payload;
+}
+
+TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
+  const FeatureMap& f = feature_map("state+clock+start");
+  const Matrix x = random_rows(200, 27, 1);
+  const Model m = Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3, nullptr, f);
+  const fs::path path = temp_model("features");
+  save_model(m, path);
+  const Model back = load_model(path);
+  EXPECT_EQ(back.features().name(), "state+clock+start");
+  const auto [header, payload] = read_parts(path);
+  EXPECT_EQ(header.at("version"), 2);
+  EXPECT_EQ(header.at("input_dim"), 27);
+  // The clock and the start reach the regressor: the same state at another step acts differently.
+  const std::vector<State> at0{State{}}, at5(6, State{});
+  EXPECT_EQ(back.act(History{at0, {}}), m.act(History{at0, {}}));
+  EXPECT_NE(back.act(History{at0, {}}), back.act(History{at5, {}}));
+  fs::remove(path);
+}
+
+TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
+  const Matrix x = random_rows(200, 24, 2);
+  const fs::path path = temp_model("mismatch");
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  auto [header, payload] = read_parts(path);
+  header["features"] = "state+clock";  // 25 inputs, but the regressor and the header say 24
+  write_parts(path, header, payload);
+  const std::string error = test::error_of([&] { load_model(path); });
+  EXPECT_THAT(error, HasSubstr(path.string() + ": the regressor reads 24 inputs, but feature map \"state+clock\" produces 25"));
+  header["features"] = "state+tomorrow";
+  write_parts(path, header, payload);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("unknown feature map \"state+tomorrow\""));
+  EXPECT_THROW(load_model(path), InputError);
+  fs::remove(path);
+}
+
+TEST(ModelFile, VersionOneReadsAsTheStateMap) {
+  const Matrix x = random_rows(200, 24, 4);
+  const Model m = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
+  const fs::path path = temp_model("v1");
+  save_model(m, path);
+  auto [header, payload] = read_parts(path);
+  for (const char* key : {"features", "features_version", "input_dim", "input_names"}) header.erase(key);
+  header["version"] = 1;
+  write_parts(path, header, payload);
+  const Model back = load_model(path);
+  EXPECT_EQ(back.features().name(), "state");
+  EXPECT_EQ(back.predict(x.topRows(5)), m.predict(x.topRows(5)));
+  fs::remove(path);
+}
+
+}  // namespace
+}  // namespace dicestack
