@@ -86,8 +86,9 @@ std::string outcome_text(const Outcome& o) {
 int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, const std::string& curve_key,
                     const nlohmann::json& curve, bool json, const std::string& text) {
   nlohmann::json saved = summary;
+  saved["format"] = kBaselineFormat;
   if (!curve.is_null()) saved[curve_key] = curve;
-  AtomicFile f(file);
+  AtomicFile f(file, Ownership::json_object("dicestack baseline summary", kBaselineFormat));
   f.stream() << saved.dump(1);
   f.commit();
   print_line(json ? summary.dump() : text);
@@ -95,6 +96,7 @@ int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, c
 }
 
 int run_optimise(OptimiseCommandOptions opt) {
+  check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = open_loop_world(opt);
   OpenLoopProblem problem(world, opt.settings, opt.threads);
   ProgressBar bar;
@@ -191,6 +193,7 @@ struct ReinforceCommandOptions {
 };
 
 int run_reinforce(const ReinforceCommandOptions& opt) {
+  check_demo_set_replaceable(opt.out);
   const WorldConfig world = opt.world.load();
   ProgressBar bar;
   const ReinforceResult r = reinforce(world, opt.reinforce, [&](const ReinforcePoint& p) {
@@ -230,6 +233,7 @@ struct RrtCommandOptions {
 };
 
 int run_rrt(const RrtCommandOptions& opt) {
+  check_demo_set_replaceable(opt.out);
   const WorldConfig world = opt.world.load();
   ProgressBar bar;
   const RrtResult r = rrt(world, opt.rrt, [&](int nodes, double best) {

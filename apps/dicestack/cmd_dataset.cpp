@@ -167,7 +167,7 @@ void add_dataset_commands(CLI::App& app) {
   cupdice->add_option("src", imp->src, "Folder of imitate_*.csv files (searched recursively)")
       ->required()
       ->check(CLI::ExistingDirectory);
-  cupdice->add_option("--out", imp->out, "Folder to write the demonstration set to (replaced whole)")->required();
+  cupdice->add_option("--out", imp->out, "Folder to write the demonstration set to (missing, empty, or a dicestack set, which is replaced whole)")->required();
   imp->world.add_to(*cupdice);
   cupdice->callback([imp] { run_import(*imp); });
 

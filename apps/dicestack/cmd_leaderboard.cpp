@@ -137,6 +137,31 @@ std::string fixed(double v, int digits) {
   return s;
 }
 
+constexpr const char* kLeaderboardFormat = "dicestack-leaderboard";
+constexpr const char* kPartialFormat = "dicestack-leaderboard-partial";
+constexpr const char* kCsvHeader =
+    "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
+    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
+
+// The first line a written table starts with (md and latex get a marker comment), and which
+// existing files --out may replace: tables of the same format that dicestack wrote.
+std::string file_marker(const std::string& format) {
+  if (format == "md") return "<!-- dicestack leaderboard -->\n";
+  if (format == "latex") return "% dicestack leaderboard\n";
+  return "";
+}
+
+Ownership table_ownership(const std::string& format) {
+  if (format == "json") return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"});
+  if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader});
+  const std::string marker = file_marker(format);
+  return Ownership::first_line("dicestack leaderboard (" + format + ")", {marker.substr(0, marker.size() - 1)});
+}
+
+Ownership partial_ownership() {
+  return Ownership::json_object("dicestack leaderboard progress file", kPartialFormat, {"meta", "rows"});
+}
+
 std::string render(const std::vector<Row>& rows, const std::string& format, const std::string& header, const json& meta) {
   std::ostringstream os;
   const std::vector<std::string> cols{"regressor", "learner", "train error", "test error", "dice in cup",
@@ -148,12 +173,12 @@ std::string render(const std::vector<Row>& rows, const std::string& format, cons
   };
   if (format == "json") {
     json j = meta;
+    j["format"] = kLeaderboardFormat;
     j["rows"] = json::array();
     for (const auto& r : rows) j["rows"].push_back(row_json(r));
     os << j.dump(2) << '\n';
   } else if (format == "csv") {
-    os << "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
-          "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step\n";
+    os << kCsvHeader << '\n';
     for (const auto& r : rows) {
       const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
       os << r.regressor << ',' << r.learner << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
@@ -264,6 +289,10 @@ int run_leaderboard(LeaderboardOptions opt) {
   // Resume: rows already measured with the same settings are read back.
   const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
   json done = json::object();
+  if (!opt.out.empty()) {  // refuse a user's files before any work
+    check_replaceable(opt.out, table_ownership(opt.format));
+    check_replaceable(partial, partial_ownership());
+  }
   if (!partial.empty() && std::filesystem::exists(partial)) {
     try {
       json p = json::parse(std::ifstream(partial));
@@ -319,8 +348,8 @@ int run_leaderboard(LeaderboardOptions opt) {
       rows.push_back(row);
       if (!partial.empty()) {
         done[key] = row_json(row);
-        AtomicFile f(partial);
-        f.stream() << json{{"meta", meta}, {"rows", done}}.dump();
+        AtomicFile f(partial, partial_ownership());
+        f.stream() << json{{"format", kPartialFormat}, {"meta", meta}, {"rows", done}}.dump();
         f.commit();
       }
     }
@@ -355,10 +384,10 @@ int run_leaderboard(LeaderboardOptions opt) {
   if (opt.out.empty()) {
     std::cout << table << std::flush;
   } else {
-    AtomicFile f(opt.out);
-    f.stream() << table;
+    AtomicFile f(opt.out, table_ownership(opt.format));
+    f.stream() << file_marker(opt.format) << table;
     f.commit();
-    std::filesystem::remove(partial);
+    if (partial_ownership().recognises(partial)) std::filesystem::remove(partial);
     std::cout << table << "wrote " << opt.out.string() << '\n' << std::flush;
   }
   return 0;

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/record.hpp>
 
 #include "cli.hpp"
@@ -25,6 +26,7 @@ struct RecordOptions {
 };
 
 int run_record(const RecordOptions& opt) {
+  check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Episode> eps = record_expert(opt.expert, {}, world, opt.episodes, opt.seed, opt.threads,
@@ -89,7 +91,7 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--expert", opt->expert, "Expert name")->capture_default_str();
   cmd->add_option("--episodes", opt->episodes, "Episodes from random starts")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->capture_default_str();
-  cmd->add_option("--out", opt->out, "Demonstration folder to write (replaced whole)")->required();
+  cmd->add_option("--out", opt->out, "Demonstration folder to write (missing, empty, or a dicestack set, which is replaced whole)")->required();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--noise", opt->noise,
                   "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "

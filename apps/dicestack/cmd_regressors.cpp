@@ -102,11 +102,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // another tool reads back exactly these doubles).
 template <std::size_t N>
 void write_matrix_csv(const std::filesystem::path& path, const Matrix& m, const std::array<std::string_view, N>& names) {
-  AtomicFile file(path);
+  std::string header;
+  for (std::size_t j = 0; j < N; ++j) header += (j ? "," : "") + std::string(names[j]);
+  AtomicFile file(path, Ownership::first_line("dicestack exported split CSV", {header}));
   auto& out = file.stream();
   out.precision(17);
-  for (std::size_t j = 0; j < N; ++j) out << (j ? "," : "") << names[j];
-  out << '\n';
+  out << header << '\n';
   for (Eigen::Index i = 0; i < m.rows(); ++i)
     for (Eigen::Index j = 0; j < m.cols(); ++j) out << m(i, j) << (j + 1 < m.cols() ? ',' : '\n');
   file.commit();

@@ -7,6 +7,7 @@
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/regressors/model.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -27,6 +28,7 @@ struct TrainOptions {
 
 int run_train(const TrainOptions& opt) {
   const WorldConfig world = opt.world.load();
+  check_replaceable(opt.out, model_ownership());  // refuse a user's file before any work
   const auto dir = opt.demos.resolve(world);
   const DemoSet set = read_demo_set(dir);
   const auto learner = LearnerRegistry::global().create(opt.learner, opt.options);

@@ -1,14 +1,123 @@
 #include <dicestack/core/atomic_file.hpp>
 
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <charconv>
+#include <random>
 #include <system_error>
+
+#include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
 
 namespace dicestack {
+namespace {
 
-AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
-  tmp_ = path_;
-  tmp_ += ".tmp";
+namespace fs = std::filesystem;
+
+std::string first_line_of(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line)) return {};
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  return line;
+}
+
+bool has_format(const nlohmann::json& j, const std::string& format, const std::vector<std::string>& legacy_keys) {
+  if (!j.is_object()) return false;
+  if (j.contains("format")) return j["format"].is_string() && j["format"].get<std::string>() == format;
+  if (legacy_keys.empty()) return false;
+  for (const auto& k : legacy_keys)
+    if (!j.contains(k)) return false;
+  return true;
+}
+
+std::string leftover_prefix(const fs::path& target, std::string_view tag) {
+  return "." + target.filename().string() + "." + std::string(tag) + "-";
+}
+
+}  // namespace
+
+Ownership Ownership::json_object(std::string what, std::string format, std::vector<std::string> legacy_keys) {
+  return {std::move(what), [format = std::move(format), keys = std::move(legacy_keys)](const fs::path& p) {
+            std::ifstream in(p, std::ios::binary);
+            const auto j = nlohmann::json::parse(in, nullptr, false);
+            return !j.is_discarded() && has_format(j, format, keys);
+          }};
+}
+
+Ownership Ownership::json_first_line(std::string what, std::string format) {
+  return {std::move(what), [format = std::move(format)](const fs::path& p) {
+            const auto j = nlohmann::json::parse(first_line_of(p), nullptr, false);
+            return !j.is_discarded() && has_format(j, format, {});
+          }};
+}
+
+Ownership Ownership::first_line(std::string what, std::vector<std::string> lines) {
+  return {std::move(what), [lines = std::move(lines)](const fs::path& p) {
+            const std::string line = first_line_of(p);
+            for (const auto& l : lines)
+              if (line == l) return true;
+            return false;
+          }};
+}
+
+Ownership Ownership::unchecked(std::string what) { return {std::move(what), nullptr}; }
+
+void check_replaceable(const fs::path& path, const Ownership& owner) {
+  std::error_code ec;
+  const auto st = fs::symlink_status(path, ec);
+  if (ec || st.type() == fs::file_type::not_found) return;
+  if (!owner.recognises && st.type() == fs::file_type::regular) return;
+  if (st.type() == fs::file_type::regular && owner.recognises(path)) return;
+  const std::string kind = st.type() == fs::file_type::directory ? " (it is a folder)"
+                           : st.type() == fs::file_type::regular ? ""
+                                                                  : " (it is not a regular file)";
+  throw InputError(path.string() + ": exists and is not a " + owner.what + kind +
+                   "; refusing to replace it: choose another --out or remove it yourself");
+}
+
+bool process_is_running(long pid) {
+  if (pid <= 0) return true;  // not a pid we wrote; never treat it as dead
+  return !(kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH);
+}
+
+fs::path temporary_sibling(const fs::path& target, std::string_view tag) {
+  static std::atomic<unsigned long> counter{0};
+  thread_local std::mt19937_64 rng{std::random_device{}()};  // only names scratch files
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  return parent / (leftover_prefix(target, tag) + std::to_string(getpid()) + "-" + std::to_string(counter++) + "x" +
+                   std::to_string(rng() % 1000000000));
+}
+
+std::vector<fs::path> dead_leftovers(const fs::path& target, std::string_view tag) {
+  std::vector<fs::path> out;
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = leftover_prefix(target, tag);
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const char* digits = name.data() + prefix.size();
+    const char* stop = name.data() + name.size();
+    long pid = 0;
+    const auto r = std::from_chars(digits, stop, pid);
+    if (r.ec != std::errc() || r.ptr == digits || r.ptr == stop || *r.ptr != '-') continue;
+    if (!process_is_running(pid)) out.push_back(it->path());
+  }
+  return out;
+}
+
+AtomicFile::AtomicFile(fs::path path, const Ownership& owner) : path_(std::move(path)) {
+  check_replaceable(path_, owner);
+  for (const auto& old : dead_leftovers(path_, "tmp")) {
+    std::error_code ignored;
+    if (fs::is_regular_file(old, ignored)) fs::remove(old, ignored);
+  }
+  tmp_ = temporary_sibling(path_, "tmp");
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_) throw InputError(tmp_.string() + ": cannot create file");
 }
@@ -17,7 +126,7 @@ AtomicFile::~AtomicFile() {
   if (!committed_) {
     out_.close();
     std::error_code ignored;
-    std::filesystem::remove(tmp_, ignored);
+    fs::remove(tmp_, ignored);
   }
 }
 
@@ -27,7 +136,7 @@ void AtomicFile::commit() {
   out_.close();
   if (!ok || out_.fail()) throw InputError(tmp_.string() + ": write failed");
   std::error_code ec;
-  std::filesystem::rename(tmp_, path_, ec);
+  fs::rename(tmp_, path_, ec);
   if (ec) throw InputError(path_.string() + ": cannot rename " + tmp_.string() + " into place: " + ec.message());
   committed_ = true;
 }

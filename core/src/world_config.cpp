@@ -282,7 +282,17 @@ WorldConfig load_world_config(const std::filesystem::path& path) {
 
 void save_world_config(const WorldConfig& config, const std::filesystem::path& path) {
   validate(config);
-  AtomicFile file(path);
+  // Ours: a JSON object whose sections are all world config sections (the fields we write).
+  static const json sections = json::parse(to_json(WorldConfig{}));
+  const Ownership ours{"dicestack world config", [](const std::filesystem::path& p) {
+                         std::ifstream in(p, std::ios::binary);
+                         const json j = json::parse(in, nullptr, false);
+                         if (j.is_discarded() || !j.is_object() || j.empty()) return false;
+                         for (const auto& [key, value] : j.items())
+                           if (!sections.contains(key)) return false;
+                         return true;
+                       }};
+  AtomicFile file(path, ours);
   file.stream() << to_json(config);
   file.commit();
 }

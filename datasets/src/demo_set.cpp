@@ -1,6 +1,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -70,8 +71,10 @@ std::string number_text(double v) {
   return std::string(buf, r.ptr);
 }
 
+Ownership episode_csv_ownership();
+
 void write_episode_csv(const Episode& e, const fs::path& path) {
-  AtomicFile file(path);
+  AtomicFile file(path, episode_csv_ownership());
   auto& out = file.stream();
   const auto columns = episode_csv_columns();
   for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
@@ -141,26 +144,51 @@ Outcome outcome_from(const json& j, const fs::path& meta, const std::string& fil
   return o;
 }
 
-// Writes the folder next to its destination, then swaps it in whole.
+Ownership episode_csv_ownership() {
+  std::string header;
+  for (const auto& c : episode_csv_columns()) header += (header.empty() ? "" : ",") + c;
+  return Ownership::first_line("dicestack episode CSV", {header});
+}
+
+Ownership meta_ownership() { return Ownership::json_object("dicestack demonstration meta.json", kDemoFormat); }
+
+// Our scratch files and folders: ".<name>.tmp-<digits>-..." or ".<name>.old-<digits>-...".
+bool is_scratch_name(const std::string& name) {
+  if (name.empty() || name[0] != '.') return false;
+  for (const char* tag : {".tmp-", ".old-"}) {
+    const auto at = name.rfind(tag);
+    if (at != std::string::npos && at > 1 && at + 5 < name.size() && std::isdigit(static_cast<unsigned char>(name[at + 5])))
+      return true;
+  }
+  return false;
+}
+
+// Writes the folder next to its destination, then swaps it in whole. A dead run's scratch
+// folders of `dir` are removed first; if it died between moving the old set aside and moving
+// the new one in, its old set is put back (it is ours, and the only copy).
 void replace_folder(const fs::path& dir, const std::function<void(const fs::path&)>& fill) {
   const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
   fs::create_directories(parent);
-  const std::string stem = dir.filename().string();
-  std::random_device rd;  // only names a scratch folder; never affects results
-  const fs::path tmp = parent / ("." + stem + ".tmp-" + std::to_string(rd()));
-  const fs::path old = parent / ("." + stem + ".old-" + std::to_string(rd()));
+  std::error_code ec;
+  for (const auto& old : dead_leftovers(dir, "old")) {
+    if (!fs::exists(fs::symlink_status(dir, ec)) && is_own_demo_set(old)) fs::rename(old, dir, ec);
+    else if (is_own_demo_set(old) || fs::is_empty(old, ec)) fs::remove_all(old, ec);
+  }
+  for (const auto& tmp : dead_leftovers(dir, "tmp"))
+    if (fs::is_directory(fs::symlink_status(tmp, ec))) fs::remove_all(tmp, ec);
+  check_demo_set_replaceable(dir);
+  const fs::path tmp = temporary_sibling(dir, "tmp");
+  const fs::path old = temporary_sibling(dir, "old");
   fs::create_directory(tmp);
   try {
     fill(tmp);
     if (fs::exists(dir)) fs::rename(dir, old);
     fs::rename(tmp, dir);
   } catch (...) {
-    std::error_code ec;
     fs::remove_all(tmp, ec);
     if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
     throw;
   }
-  std::error_code ec;
   fs::remove_all(old, ec);
 }
 
@@ -298,6 +326,55 @@ DemoSet read_demo_set(const fs::path& dir) {
   return set;
 }
 
+bool is_own_demo_set(const fs::path& dir, std::string* why) {
+  auto no = [&](std::string reason) {
+    if (why) *why = std::move(reason);
+    return false;
+  };
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) return no("it is not a folder");
+  const fs::path meta_path = dir / "meta.json";
+  json meta;
+  if (fs::is_regular_file(fs::symlink_status(meta_path, ec))) {
+    std::ifstream in(meta_path, std::ios::binary);
+    meta = json::parse(in, nullptr, false);
+  }
+  std::set<std::string> listed;
+  const bool meta_ok = meta.is_object() && meta.value("format", json()) == json(kDemoFormat) && meta.contains("episodes") &&
+                       meta["episodes"].is_array();
+  if (meta_ok)
+    for (const auto& entry : meta["episodes"])
+      if (entry.is_object() && entry.contains("file") && entry["file"].is_string()) listed.insert(entry["file"].get<std::string>());
+  const Ownership sidecar = Ownership::json_object("dicestack baseline summary", kBaselineFormat);
+  std::vector<std::string> foreign;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const bool file = it->is_regular_file(ec) && !it->is_symlink(ec);
+    if (meta_ok && file && (name == "meta.json" || listed.contains(name))) continue;
+    if (meta_ok && file && it->path().extension() == ".json" && sidecar.recognises(it->path())) continue;
+    if (is_scratch_name(name)) continue;
+    foreign.push_back(name == "meta.json" ? std::string("a meta.json that is not ours") : name + (it->is_directory(ec) ? "/" : ""));
+  }
+  if (ec) return no("it cannot be listed: " + ec.message());
+  if (!foreign.empty()) {
+    std::sort(foreign.begin(), foreign.end());
+    return no("it holds " + foreign.front() + (foreign.size() > 1 ? " and " + std::to_string(foreign.size() - 1) + " more" : ""));
+  }
+  if (!meta_ok) return no("it has no dicestack meta.json");
+  return true;
+}
+
+void check_demo_set_replaceable(const fs::path& dir) {
+  std::error_code ec;
+  const auto st = fs::symlink_status(dir, ec);
+  if (ec || st.type() == fs::file_type::not_found) return;
+  if (st.type() == fs::file_type::directory && fs::is_empty(dir, ec) && !ec) return;
+  std::string why;
+  if (is_own_demo_set(dir, &why)) return;
+  throw InputError(dir.string() + ": exists and is not a dicestack demonstration set (" + why +
+                   "); refusing to replace it: choose another --out or remove it yourself");
+}
+
 void write_demo_set(const DemoSet& set, const fs::path& dir) {
   validate(set.world);
   std::vector<std::string> files;
@@ -307,7 +384,7 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
   }
   replace_folder(dir, [&](const fs::path& tmp) {
     for (std::size_t i = 0; i < set.episodes.size(); ++i) write_episode_csv(set.episodes[i], tmp / files[i]);
-    AtomicFile meta(tmp / "meta.json");
+    AtomicFile meta(tmp / "meta.json", meta_ownership());
     meta.stream() << meta_json(set, files).dump(2) << '\n';
     meta.commit();
   });
@@ -319,6 +396,7 @@ std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Epi
   if (fs::exists(dir / "meta.json")) {
     set = read_demo_set(dir);
   } else {
+    check_demo_set_replaceable(dir);
     set.world = world;
     set.description = description;
     fs::create_directories(dir);
@@ -337,7 +415,7 @@ std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Epi
     files.push_back(file);
     set.episodes.push_back(std::move(e));
   }
-  AtomicFile meta(dir / "meta.json");
+  AtomicFile meta(dir / "meta.json", meta_ownership());
   meta.stream() << meta_json(set, files).dump(2) << '\n';
   meta.commit();
   return added;

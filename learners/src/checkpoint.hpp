@@ -16,10 +16,14 @@ nlohmann::json curve_to_json(const std::vector<CurvePoint>& curve);
 std::vector<CurvePoint> curve_from_json(const nlohmann::json& json);
 
 /// Writes `data` to dir/data-<iteration>, then `state` (plus "iteration" and "data") to
-/// dir/<state_file>, both atomically and in that order, then removes older data folders: the
-/// state always names complete data of its own iteration, whenever the run is killed.
+/// dir/<state_file> (with "format": "dicestack-checkpoint"), both atomically and in that order,
+/// then removes older data-<integer> folders that are dicestack demonstration sets (never a
+/// user's data-notes/): the state always names complete data of its own iteration.
 void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::json state, const std::string& state_file,
                      const LearnContext& context, const std::vector<Episode>& data, const std::string& description);
+
+/// Removes DaD's earlier best-<integer>.model files in `dir` that are dicestack models, except `keep`.
+void remove_old_best_models(const std::filesystem::path& dir, const std::string& keep);
 
 /// The aggregated data a checkpoint state names.
 std::vector<Episode> load_checkpoint_data(const LearnContext& context, const nlohmann::json& state);

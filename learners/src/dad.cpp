@@ -116,16 +116,13 @@ class Dad final : public Learner {
         // The best model is named by its iteration and written before the state that names it.
         const std::string best_file = "best-" + std::to_string(best_iteration) + ".model";
         fs::create_directories(c.checkpoint_dir);
-        if (!fs::exists(c.checkpoint_dir / best_file)) save_model(*best, c.checkpoint_dir / best_file);
+        if (!model_ownership().recognises(c.checkpoint_dir / best_file)) save_model(*best, c.checkpoint_dir / best_file);
         save_checkpoint(c.checkpoint_dir, k,
                         {{"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
                          {"best_model", best_file}, {"best_deviation", best_deviation}, {"corrections_kept", corrections},
                          {"corrections_filtered", filtered}, {"curve", curve_to_json(result.curve)}},
                         "dad.json", c, data, "DaD data after iteration " + std::to_string(k));
-        for (const auto& entry : fs::directory_iterator(c.checkpoint_dir)) {
-          const std::string name = entry.path().filename().string();
-          if (name.rfind("best-", 0) == 0 && name != best_file) fs::remove(entry.path());
-        }
+        remove_old_best_models(c.checkpoint_dir, best_file);
       }
     }
     const std::shared_ptr<Model> chosen = params().boolean("keep_best") ? best : model;

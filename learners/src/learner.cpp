@@ -1,5 +1,6 @@
 #include <dicestack/learners/learner.hpp>
 
+#include <cctype>
 #include <fstream>
 
 #include <dicestack/core/atomic_file.hpp>
@@ -59,11 +60,27 @@ std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episod
 
 namespace fs = std::filesystem;
 
+namespace {
+
+constexpr const char* kCurveHeader = "iteration,window,dataset_rows,deviation,stacked_rate,realistic_success_rate,dice_in_cup_mean";
+constexpr const char* kCheckpointFormat = "dicestack-checkpoint";
+
+// "data-<digits>" or "best-<digits>.model" (suffix empty or ".model").
+bool numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
+  if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0) return false;
+  if (name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) return false;
+  for (std::size_t i = prefix.size(); i < name.size() - suffix.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
+  return true;
+}
+
+}  // namespace
+
 void write_curve_csv(const std::vector<CurvePoint>& curve, const fs::path& path) {
-  AtomicFile f(path);
+  AtomicFile f(path, Ownership::first_line("dicestack learning curve CSV", {kCurveHeader}));
   auto& os = f.stream();
   os.precision(17);
-  os << "iteration,window,dataset_rows,deviation,stacked_rate,realistic_success_rate,dice_in_cup_mean\n";
+  os << kCurveHeader << '\n';
   for (const auto& p : curve)
     os << p.iteration << ',' << p.window << ',' << p.dataset_rows << ',' << p.deviation << ',' << p.stacked_rate << ','
        << p.realistic_success_rate << ',' << p.dice_in_cup_mean << '\n';
@@ -97,14 +114,24 @@ void save_checkpoint(const fs::path& dir, int iteration, nlohmann::json state, c
   set.episodes = data;
   const std::string folder = "data-" + std::to_string(iteration);
   write_demo_set(set, dir / folder);
+  state["format"] = kCheckpointFormat;
   state["iteration"] = iteration;
   state["data"] = folder;
-  AtomicFile f(dir / state_file);
+  AtomicFile f(dir / state_file, Ownership::json_object("dicestack checkpoint state", kCheckpointFormat, {"iteration", "data"}));
   f.stream() << state.dump();
   f.commit();
   for (const auto& entry : fs::directory_iterator(dir)) {  // older iterations' data, now unreferenced
     const std::string name = entry.path().filename().string();
-    if (name.rfind("data-", 0) == 0 && name != folder) fs::remove_all(entry.path());
+    if (name != folder && numbered(name, "data-", "") && is_own_demo_set(entry.path())) fs::remove_all(entry.path());
+  }
+}
+
+void remove_old_best_models(const fs::path& dir, const std::string& keep) {
+  const Ownership model = model_ownership();
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name != keep && numbered(name, "best-", ".model") && entry.is_regular_file() && model.recognises(entry.path()))
+      fs::remove(entry.path());
   }
 }
 

@@ -68,6 +68,8 @@ Matrix Model::predict(const Matrix& rows) const {
   return out;
 }
 
+Ownership model_ownership() { return Ownership::json_first_line("dicestack model file", kModelFormat); }
+
 void save_model(const Model& model, const std::filesystem::path& path) {
   const Regressor& r = model.regressor();
   const std::string payload = r.save_payload();
@@ -91,7 +93,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                     {"record", model.record},
                     {"payload_bytes", payload.size()},
                     {"payload_fnv1a", fnv1a_hex(payload)}};
-  AtomicFile file(path);
+  AtomicFile file(path, model_ownership());
   file.stream() << header.dump() << '\n' << payload;
   file.commit();
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -331,6 +332,82 @@ TEST(CliRender, VideoFramesAndPlotOfARecordedEpisode) {
   EXPECT_EQ(bad.status, 1);
   EXPECT_THAT(bad.output, HasSubstr("unknown output kind"));
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace dicestack
+
+namespace dicestack {
+namespace {
+
+// Issue 18: outputs replace only what dicestack wrote.
+std::filesystem::path user_folder(const std::string& name) {
+  const auto root = std::filesystem::temp_directory_path() / ("dicestack_cli_safe_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root / "out" / "sub");
+  std::ofstream(root / "out" / "notes.txt") << "mine";
+  std::ofstream(root / "out" / "sub" / "notes.txt") << "mine too";
+  return root;
+}
+
+void expect_untouched(const std::filesystem::path& out) {
+  EXPECT_TRUE(std::filesystem::exists(out / "notes.txt"));
+  EXPECT_TRUE(std::filesystem::exists(out / "sub" / "notes.txt"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 2);
+}
+
+TEST(CliSafeOutputs, EveryDemoWriterRefusesAUsersFolder) {
+  const auto root = user_folder("folder");
+  const std::string out = (root / "out").string();
+  const std::string cupdice = std::string(DICESTACK_SOURCE_DIR) + "/data/cupdice";
+  for (const std::string& cmd : {"record --expert scripted --episodes 1 --out " + out,
+                                "import cupdice " + cupdice + " --out " + out,
+                                "optimise --method cmaes --steps 5 --evaluations 20 --out " + out,
+                                "reinforce --iterations 1 --batch 2 --steps 4 --out " + out,
+                                "rrt --nodes 3 --extend-steps 2 --extend-iterations 2 --out " + out}) {
+    const Process p = run(cmd);
+    EXPECT_EQ(p.status, 1) << cmd << "\n" << p.output;
+    EXPECT_THAT(p.output, HasSubstr(out + ": exists and is not a dicestack demonstration set (it holds notes.txt")) << cmd;
+    expect_untouched(root / "out");
+  }
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(root), std::filesystem::directory_iterator{}), 1)
+      << "no scratch folders left";
+  std::filesystem::remove_all(root);
+}
+
+TEST(CliSafeOutputs, RecordRefusesAModelFileAndRewritesItsOwnSet) {
+  const auto root = user_folder("model");
+  const auto model = root / "policy.dsm";
+  std::ofstream(model) << R"({"format": "dicestack-model", "version": 1})" << "\npayload";
+  const Process p = run("record --expert scripted --episodes 1 --out " + model.string());
+  EXPECT_EQ(p.status, 1) << p.output;
+  EXPECT_THAT(p.output, HasSubstr(model.string() + ": exists and is not a dicestack demonstration set"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(model));
+  const auto set = root / "set";
+  for (int i = 0; i < 2; ++i) {
+    const Process r = run("record --expert scripted --episodes 1 --seed " + std::to_string(i) + " --out " + set.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+  }
+  EXPECT_EQ(run("dataset validate " + set.string()).status, 0);
+  const auto optimised = root / "optimised";
+  for (int i = 0; i < 2; ++i)  // a set with its optimise.json sidecar is ours too
+    ASSERT_EQ(run("optimise --method cmaes --steps 5 --evaluations 20 --out " + optimised.string()).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(optimised / "optimise.json")).at("format"), "dicestack-baseline");
+  std::filesystem::remove_all(root);
+}
+
+TEST(CliSafeOutputs, TrainRefusesAUsersTextFile) {
+  const auto root = user_folder("train");
+  const auto notes = root / "notes.txt";
+  std::ofstream(notes) << "my notes\n";
+  const Process p = run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + notes.string());
+  EXPECT_EQ(p.status, 1) << p.output;
+  EXPECT_THAT(p.output, HasSubstr(notes.string() + ": exists and is not a dicestack model file; refusing to replace it"));
+  std::ifstream in(notes);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "my notes");
+  std::filesystem::remove_all(root);
 }
 
 }  // namespace

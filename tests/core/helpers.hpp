@@ -1,5 +1,8 @@
 #pragma once
 // Small helpers shared by the core tests.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstring>
 #include <string>
 #include <vector>
@@ -30,6 +33,15 @@ std::string error_of(F&& f) {
     return e.what();
   }
   return {};
+}
+
+/// The pid of a child that has exited and been reaped: a process that no longer runs.
+inline long dead_pid() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  return static_cast<long>(child);
 }
 
 }  // namespace dicestack::test

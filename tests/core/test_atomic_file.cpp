@@ -1,4 +1,7 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -6,16 +9,28 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 
+#include "helpers.hpp"
+
 namespace dicestack {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const Ownership kText = Ownership::first_line("test text file", {"old", "new", "half"});
+
+fs::path unique_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dicestack_atomic_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
 
 TEST(AtomicFile, NothingAppearsWithoutCommit) {
   const fs::path path = fs::temp_directory_path() / "dicestack_atomic_a.txt";
   fs::remove(path);
   {
-    AtomicFile f(path);
+    AtomicFile f(path, kText);
     f.stream() << "half";
     EXPECT_TRUE(fs::exists(f.temporary_path()));
   }
@@ -27,7 +42,7 @@ TEST(AtomicFile, CommitReplacesTheOldFileWhole) {
   const fs::path path = fs::temp_directory_path() / "dicestack_atomic_b.txt";
   { std::ofstream(path) << "old"; }
   {
-    AtomicFile f(path);
+    AtomicFile f(path, kText);
     f.stream() << "new";
     std::ifstream still(path);
     std::string text;
@@ -43,7 +58,66 @@ TEST(AtomicFile, CommitReplacesTheOldFileWhole) {
 }
 
 TEST(AtomicFile, UnwritableDirectoryIsAnInputError) {
-  EXPECT_THROW(AtomicFile("/nonexistent-dir/x.txt"), InputError);
+  EXPECT_THROW(AtomicFile("/nonexistent-dir/x.txt", kText), InputError);
+}
+
+TEST(AtomicFile, AFileThatIsNotOursIsRefusedAndKept) {
+  const fs::path dir = unique_dir("foreign");
+  const fs::path path = dir / "model.dsm";
+  { std::ofstream(path) << "my own notes\n"; }
+  const Ownership model = Ownership::json_first_line("dicestack model file", "dicestack-model");
+  const std::string message = test::error_of([&] { AtomicFile f(path, model); });
+  EXPECT_THAT(message, HasSubstr(path.string() + ": exists and is not a dicestack model file; refusing to replace it"));
+  EXPECT_THROW((void)AtomicFile(path, model), InputError);
+  std::ifstream in(path);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "my own notes");
+  EXPECT_THROW((void)AtomicFile(dir, model), InputError) << "a folder is never replaced by a file";
+  { std::ofstream(path) << R"({"format": "dicestack-model", "version": 1})" << "\npayload"; }
+  {
+    AtomicFile f(path, model);  // one of ours: replaced
+    f.stream() << R"({"format": "dicestack-model"})" << '\n';
+    f.commit();
+  }
+  EXPECT_TRUE(model.recognises(path));
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, TwoWritersOfOnePathBothCommitAndTheLastWins) {
+  const fs::path dir = unique_dir("two");
+  const fs::path path = dir / "out.txt";
+  AtomicFile a(path, kText), b(path, kText);
+  EXPECT_NE(a.temporary_path(), b.temporary_path());
+  a.stream() << "old";
+  b.stream() << "new";
+  EXPECT_NO_THROW(a.commit());
+  EXPECT_NO_THROW(b.commit());
+  std::ifstream in(path);
+  std::string text;
+  in >> text;
+  EXPECT_EQ(text, "new");
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, DeadRunsLeftoversAreRemovedLiveOnesKept) {
+  const fs::path dir = unique_dir("leftovers");
+  const fs::path path = dir / "out.txt";
+  const fs::path dead = dir / (".out.txt.tmp-" + std::to_string(test::dead_pid()) + "-x");
+  const fs::path live = dir / (".out.txt.tmp-" + std::to_string(getpid()) + "-x");
+  const fs::path parent = dir / (".out.txt.tmp-" + std::to_string(getppid()) + "-x");
+  const fs::path other = dir / (".other.txt.tmp-" + std::to_string(test::dead_pid()) + "-x");
+  for (const auto& p : {dead, live, parent, other}) std::ofstream(p) << "half";
+  {
+    AtomicFile f(path, kText);
+    f.stream() << "new";
+    f.commit();
+  }
+  EXPECT_FALSE(fs::exists(dead)) << "a killed run's temporary file of this target is cleaned up";
+  EXPECT_TRUE(fs::exists(live)) << "a running writer's temporary file is never touched";
+  EXPECT_TRUE(fs::exists(parent));
+  EXPECT_TRUE(fs::exists(other)) << "only leftovers of this target";
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/demo_set.hpp>
@@ -114,6 +117,89 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("broken_meta"), HasSubstr("meta.json: not valid JSON"));
   EXPECT_THAT(read_error("bad_world"), HasSubstr("\"physics.substeps\""));
   EXPECT_THROW(read_demo_set(kData / "bad" / "nan"), InputError);
+}
+
+fs::path unique_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dicestack_demo_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(DemoSet, AUsersFolderIsRefusedAndLeftUntouched) {
+  const DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("user");
+  const fs::path out = root / "out";
+  fs::create_directories(out / "sub");
+  { std::ofstream(out / "notes.txt") << "mine"; }
+  { std::ofstream(out / "sub" / "notes.txt") << "mine too"; }
+  const std::string message = test::error_of([&] { write_demo_set(set, out); });
+  EXPECT_THAT(message, HasSubstr(out.string() + ": exists and is not a dicestack demonstration set (it holds notes.txt"));
+  EXPECT_THAT(message, HasSubstr("refusing to replace it"));
+  EXPECT_THROW(write_demo_set(set, out), InputError);
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  EXPECT_TRUE(fs::exists(out / "sub" / "notes.txt"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 2);
+  EXPECT_EQ(std::distance(fs::directory_iterator(root), fs::directory_iterator{}), 1) << "no scratch folders left";
+  // A set of ours with a user's file added is not ours any more.
+  write_demo_set(set, root / "set");
+  { std::ofstream(root / "set" / "notes.txt") << "mine"; }
+  EXPECT_THROW(write_demo_set(set, root / "set"), InputError);
+  EXPECT_THROW(append_to_demo_set(out, {set.episodes[0]}, set.world, "x"), InputError);
+  fs::remove_all(root);
+}
+
+TEST(DemoSet, AFileAtTheTargetIsRefused) {
+  const DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("file");
+  { std::ofstream(root / "model.dsm") << R"({"format": "dicestack-model"})" << "\n"; }
+  EXPECT_THAT(test::error_of([&] { write_demo_set(set, root / "model.dsm"); }),
+              HasSubstr((root / "model.dsm").string() + ": exists and is not a dicestack demonstration set"));
+  EXPECT_TRUE(fs::is_regular_file(root / "model.dsm"));
+  fs::remove_all(root);
+}
+
+TEST(DemoSet, OurOwnSetWithSidecarsAnEmptyFolderAndAMissingPathAreWritten) {
+  DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("own");
+  write_demo_set(set, root / "missing" / "out");
+  EXPECT_EQ(read_demo_set(root / "missing" / "out").episodes.size(), 2u);
+  fs::create_directories(root / "empty");
+  write_demo_set(set, root / "empty");
+  EXPECT_EQ(read_demo_set(root / "empty").episodes.size(), 2u);
+  { std::ofstream(root / "empty" / "optimise.json") << R"({"format": "dicestack-baseline", "best_cost": 1})"; }
+  EXPECT_TRUE(is_own_demo_set(root / "empty"));
+  set.episodes.pop_back();
+  write_demo_set(set, root / "empty");
+  EXPECT_EQ(read_demo_set(root / "empty").episodes.size(), 1u);
+  { std::ofstream(root / "empty" / "rrt.json") << R"({"best_cost": 1})"; }  // no marker: not ours
+  std::string why;
+  EXPECT_FALSE(is_own_demo_set(root / "empty", &why));
+  EXPECT_EQ(why, "it holds rrt.json");
+  fs::remove_all(root);
+}
+
+TEST(DemoSet, DeadRunsScratchFoldersAreRemovedLiveOnesKept) {
+  const DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("scratch");
+  const fs::path dead = root / (".out.tmp-" + std::to_string(test::dead_pid()) + "-x");
+  const fs::path dead_old = root / (".out.old-" + std::to_string(test::dead_pid()) + "-x");
+  const fs::path live = root / (".out.tmp-" + std::to_string(getpid()) + "-x");
+  const fs::path parent = root / (".out.tmp-" + std::to_string(getppid()) + "-x");
+  const fs::path other = root / (".other.tmp-" + std::to_string(test::dead_pid()) + "-x");
+  for (const auto& p : {dead, live, parent, other}) {
+    fs::create_directories(p);
+    std::ofstream(p / "episode_0000.csv") << "half";
+  }
+  write_demo_set(set, dead_old);  // a killed run's set, moved aside before its new one was in place
+  write_demo_set(set, root / "out");
+  EXPECT_FALSE(fs::exists(dead)) << "a killed run's scratch folder of this target is cleaned up";
+  EXPECT_FALSE(fs::exists(dead_old));
+  EXPECT_TRUE(fs::exists(live / "episode_0000.csv")) << "a running writer's scratch folder is never touched";
+  EXPECT_TRUE(fs::exists(parent / "episode_0000.csv"));
+  EXPECT_TRUE(fs::exists(other)) << "only leftovers of this target";
+  EXPECT_EQ(read_demo_set(root / "out").episodes.size(), 2u);
+  fs::remove_all(root);
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
@@ -196,6 +199,22 @@ TEST(Dagger, ResumeEqualsUninterrupted) {
   ASSERT_EQ(resumed.curve.size(), 3u);
   EXPECT_EQ(resumed.curve.back().dataset_rows, whole.curve.back().dataset_rows);
   std::filesystem::remove_all(dir);
+}
+
+TEST(Checkpoint, CleanupRemovesOnlyOurOwnOlderDataFolders) {
+  LearnContext c = small_context(2);
+  c.checkpoint_dir = std::filesystem::temp_directory_path() / ("dicestack_checkpoint_user_" + std::to_string(getpid()));
+  std::filesystem::remove_all(c.checkpoint_dir);
+  std::filesystem::create_directories(c.checkpoint_dir / "data-notes");
+  std::filesystem::create_directories(c.checkpoint_dir / "data-7");
+  { std::ofstream(c.checkpoint_dir / "data-notes" / "notes.txt") << "mine"; }
+  { std::ofstream(c.checkpoint_dir / "data-7" / "notes.txt") << "mine"; }
+  LearnerRegistry::global().create("dagger", {"iterations=2", "rollouts=2", "beta=1", "include_demos=false", "expert=scripted"})->learn(c);
+  EXPECT_TRUE(std::filesystem::exists(c.checkpoint_dir / "data-notes" / "notes.txt")) << "a user's folder is kept";
+  EXPECT_TRUE(std::filesystem::exists(c.checkpoint_dir / "data-7" / "notes.txt")) << "not a dicestack set: kept";
+  EXPECT_FALSE(std::filesystem::exists(c.checkpoint_dir / "data-1")) << "our own older data is removed";
+  EXPECT_EQ(read_demo_set(c.checkpoint_dir / "data-2").episodes.size(), 4u);
+  std::filesystem::remove_all(c.checkpoint_dir);
 }
 
 }  // namespace

@@ -135,7 +135,8 @@ std::string to_json(const WorldConfig& config);
 /// Reads a JSON file; throws InputError if unreadable, ConfigError if invalid.
 WorldConfig load_world_config(const std::filesystem::path& path);
 
-/// Writes a JSON file atomically (temporary file, then rename).
+/// Writes a JSON file atomically (temporary file, then rename). An existing file is replaced only
+/// if it is a JSON object of world config sections; anything else is refused (InputError).
 void save_world_config(const WorldConfig& config, const std::filesystem::path& path);
 
 }  // namespace dicestack

@@ -13,6 +13,8 @@ namespace dicestack {
 
 inline constexpr const char* kDemoFormat = "dicestack-demos";
 inline constexpr int kDemoFormatVersion = 1;
+/// Format marker of the JSON summaries the baselines (optimise, reinforce, rrt) write into a set.
+inline constexpr const char* kBaselineFormat = "dicestack-baseline";
 
 /// A folder of episodes and what meta.json says about them.
 struct DemoSet {
@@ -34,11 +36,24 @@ DemoSet read_demo_set(const std::filesystem::path& dir);
 /// Reads one episode CSV (name = the file stem). Throws InputError as read_demo_set does.
 Episode read_episode_csv(const std::filesystem::path& file);
 
-/// Writes a set into `dir` (created, or replaced whole): files go to a temporary folder that
-/// is renamed into place, so a failure never leaves half a set. Throws InputError.
+/// True when `dir` is a demonstration set dicestack wrote, so one of our writers may replace or
+/// remove it: meta.json parses with "format": "dicestack-demos" and every entry is meta.json, an
+/// episode CSV it lists, a sidecar JSON with "format": "dicestack-baseline", or one of our
+/// scratch files. Otherwise false, with the reason in `why` ("it holds notes.txt").
+bool is_own_demo_set(const std::filesystem::path& dir, std::string* why = nullptr);
+
+/// Throws InputError unless `dir` is missing, an empty folder, or is_own_demo_set: "DIR: exists and
+/// is not a dicestack demonstration set (it holds notes.txt); refusing to replace it: ...".
+void check_demo_set_replaceable(const std::filesystem::path& dir);
+
+/// Writes a set into `dir` (created, or replaced whole if check_demo_set_replaceable allows it):
+/// files go to a temporary folder (".<name>.tmp-<pid>-<unique>") renamed into place, so a failure
+/// never leaves half a set. Dead runs' scratch folders of `dir` are removed first (a live run's
+/// never). Throws InputError.
 void write_demo_set(const DemoSet& set, const std::filesystem::path& dir);
 
-/// Appends episodes to the set in `dir` (created if missing) and rewrites its meta.json
+/// Appends episodes to the set in `dir` (created if missing or empty; any other folder without a
+/// meta.json is refused with InputError) and rewrites its meta.json
 /// atomically; new episodes get the next free names. Returns the names given.
 std::vector<std::string> append_to_demo_set(const std::filesystem::path& dir, std::vector<Episode> episodes,
                                             const WorldConfig& world, const std::string& description);

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/datasets/features.hpp>
 #include <dicestack/datasets/standardizer.hpp>
@@ -56,7 +57,12 @@ class Model {
   Standardizer y_;
 };
 
-/// Writes a model file atomically. Throws InputError.
+/// Which existing files save_model may replace: a first line that is JSON with
+/// "format": "dicestack-model". Also what checkpoint cleanup removes.
+Ownership model_ownership();
+
+/// Writes a model file atomically. An existing file at `path` that is not a dicestack model is
+/// refused (InputError naming it) and left as it is. Throws InputError.
 void save_model(const Model& model, const std::filesystem::path& path);
 
 /// Reads a model file (any version up to kModelFormatVersion), checking format, version,
