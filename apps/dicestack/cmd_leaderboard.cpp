@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <iostream>
 #include <sstream>
 
@@ -31,7 +32,7 @@ using nlohmann::json;
 struct LeaderboardOptions {
   WorldOption world;
   DemosOption demos;
-  std::vector<std::string> regressors, learners, options, baselines;
+  std::vector<std::string> regressors, learners, options, baselines, features;
   std::string profile = "quick", format = "md", split = "episodes";
   int episodes = 0, seeds = 1, threads = 0;
   std::uint64_t seed = 0;
@@ -39,14 +40,15 @@ struct LeaderboardOptions {
 };
 
 struct Row {
-  std::string regressor, learner;
+  std::string regressor, learner, features = "-";
   double train_error = 0, test_error = 0, fit_s = 0, us_per_step = 0, dice_in_cup = 0;
   int episodes = 0, stacked = 0, walls = 0, success = 0;
 };
 
 json row_json(const Row& r) {
   const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
-  return {{"regressor", r.regressor},     {"learner", r.learner},          {"train_error", r.train_error},
+  return {{"regressor", r.regressor},     {"learner", r.learner},          {"features", r.features},
+          {"train_error", r.train_error},
           {"test_error", r.test_error},   {"dice_in_cup_mean", r.dice_in_cup}, {"episodes", r.episodes},
           {"stacked", r.stacked},         {"wall_contact", r.walls},       {"realistic_success", r.success},
           {"stacked_rate", st.value},     {"stacked_ci95", {st.low, st.high}},
@@ -111,6 +113,7 @@ Row row_from(const json& j) {
   Row r;
   r.regressor = j.at("regressor");
   r.learner = j.at("learner");
+  r.features = j.value("features", "-");
   r.train_error = j.at("train_error");
   r.test_error = j.at("test_error");
   r.dice_in_cup = j.at("dice_in_cup_mean");
@@ -140,6 +143,10 @@ std::string fixed(double v, int digits) {
 constexpr const char* kLeaderboardFormat = "dicestack-leaderboard";
 constexpr const char* kPartialFormat = "dicestack-leaderboard-partial";
 constexpr const char* kCsvHeader =
+    "regressor,learner,features,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
+    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
+// The header before feature maps had a column (still ours to replace).
+constexpr const char* kCsvHeaderV1 =
     "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
     "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
 
@@ -153,7 +160,7 @@ std::string file_marker(const std::string& format) {
 
 Ownership table_ownership(const std::string& format) {
   if (format == "json") return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"});
-  if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader});
+  if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1});
   const std::string marker = file_marker(format);
   return Ownership::first_line("dicestack leaderboard (" + format + ")", {marker.substr(0, marker.size() - 1)});
 }
@@ -164,10 +171,10 @@ Ownership partial_ownership() {
 
 std::string render(const std::vector<Row>& rows, const std::string& format, const std::string& header, const json& meta) {
   std::ostringstream os;
-  const std::vector<std::string> cols{"regressor", "learner", "train error", "test error", "dice in cup",
+  const std::vector<std::string> cols{"regressor", "learner", "features", "train error", "test error", "dice in cup",
                                       "stacked", "wall contact", "realistic success", "fit s", "us/step"};
   auto cells = [](const Row& r) {
-    return std::vector<std::string>{r.regressor, r.learner, fixed(r.train_error, 3), fixed(r.test_error, 3),
+    return std::vector<std::string>{r.regressor, r.learner, r.features, fixed(r.train_error, 3), fixed(r.test_error, 3),
                                     fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
                                     pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
   };
@@ -181,12 +188,12 @@ std::string render(const std::vector<Row>& rows, const std::string& format, cons
     os << kCsvHeader << '\n';
     for (const auto& r : rows) {
       const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
-      os << r.regressor << ',' << r.learner << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
+      os << r.regressor << ',' << r.learner << ',' << r.features << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
          << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
          << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
     }
   } else if (format == "latex") {
-    os << "% " << header << "\n\\begin{tabular}{llrrrrrrrr}\n\\hline\n";
+    os << "% " << header << "\n\\begin{tabular}{lllrrrrrrrr}\n\\hline\n";
     for (std::size_t c = 0; c < cols.size(); ++c) os << cols[c] << (c + 1 < cols.size() ? " & " : " \\\\\n\\hline\n");
     for (const auto& r : rows) {
       const auto v = cells(r);
@@ -201,7 +208,7 @@ std::string render(const std::vector<Row>& rows, const std::string& format, cons
     os << header << "\n\n|";
     for (const auto& c : cols) os << ' ' << c << " |";
     os << "\n|";
-    for (std::size_t c = 0; c < cols.size(); ++c) os << (c < 2 ? "---|" : "---:|");
+    for (std::size_t c = 0; c < cols.size(); ++c) os << (c < 3 ? "---|" : "---:|");
     os << '\n';
     for (const auto& r : rows) {
       os << '|';
@@ -219,13 +226,14 @@ int run_leaderboard(LeaderboardOptions opt) {
   const auto dir = opt.demos.resolve(world);
   const DemoSet set = read_demo_set(dir);
   const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
-  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger"} : opt.learners;
+  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger", "dart"} : opt.learners;
   // Learner options: the profile's defaults, then --option (for every learner that has the key).
   auto options_for = [&](const std::string& learner) {
     std::vector<std::string> out;
     if (learner == "dagger") out = paper ? std::vector<std::string>{"iterations=5", "rollouts=20"}
                                          : std::vector<std::string>{"iterations=2", "rollouts=10"};
     if (learner == "dad" && !paper) out = {"windows=2", "iterations=1", "corrector_iterations=10"};  // paper: its defaults
+    if (learner == "dart" && !paper) out = {"episodes=100"};  // paper: its defaults (300)
     for (const auto& kv : opt.options) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -247,9 +255,32 @@ int run_leaderboard(LeaderboardOptions opt) {
     if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
 
+  // (learner, feature map) rows: each learner with every map of --features it can read, or with
+  // its own default map.
+  std::vector<std::pair<std::string, std::string>> combos;
+  for (const auto& l : learners) {
+    const LearnerInfo& info = LearnerRegistry::global().info(l);
+    for (const auto& f : opt.features.empty() ? std::vector<std::string>{info.default_features} : opt.features) {
+      feature_map(f);  // unknown names fail before any work
+      if (info.state_features_only && f != "state") {
+        print_progress("note: " + l + " reads only the state; skipping features " + f);
+        continue;
+      }
+      if (opt.split == "rows" && f != "state")
+        throw ConfigError("features \"" + f + "\" read an episode's history; --split rows shuffles the rows: use --split episodes");
+      combos.emplace_back(l, f);
+    }
+  }
+
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
   const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
+  std::map<std::string, Split> feature_splits;  // the same split seen through each feature map
+  auto split_for = [&](const std::string& f) -> const Split& {
+    if (f == "state") return split;
+    if (!feature_splits.contains(f)) feature_splits.emplace(f, split_by_episode(set.episodes, feature_map(f)));
+    return feature_splits.at(f);
+  };
   std::vector<Episode> train, held_out;
   if (opt.split == "rows") {
     Episode rows;
@@ -276,13 +307,14 @@ int run_leaderboard(LeaderboardOptions opt) {
          << " episodes, " << frames << " frames); split " << split.description << "; profile " << opt.profile << "; "
          << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
          << " training seed(s); rates with 95% Wilson intervals";
-  json learner_options = json::object();
+  json learner_options = json::object(), row_features = json::array();
   for (const auto& l : learners) learner_options[l] = options_for(l);
-  header << "; learner options " << learner_options.dump();
+  for (const auto& [l, f] : combos) row_features.push_back(l + " " + f);
+  header << "; learner options " << learner_options.dump() << "; features " << row_features.dump();
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
            << " budgets, then played from the same random starts";
-  const json meta{{"learner_options", learner_options}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
+  const json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
                   {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
 
@@ -302,17 +334,18 @@ int run_leaderboard(LeaderboardOptions opt) {
   }
 
   std::vector<Row> rows;
-  const std::size_t total = learners.size() * regressors.size();
+  const std::size_t total = combos.size() * regressors.size();
   std::size_t index = 0;
-  for (const auto& learner_name : learners) {
+  for (const auto& [learner_name, features] : combos) {
+    const Split& fsplit = split_for(features);
     for (const auto& name : regressors) {
       ++index;
-      const std::string key = learner_name + "/" + name;
+      const std::string key = learner_name + "/" + features + "/" + name;
       if (done.contains(key)) {
         rows.push_back(row_from(done[key]));
         continue;
       }
-      Row row{name, learner_name};
+      Row row{name, learner_name, features};
       for (int s = 0; s < opt.seeds; ++s) {
         const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(s);
         print_progress("[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name +
@@ -320,6 +353,7 @@ int run_leaderboard(LeaderboardOptions opt) {
         LearnContext c;
         c.world = world;
         c.regressor = name;
+        c.features = features;
         c.seed = seed;
         c.threads = opt.threads;
         c.demos = train;
@@ -336,8 +370,11 @@ int run_leaderboard(LeaderboardOptions opt) {
         const auto t0 = std::chrono::steady_clock::now();
         const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
         row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
-        row.train_error += scaled_l1_error(split.train.y, learned.model->predict(split.train.x), sigma) / opt.seeds;
-        row.test_error += split.test.rows() ? scaled_l1_error(split.test.y, learned.model->predict(split.test.x), sigma) / opt.seeds : 0.0;
+        row.train_error += scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma) / opt.seeds;
+        if (fsplit.test.rows() == 0)
+          row.test_error = -1;  // no test episode: printed "-"
+        else
+          row.test_error += scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma) / opt.seeds;
         print_progress("[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name +
                        ": " + std::to_string(episodes) + " rollouts");
         std::shared_ptr<const Model> model = learned.model;
@@ -401,7 +438,11 @@ void add_leaderboard_command(CLI::App& app) {
   opt->world.add_to(*cmd);
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressors", opt->regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
-  cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc, dagger)")->delimiter(',');
+  cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc, dagger, dart)")->delimiter(',');
+  cmd->add_option("--features", opt->features,
+                  "Feature maps (comma-separated): a row per learner and map it can read (default: each learner's own, "
+                  "see `dicestack learners`)")
+      ->delimiter(',');
   cmd->add_option("--option", opt->options, "key=value learner option (applied to the learners that have it); repeatable");
   cmd->add_option("--baselines", opt->baselines,
                   "Baselines without demonstrations as rows of their own: cmaes, de, basinhop, bayes, reinforce, rrt "

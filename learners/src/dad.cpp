@@ -229,7 +229,8 @@ class Dad final : public Learner {
 
 void register_dad(LearnerRegistry& r) {
   r.add({"dad", "DaD with windowed annealing: corrections towards the demonstrations, found in the simulator",
-         Dad::schema(), [](std::string n, Params p) { return std::make_unique<Dad>(std::move(n), std::move(p)); }, true});
+         Dad::schema(), [](std::string n, Params p) { return std::make_unique<Dad>(std::move(n), std::move(p)); }, true,
+         "state", true});
 }
 
 }  // namespace dicestack

@@ -1,3 +1,5 @@
+#include <limits>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/learners/learner.hpp>
@@ -22,7 +24,11 @@ class Dart final : public Learner {
       if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
     if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
     std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
-    auto recorded = record_expert(params().choice("expert"), {}, c.world, episodes, c.seed, c.threads, fraction);
+    ExpertConfig expert;
+    // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
+    // depend on the noise so far; without replanning its plan is a function of the start.
+    if (!params().boolean("replan")) expert.replan_interval = std::numeric_limits<int>::max();
+    auto recorded = record_expert(params().choice("expert"), expert, c.world, episodes, c.seed, c.threads, fraction);
     int successes = 0;
     const bool successes_only = params().boolean("successes_only");
     for (auto& e : recorded) {
@@ -53,6 +59,7 @@ class Dart final : public Learner {
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
+            {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the noise pushes the world off its prediction", {}},
             {"successes_only", ParamType::boolean, "false", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
   }

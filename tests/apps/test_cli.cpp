@@ -281,6 +281,44 @@ TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
   EXPECT_THAT(tex.output, HasSubstr("\\end{tabular}"));
 }
 
+TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
+  const auto model = std::filesystem::temp_directory_path() / ("dicestack_cli_dart_" + std::to_string(getpid()) + ".dsm");
+  Process p = run("train --demos " + kTinyDemos + " --regressor knn --learner dart --option episodes=3 --seed 1 --out " +
+                  model.string() + " --json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start");
+  p = run("evaluate --model " + model.string() + " --episodes 2 --json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start");
+  p = run("train --demos " + kTinyDemos + " --regressor knn --features state+tomorrow --out " + model.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("unknown feature map \"state+tomorrow\""));
+  std::filesystem::remove(model);
+  // A row per learner and map it can read; DaD reads only the state, so its state+clock row is skipped.
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr --learners bc,dad --features state,state+clock "
+          "--option windows=1 --option iterations=1 --option corrector_iterations=2 --episodes 2 --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  const auto table = nlohmann::json::parse(p.output);
+  EXPECT_EQ(table["features"], nlohmann::json({"bc state", "bc state+clock", "dad state"}));
+  const auto rows = table["rows"];
+  ASSERT_EQ(rows.size(), 4u);  // bc state, bc state+clock, dad state, playback
+  EXPECT_EQ(rows[0]["features"], "state");
+  EXPECT_EQ(rows[1]["features"], "state+clock");
+  EXPECT_EQ(rows[2]["learner"], "dad");
+  EXPECT_EQ(rows[2]["features"], "state");
+}
+
+TEST(CliLearning, RecordWithNoiseRecordsTheCleanActionsAndSaysSo) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dicestack_cli_noise_" + std::to_string(getpid()));
+  const Process p = run("record --expert scripted --episodes 2 --noise 0.2 --out " + dir.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  std::ifstream meta(dir / "meta.json");
+  const auto j = nlohmann::json::parse(meta);
+  EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("DART noise"));
+  EXPECT_EQ(run("dataset validate " + dir.string()).status, 0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliBaselines, LeaderboardAddsBaselineRowsFromTheSameStarts) {
   const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 2 --seed 4 "
                         "--baselines de,rrt --format json", false);

@@ -83,6 +83,7 @@ struct LearnerInfo {
   std::function<std::unique_ptr<Learner>(std::string, Params)> factory;
   bool needs_trajectories = false;  ///< learns from whole episodes, so not from shuffled rows
   std::string default_features = "state";  ///< the feature map used when none is named (docs/learners.md)
+  bool state_features_only = false;        ///< reads no feature map but "state" (DaD's corrections are windows)
 };
 
 /// Learners by name ("bc", "dagger", "dad", "dart"); built-ins registered on first use.

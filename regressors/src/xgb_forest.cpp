@@ -1,0 +1,130 @@
+#include "xgb_forest.hpp"
+
+#include <cmath>
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+
+namespace dicestack::detail {
+namespace {
+
+// Floats parsed as floats (strtof), so thresholds and leaf values are bit-identical to xgboost's.
+using FloatJson = nlohmann::basic_json<std::map, std::vector, std::string, bool, std::int64_t, std::uint64_t, float>;
+
+[[noreturn]] void fail(const std::string& what) { throw InputError("gbt: " + what); }
+
+}  // namespace
+
+XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_t outputs) {
+  FloatJson j;
+  try {
+    j = FloatJson::parse(text.begin(), text.end(), nullptr, true, false);
+  } catch (const FloatJson::exception& e) {
+    fail(std::string("the payload is not xgboost's JSON model: ") + e.what());
+  }
+  XgbForest f;
+  if (outputs == 0 || outputs > 64) fail("a model predicts 1 to 64 outputs, not " + std::to_string(outputs));
+  f.outputs_ = outputs;
+  try {
+    const auto& learner = j.at("learner");
+    if (learner.at("objective").at("name").get<std::string>() != "reg:squarederror")
+      fail("the model's objective is not reg:squarederror");
+    const auto& param = learner.at("learner_model_param");
+    const unsigned long targets = std::stoul(param.at("num_target").get<std::string>());
+    if (targets != outputs)
+      fail("the model has " + std::to_string(targets) + " targets, the header says " + std::to_string(outputs));
+    if (std::stoul(param.at("num_feature").get<std::string>()) != inputs)
+      fail("the model reads " + param.at("num_feature").get<std::string>() + " features, the header says " +
+           std::to_string(inputs));
+    f.base_score_ = std::stof(param.at("base_score").get<std::string>());
+    if (!std::isfinite(f.base_score_)) fail("base_score is not finite");
+    const auto& booster = learner.at("gradient_booster");
+    if (booster.at("name").get<std::string>() != "gbtree") fail("the booster is not gbtree");
+    const auto& model = booster.at("model");
+    const auto& trees = model.at("trees");
+    const auto& info = model.at("tree_info");
+    if (!trees.is_array() || !info.is_array() || trees.size() != info.size())
+      fail("tree_info lists " + std::to_string(info.size()) + " trees, the model holds " + std::to_string(trees.size()));
+    for (std::size_t t = 0; t < trees.size(); ++t) {
+      const std::string where = "tree " + std::to_string(t) + ": ";
+      const auto target = info[t].get<std::int64_t>();
+      if (target < 0 || static_cast<std::size_t>(target) >= outputs)
+        fail(where + "target " + std::to_string(target) + " is not below " + std::to_string(outputs));
+      const auto& tree = trees[t];
+      const auto& left = tree.at("left_children");
+      const auto& right = tree.at("right_children");
+      const auto& feature = tree.at("split_indices");
+      const auto& value = tree.at("split_conditions");
+      const auto& dleft = tree.at("default_left");
+      const auto& type = tree.at("split_type");
+      const std::size_t n = left.size();
+      if (n == 0 || n > (1u << 26)) fail(where + "has " + std::to_string(n) + " nodes");
+      for (const auto* a : {&right, &feature, &value, &dleft, &type})
+        if (!a->is_array() || a->size() != n) fail(where + "its node arrays differ in length");
+      const auto base = static_cast<std::int64_t>(f.nodes_.size());
+      std::vector<char> seen(n, 0);
+      // Walk from the root: each node reached once (a tree), every index checked before use.
+      std::vector<std::pair<std::int64_t, int>> stack{{0, 0}};
+      while (!stack.empty()) {
+        const auto [i, depth] = stack.back();
+        stack.pop_back();
+        const std::string at = where + "node " + std::to_string(i) + ": ";
+        if (seen[static_cast<std::size_t>(i)]) fail(at + "reached twice; not a tree");
+        seen[static_cast<std::size_t>(i)] = 1;
+        if (depth > 64) fail(at + "deeper than 64");
+        const auto l = left[static_cast<std::size_t>(i)].get<std::int64_t>();
+        const auto r = right[static_cast<std::size_t>(i)].get<std::int64_t>();
+        const float v = value[static_cast<std::size_t>(i)].get<float>();
+        if (!std::isfinite(v)) fail(at + "value is not finite");
+        if (l == -1 && r == -1) continue;
+        for (const auto c : {l, r})
+          if (c <= 0 || c >= static_cast<std::int64_t>(n))
+            fail(at + "child " + std::to_string(c) + " is out of range (the tree has " + std::to_string(n) + " nodes)");
+        if (type[static_cast<std::size_t>(i)].get<int>() != 0) fail(at + "categorical splits are not supported");
+        const auto k = feature[static_cast<std::size_t>(i)].get<std::int64_t>();
+        if (k < 0 || static_cast<std::size_t>(k) >= inputs)
+          fail(at + "splits on feature " + std::to_string(k) + " of " + std::to_string(inputs));
+        stack.emplace_back(l, depth + 1);
+        stack.emplace_back(r, depth + 1);
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        Node node;
+        node.value = value[i].get<float>();
+        node.default_left = dleft[i].get<int>() != 0;
+        if (seen[i] && left[i].get<std::int64_t>() != -1) {
+          node.left = static_cast<std::int32_t>(base + left[i].get<std::int64_t>());
+          node.right = static_cast<std::int32_t>(base + right[i].get<std::int64_t>());
+          node.feature = static_cast<std::uint32_t>(feature[i].get<std::int64_t>());
+        }
+        f.nodes_.push_back(node);
+      }
+      f.roots_.push_back(static_cast<std::uint32_t>(base));
+      f.targets_.push_back(static_cast<std::uint32_t>(target));
+    }
+  } catch (const FloatJson::exception& e) {
+    fail(std::string("malformed xgboost model: ") + e.what());
+  } catch (const std::logic_error& e) {  // std::stoul / std::stof on a bad number
+    fail(std::string("malformed xgboost model parameter: ") + e.what());
+  }
+  return f;
+}
+
+void XgbForest::predict(std::span<const double> x, std::span<double> y) const {
+  float sum[64];
+  for (std::size_t k = 0; k < outputs_; ++k) sum[k] = base_score_;
+  for (std::size_t t = 0; t < roots_.size(); ++t) {
+    const Node* node = &nodes_[roots_[t]];
+    while (node->left >= 0) {
+      const auto v = static_cast<float>(x[node->feature]);
+      const bool go_left = std::isnan(v) ? node->default_left : v < node->value;
+      node = &nodes_[static_cast<std::size_t>(go_left ? node->left : node->right)];
+    }
+    sum[targets_[t]] += node->value;
+  }
+  for (std::size_t k = 0; k < outputs_; ++k) y[k] = sum[k];
+}
+
+}  // namespace dicestack::detail
