@@ -53,14 +53,14 @@ class Dart final : public Learner {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
     return {{"expert", ParamType::choice, "scripted", 0, 0, "the expert that demonstrates and labels", names},
-            {"noise", ParamType::real, "0.2", 0, 10,
+            {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
             {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the noise pushes the world off its prediction", {}},
-            {"successes_only", ParamType::boolean, "false", 0, 1, "fit only on the noisy episodes that succeeded", {}},
+            {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
   }
 };

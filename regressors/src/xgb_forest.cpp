@@ -1,5 +1,6 @@
 #include "xgb_forest.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -26,7 +27,10 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
     fail(std::string("the payload is not xgboost's JSON model: ") + e.what());
   }
   XgbForest f;
-  if (outputs == 0 || outputs > 64) fail("a model predicts 1 to 64 outputs, not " + std::to_string(outputs));
+  if (outputs == 0 || outputs > kMaxOutputs)
+    fail("a model predicts 1 to " + std::to_string(kMaxOutputs) + " outputs, not " + std::to_string(outputs));
+  if (inputs == 0 || inputs > kMaxInputs)
+    fail("a model reads 1 to " + std::to_string(kMaxInputs) + " inputs, not " + std::to_string(inputs));
   f.outputs_ = outputs;
   try {
     const auto& learner = j.at("learner");
@@ -113,16 +117,29 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
 }
 
 void XgbForest::predict(std::span<const double> x, std::span<double> y) const {
-  float sum[64];
+  float in[kMaxInputs];
+  for (std::size_t j = 0; j < x.size() && j < kMaxInputs; ++j) in[j] = static_cast<float>(x[j]);
+  float sum[kMaxOutputs];
   for (std::size_t k = 0; k < outputs_; ++k) sum[k] = base_score_;
-  for (std::size_t t = 0; t < roots_.size(); ++t) {
-    const Node* node = &nodes_[roots_[t]];
-    while (node->left >= 0) {
-      const auto v = static_cast<float>(x[node->feature]);
-      const bool go_left = std::isnan(v) ? node->default_left : v < node->value;
-      node = &nodes_[static_cast<std::size_t>(go_left ? node->left : node->right)];
+  // A block of trees walked one level at a time: their loads are independent, so the cache
+  // misses of a deep forest overlap instead of queueing one after another.
+  constexpr std::size_t kBlock = 16;
+  const Node* at[kBlock];
+  for (std::size_t begin = 0; begin < roots_.size(); begin += kBlock) {
+    const std::size_t n = std::min(kBlock, roots_.size() - begin);
+    for (std::size_t i = 0; i < n; ++i) at[i] = &nodes_[roots_[begin + i]];
+    for (bool moving = true; moving;) {
+      moving = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Node* node = at[i];
+        if (node->left < 0) continue;
+        const float v = in[node->feature];
+        const bool go_left = std::isnan(v) ? node->default_left : v < node->value;
+        at[i] = &nodes_[static_cast<std::size_t>(go_left ? node->left : node->right)];
+        moving = true;
+      }
     }
-    sum[targets_[t]] += node->value;
+    for (std::size_t i = 0; i < n; ++i) sum[targets_[begin + i]] += at[i]->value;  // in tree order, as xgboost sums
   }
   for (std::size_t k = 0; k < outputs_; ++k) y[k] = sum[k];
 }

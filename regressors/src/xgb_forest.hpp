@@ -28,6 +28,7 @@ class XgbForest {
   std::size_t trees() const { return roots_.size(); }
 
  private:
+  static constexpr std::size_t kMaxInputs = 256, kMaxOutputs = 64;  // stack rows on the hot path
   struct Node {
     std::int32_t left = -1;  ///< absolute node index; -1 for a leaf
     std::int32_t right = -1;

@@ -283,7 +283,7 @@ TEST(CliLearning, LeaderboardIsDeterministicAndEveryFormatIsWellFormed) {
 
 TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   const auto model = std::filesystem::temp_directory_path() / ("dicestack_cli_dart_" + std::to_string(getpid()) + ".dsm");
-  Process p = run("train --demos " + kTinyDemos + " --regressor knn --learner dart --option episodes=3 --seed 1 --out " +
+  Process p = run("train --demos " + kTinyDemos + " --regressor knn --learner dart --option episodes=3 --option successes_only=false --seed 1 --out " +
                   model.string() + " --json", false);
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start");

@@ -94,7 +94,7 @@ TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
 }
 
 TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
-  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2"});
+  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2", "successes_only=false"});
   LearnContext c;
   c.world = short_world();
   c.regressor = "knn";
@@ -108,7 +108,10 @@ TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
   EXPECT_EQ(one.model->features().name(), "state+clock+start");
   EXPECT_EQ(one.model->record.at("learner"), "dart");
   // Without noise the data are the expert's own clean episodes: a different model.
-  const auto quiet = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0"})->learn(c);
+  const auto quiet = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0", "successes_only=false"})->learn(c);
+  // In 60 steps the expert never stacks: with the default successes_only nothing is left to fit.
+  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", {"episodes=2"})->learn(c); }),
+              HasSubstr("dart: no demonstration to fit (the expert succeeded in none of 2 noisy episodes)"));
   EXPECT_NE(quiet.model->regressor().save_payload(), one.model->regressor().save_payload());
   EXPECT_EQ(LearnerRegistry::global().info("dart").default_features, "state+clock+start");
 }
@@ -121,7 +124,7 @@ TEST(Dart, AModelFileAloneRollsOut) {
   c.regressor = "linear_svr";
   c.features = "state+clock+start";
   c.seed = 2;
-  const auto learned = LearnerRegistry::global().create("dart", {"episodes=3"})->learn(c);
+  const auto learned = LearnerRegistry::global().create("dart", {"episodes=3", "successes_only=false"})->learn(c);
   const fs::path path = fs::temp_directory_path() / ("dicestack_dart_alone_" + std::to_string(getpid()) + ".dsm");
   save_model(*learned.model, path);
   auto model = std::make_shared<const Model>(load_model(path));
