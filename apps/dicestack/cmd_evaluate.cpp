@@ -6,6 +6,7 @@
 
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/metrics.hpp>
+#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 
 #include "cli.hpp"
@@ -16,7 +17,7 @@ namespace {
 
 struct EvaluateOptions {
   WorldOption world;
-  std::filesystem::path model, demos;
+  std::filesystem::path model, demos, save_rollouts;
   int episodes = 20;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -29,8 +30,19 @@ nlohmann::json rate_json(const Rate& r) { return {r.value, r.low, r.high}; }
 int run_evaluate(const EvaluateOptions& opt) {
   const WorldConfig world = opt.world.load();
   auto model = std::make_shared<const Model>(load_model(opt.model));
+  if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
+  std::vector<Episode> rollouts;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,
-                               opt.threads, initial_push_from(opt.push));
+                               opt.threads, initial_push_from(opt.push), opt.save_rollouts.empty() ? nullptr : &rollouts);
+  if (!opt.save_rollouts.empty()) {
+    DemoSet set;
+    set.world = world;
+    set.description = "rollouts of " + opt.model.string();
+    set.provenance = "dicestack evaluate --model " + opt.model.string() + " --episodes " + std::to_string(opt.episodes) +
+                     " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
+    set.episodes = std::move(rollouts);
+    write_demo_set(set, opt.save_rollouts);
+  }
   nlohmann::json j{{"model", opt.model.string()},
                    {"regressor", model->regressor().name()},
                    {"features", model->features().name()},
@@ -92,6 +104,8 @@ void add_evaluate_command(CLI::App& app) {
   cmd->add_option("--initial-push", opt->push, "The paper's jump-start: none, left or right")
       ->check(CLI::IsMember({"none", "left", "right"}))
       ->capture_default_str();
+  cmd->add_option("--save-rollouts", opt->save_rollouts,
+                  "Also write the rollouts as a demonstration set (source policy; outcomes in meta.json)");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt] { run_evaluate(*opt); });
 }

@@ -1,6 +1,7 @@
 // `dicestack record`: demonstrations from an automatic expert (docs/expert.md).
 #include <chrono>
 #include <cstdio>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -21,7 +22,7 @@ struct RecordOptions {
   std::filesystem::path out;
   int threads = 0;
   double noise = 0.0;
-  bool successes_only = false;
+  bool successes_only = false, no_replan = false;
   bool json = false;
 };
 
@@ -29,7 +30,9 @@ int run_record(const RecordOptions& opt) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Episode> eps = record_expert(opt.expert, {}, world, opt.episodes, opt.seed, opt.threads,
+  ExpertConfig expert;
+  if (opt.no_replan) expert.replan_interval = std::numeric_limits<int>::max();
+  std::vector<Episode> eps = record_expert(opt.expert, expert, world, opt.episodes, opt.seed, opt.threads,
                                          {opt.noise, opt.noise, opt.noise});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int success = 0, stacked = 0, walls = 0;
@@ -44,7 +47,7 @@ int run_record(const RecordOptions& opt) {
   set.world = world;
   set.description = "dicestack record --expert " + opt.expert;
   set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
-                   std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
+                   std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
                    (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
                    "; episode i starts from random_start_state(world, training_start_seed(seed, i))" +
                    (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
@@ -98,6 +101,9 @@ void add_record_command(CLI::App& app) {
                   "expert's clean actions are recorded")
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
+  cmd->add_flag("--no-replan", opt->no_replan,
+                "mpc: choose the plan once, from the start, and never replan (its actions are then a function of "
+                "the start, the step and the state)");
   cmd->add_flag("--successes-only", opt->successes_only, "Keep only realistic successes");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt] { run_record(*opt); });

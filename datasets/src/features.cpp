@@ -16,6 +16,7 @@ struct Blocks {
   bool clock = false;
   bool start = false;
   bool previous = false;
+  bool start_state = false;  // the whole start state instead of its two summary numbers
 };
 
 class BuiltinFeatureMap final : public FeatureMap {
@@ -28,7 +29,8 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
 
   std::size_t width() const override {
-    return kStateDim + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0);
+    return kStateDim + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
+           (blocks_.start_state ? kStateDim : 0);
   }
 
   std::vector<std::string> column_names() const override {
@@ -38,6 +40,8 @@ class BuiltinFeatureMap final : public FeatureMap {
     if (blocks_.start) out.insert(out.end(), {"start_cup_x", "start_dice_mean_x"});
     if (blocks_.previous)
       for (auto n : state_names()) out.push_back("prev_" + std::string(n));
+    if (blocks_.start_state)
+      for (auto n : state_names()) out.push_back("start_" + std::string(n));
     return out;
   }
 
@@ -56,7 +60,9 @@ class BuiltinFeatureMap final : public FeatureMap {
     if (blocks_.previous) {
       const State& p = h.states.size() >= 2 ? h.states[h.states.size() - 2] : s;
       std::copy(p.begin(), p.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
+      at += kStateDim;
     }
+    if (blocks_.start_state) std::copy(h.start().begin(), h.start().end(), out.begin() + static_cast<std::ptrdiff_t>(at));
   }
 
  private:
@@ -74,6 +80,8 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "state+clock+start", "the state, t, and the start's cup x and mean die x", Blocks{true, true, false}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "state+history", "the state and the previous state (the start repeated at t = 0)", Blocks{false, false, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>("state+clock+start_state", "the state, t and the whole start state",
+                                                     Blocks{true, false, false, true}));
     return v;
   }();
   return *maps;

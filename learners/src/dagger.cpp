@@ -1,5 +1,6 @@
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <dicestack/core/error.hpp>
@@ -23,6 +24,10 @@ class Dagger final : public Learner {
     const int iterations = static_cast<int>(params().integer("iterations"));
     const int rollouts = static_cast<int>(params().integer("rollouts"));
     const std::string expert_name = params().choice("expert");
+    ExpertConfig expert_config;
+    // Without replanning, mpc's labels are a function of the start, the step and the state: the
+    // same on and off its own path (docs/learners.md).
+    if (!params().boolean("replan")) expert_config.replan_interval = std::numeric_limits<int>::max();
     std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
     std::shared_ptr<Model> model;
     LearnResult result;
@@ -45,7 +50,7 @@ class Dagger final : public Learner {
         auto& env = envs[static_cast<std::size_t>(w)];
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!env) env.emplace(c.world);
-        if (!expert) expert = make_expert(expert_name);
+        if (!expert) expert = make_expert(expert_name, expert_config);
         fresh[k] = mixture_rollout(*env, *expert, model.get(), beta,
                                    training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
         const int done = ++finished;
@@ -77,6 +82,7 @@ class Dagger final : public Learner {
             {"beta", ParamType::real, "0.5", 0, 1, "p of the exponential schedule beta_i = p^(i-1)", {}},
             {"schedule", ParamType::choice, "exponential", 0, 0, "exponential (p^(i-1)) or linear (1 down to 0)", {"exponential", "linear"}},
             {"expert", ParamType::choice, "mpc", 0, 0, "the expert that acts and labels", names},
+            {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the world leaves its prediction", {}},
             {"include_demos", ParamType::boolean, "true", 0, 1, "start the aggregate from the demonstrations", {}}};
   }
 

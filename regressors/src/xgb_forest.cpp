@@ -65,7 +65,8 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
       const auto& dleft = tree.at("default_left");
       const auto& type = tree.at("split_type");
       const std::size_t n = left.size();
-      if (n == 0 || n > (1u << 26)) fail(where + "has " + std::to_string(n) + " nodes");
+      if (n == 0 || n > (1u << 24)) fail(where + "has " + std::to_string(n) + " nodes");
+      if (f.nodes_.size() + n > (1u << 30)) fail(where + "the forest has more than 2^30 nodes");
       for (const auto* a : {&right, &feature, &value, &dleft, &type})
         if (!a->is_array() || a->size() != n) fail(where + "its node arrays differ in length");
       const auto base = static_cast<std::int64_t>(f.nodes_.size());
@@ -94,16 +95,24 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
         stack.emplace_back(l, depth + 1);
         stack.emplace_back(r, depth + 1);
       }
-      for (std::size_t i = 0; i < n; ++i) {
-        Node node;
+      // Laid out breadth first with each node's two children side by side (right = left + 1):
+      // 12-byte nodes, the top levels of a tree in a few cache lines.
+      f.nodes_.emplace_back();
+      std::vector<std::pair<std::size_t, std::size_t>> queue{{0, static_cast<std::size_t>(base)}};  // (xgboost's, ours)
+      for (std::size_t q = 0; q < queue.size(); ++q) {
+        const auto [i, slot] = queue[q];
+        Node& node = f.nodes_[slot];
         node.value = value[i].get<float>();
-        node.default_left = dleft[i].get<int>() != 0;
-        if (seen[i] && left[i].get<std::int64_t>() != -1) {
-          node.left = static_cast<std::int32_t>(base + left[i].get<std::int64_t>());
-          node.right = static_cast<std::int32_t>(base + right[i].get<std::int64_t>());
-          node.feature = static_cast<std::uint32_t>(feature[i].get<std::int64_t>());
-        }
-        f.nodes_.push_back(node);
+        const auto l = left[i].get<std::int64_t>();
+        if (l == -1) continue;
+        const auto children = f.nodes_.size();
+        node.left = static_cast<std::int32_t>(children);
+        node.feature = static_cast<std::uint32_t>(feature[i].get<std::int64_t>()) |
+                       (dleft[i].get<int>() != 0 ? kDefaultLeft : 0u);
+        f.nodes_.emplace_back();
+        f.nodes_.emplace_back();
+        queue.emplace_back(static_cast<std::size_t>(l), children);
+        queue.emplace_back(static_cast<std::size_t>(right[i].get<std::int64_t>()), children + 1);
       }
       f.roots_.push_back(static_cast<std::uint32_t>(base));
       f.targets_.push_back(static_cast<std::uint32_t>(target));
@@ -133,9 +142,9 @@ void XgbForest::predict(std::span<const double> x, std::span<double> y) const {
       for (std::size_t i = 0; i < n; ++i) {
         const Node* node = at[i];
         if (node->left < 0) continue;
-        const float v = in[node->feature];
-        const bool go_left = std::isnan(v) ? node->default_left : v < node->value;
-        at[i] = &nodes_[static_cast<std::size_t>(go_left ? node->left : node->right)];
+        const float v = in[node->feature & ~kDefaultLeft];
+        const bool go_left = std::isnan(v) ? (node->feature & kDefaultLeft) != 0 : v < node->value;
+        at[i] = &nodes_[static_cast<std::size_t>(node->left + (go_left ? 0 : 1))];
         moving = true;
       }
     }

@@ -29,12 +29,11 @@ class XgbForest {
 
  private:
   static constexpr std::size_t kMaxInputs = 256, kMaxOutputs = 64;  // stack rows on the hot path
+  static constexpr std::uint32_t kDefaultLeft = 1u << 31;  // in Node::feature: a NaN goes left
   struct Node {
-    std::int32_t left = -1;  ///< absolute node index; -1 for a leaf
-    std::int32_t right = -1;
-    std::uint32_t feature = 0;
-    float value = 0.0f;      ///< split threshold, or the leaf value
-    bool default_left = false;
+    std::int32_t left = -1;     ///< index of the left child (the right one follows it); -1 for a leaf
+    std::uint32_t feature = 0;  ///< split feature, | kDefaultLeft
+    float value = 0.0f;         ///< split threshold, or the leaf value
   };
   std::vector<Node> nodes_;
   std::vector<std::uint32_t> roots_, targets_;
