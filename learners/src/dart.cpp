@@ -52,14 +52,15 @@ class Dart final : public Learner {
   static std::vector<ParamSpec> schema() {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
-    return {{"expert", ParamType::choice, "scripted", 0, 0, "the expert that demonstrates and labels", names},
+    return {{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels", names},
             {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
-            {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the noise pushes the world off its prediction", {}},
+            {"replan", ParamType::boolean, "false", 0, 1,
+             "mpc: replan when the noise pushes the world off its prediction (its labels then depend on the noise so far)", {}},
             {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
   }
@@ -70,7 +71,7 @@ class Dart final : public Learner {
 void register_dart(LearnerRegistry& r) {
   r.add({"dart", "DART: the expert demonstrates under injected noise, its clean actions are the labels", Dart::schema(),
          [](std::string n, Params p) { return std::make_unique<Dart>(std::move(n), std::move(p)); }, false,
-         "state+clock+start"});
+         "state+clock+start_state"});
 }
 
 }  // namespace dicestack

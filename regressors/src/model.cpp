@@ -24,6 +24,22 @@ std::string fnv1a_hex(std::string_view bytes) {
 
 json scaler_json(const Standardizer& s) { return {{"mean", s.mean}, {"sigma", s.sigma}}; }
 
+// Version 2: FNV-1a over the header (without this field, as dumped) and the payload, so an
+// edited standardiser, parameter or dimension is caught as surely as an edited payload.
+std::string whole_checksum(json header, std::string_view payload) {
+  header.erase("checksum");
+  return fnv1a_hex(header.dump() + '\n' + std::string(payload));
+}
+
+// An integer header field, refusing 1.5, -1 or 1e30 instead of narrowing them.
+std::uint64_t header_count(const json& h, const char* key, std::uint64_t max, const std::string& where) {
+  const json& v = h.at(key);
+  if (!v.is_number_unsigned() || v.get<std::uint64_t>() > max)
+    throw InputError(where + "header field \"" + key + "\" must be an integer in [0, " + std::to_string(max) + "], got " +
+                     v.dump().substr(0, 40));
+  return v.get<std::uint64_t>();
+}
+
 }  // namespace
 
 Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y, const FeatureMap& features)
@@ -75,7 +91,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
   const std::string payload = r.save_payload();
   json params = json::object();
   for (const auto& [k, v] : r.params().as_text()) params[k] = v;
-  const json header{{"format", kModelFormat},
+  json header{{"format", kModelFormat},
                     {"version", kModelFormatVersion},
                     {"dicestack_version", DICESTACK_VERSION},
                     {"regressor", r.name()},
@@ -93,6 +109,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                     {"record", model.record},
                     {"payload_bytes", payload.size()},
                     {"payload_fnv1a", fnv1a_hex(payload)}};
+  header["checksum"] = whole_checksum(header, payload);
   AtomicFile file(path, model_ownership());
   file.stream() << header.dump() << '\n' << payload;
   file.commit();
@@ -111,13 +128,30 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
     throw InputError(where + "the first line is not a JSON header; not a dicestack model");
   }
   try {
-    if (h.value("format", "") != kModelFormat) throw InputError(where + "format is not " + kModelFormat);
-    const int version = h.at("version").get<int>();
+    if (!h.is_object() || h.value("format", "") != kModelFormat) throw InputError(where + "format is not " + kModelFormat);
+    const auto version = static_cast<int>(header_count(h, "version", 1000, where));
     if (version > kModelFormatVersion)
       throw InputError(where + "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
                        std::to_string(kModelFormatVersion) + "); upgrade dicestack");
-    const auto state_dim = h.at("state_dim").get<std::size_t>();
-    const auto action_dim = h.at("action_dim").get<std::size_t>();
+    // The payload's size against the bytes present, before anything is allocated.
+    const auto bytes = header_count(h, "payload_bytes", std::uint64_t{1} << 40, where);
+    const auto body_start = in.tellg();
+    in.seekg(0, std::ios::end);
+    const auto present = static_cast<std::uint64_t>(in.tellg() - body_start);
+    in.seekg(body_start);
+    if (present < bytes)
+      throw InputError(where + "truncated: the payload has " + std::to_string(present) + " of " + std::to_string(bytes) +
+                       " bytes");
+    if (present > bytes) throw InputError(where + "has bytes after the payload; corrupted");
+    std::string payload(static_cast<std::size_t>(bytes), '\0');
+    in.read(payload.data(), static_cast<std::streamsize>(bytes));
+    if (static_cast<std::uint64_t>(in.gcount()) != bytes) throw InputError(where + "cannot read the payload");
+    if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
+      throw InputError(where + "corrupted: the payload's checksum does not match the header");
+    if (version >= 2 && h.at("checksum").get<std::string>() != whole_checksum(h, payload))
+      throw InputError(where + "corrupted: the header's checksum does not match (the header or payload was edited)");
+    const auto state_dim = static_cast<std::size_t>(header_count(h, "state_dim", 1024, where));
+    const auto action_dim = static_cast<std::size_t>(header_count(h, "action_dim", 1024, where));
     // Version 1 had no feature map: its regressors read the 24 state numbers.
     const FeatureMap& features = [&]() -> const FeatureMap& {
       try {
@@ -132,7 +166,8 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
         throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
                          " differs from this dicestack's (" + std::to_string(features.version()) + ")");
     }
-    const std::size_t input_dim = version >= 2 ? h.at("input_dim").get<std::size_t>() : state_dim;
+    const std::size_t input_dim =
+        version >= 2 ? static_cast<std::size_t>(header_count(h, "input_dim", 1024, where)) : state_dim;
     if (input_dim != features.width())
       throw InputError(where + "the regressor reads " + std::to_string(input_dim) + " inputs, but feature map \"" +
                        features.name() + "\" produces " + std::to_string(features.width()));
@@ -160,16 +195,6 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
       return s;
     };
     Standardizer xs = scaler("x_standardizer", input_dim), ys = scaler("y_standardizer", action_dim);
-    const auto bytes = h.at("payload_bytes").get<std::size_t>();
-    std::string payload(bytes, '\0');
-    in.read(payload.data(), static_cast<std::streamsize>(bytes));
-    const auto got = static_cast<std::size_t>(in.gcount());
-    if (got != bytes)
-      throw InputError(where + "truncated: the payload has " + std::to_string(got) + " of " + std::to_string(bytes) +
-                       " bytes");
-    if (in.peek() != std::char_traits<char>::eof()) throw InputError(where + "has bytes after the payload; corrupted");
-    if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
-      throw InputError(where + "corrupted: the payload's checksum does not match the header");
     try {
       regressor->load_payload(payload, input_dim, action_dim);
     } catch (const Error& e) {

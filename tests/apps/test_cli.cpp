@@ -286,10 +286,10 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   Process p = run("train --demos " + kTinyDemos + " --regressor knn --learner dart --option episodes=3 --option successes_only=false --seed 1 --out " +
                   model.string() + " --json", false);
   ASSERT_EQ(p.status, 0) << p.output;
-  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start");
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start_state");
   p = run("evaluate --model " + model.string() + " --episodes 2 --json", false);
   ASSERT_EQ(p.status, 0) << p.output;
-  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start");
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start_state");
   p = run("train --demos " + kTinyDemos + " --regressor knn --features state+tomorrow --out " + model.string());
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown feature map \"state+tomorrow\""));

@@ -40,6 +40,17 @@ TEST(Features, StateClockStartOnAHandMadeHistory) {
   EXPECT_EQ(m.column_names().size(), m.width());
 }
 
+TEST(Features, StartStateCarriesTheWholeStart) {
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const FeatureMap& m = feature_map("state+clock+start_state");
+  ASSERT_EQ(m.width(), 49u);
+  const auto row = row_of(m, History{states, {}});
+  EXPECT_EQ(row[0], 200.0);
+  EXPECT_EQ(row[24], 1.0);
+  for (std::size_t j = 0; j < kStateDim; ++j) EXPECT_EQ(row[25 + j], 100.0 + static_cast<double>(j));
+  EXPECT_EQ(m.column_names()[25], "start_cup_x");
+}
+
 TEST(Features, HistoryRepeatsTheStartAtStepZero) {
   const FeatureMap& m = feature_map("state+history");
   ASSERT_EQ(m.width(), 48u);

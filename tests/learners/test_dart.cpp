@@ -113,7 +113,7 @@ TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
   EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", {"episodes=2"})->learn(c); }),
               HasSubstr("dart: no demonstration to fit (the expert succeeded in none of 2 noisy episodes)"));
   EXPECT_NE(quiet.model->regressor().save_payload(), one.model->regressor().save_payload());
-  EXPECT_EQ(LearnerRegistry::global().info("dart").default_features, "state+clock+start");
+  EXPECT_EQ(LearnerRegistry::global().info("dart").default_features, "state+clock+start_state");
 }
 
 TEST(Dart, AModelFileAloneRollsOut) {

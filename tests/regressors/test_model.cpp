@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <sstream>
 #include <unistd.h>
 
@@ -51,6 +52,13 @@ std::pair<nlohmann::json, std::string> read_parts(const fs::path& path) {
 void write_parts(const fs::path& path, const nlohmann::json& header, const std::string& payload) {
   std::ofstream(path, std::ios::binary) << header.dump() << '\n' << payload;
 }
+// Recomputes a version 2 header's whole-file checksum after an edit (a deliberately crafted file).
+void reseal(nlohmann::json& header, const std::string& payload) {
+  header.erase("checksum");
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a(header.dump() + '\n' + payload)));
+  header["checksum"] = hex;
+}
 
 TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
   const FeatureMap& f = feature_map("state+clock+start");
@@ -76,13 +84,35 @@ TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
   save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
   auto [header, payload] = read_parts(path);
   header["features"] = "state+clock";  // 25 inputs, but the regressor and the header say 24
+  reseal(header, payload);
   write_parts(path, header, payload);
   const std::string error = test::error_of([&] { load_model(path); });
   EXPECT_THAT(error, HasSubstr(path.string() + ": the regressor reads 24 inputs, but feature map \"state+clock\" produces 25"));
   header["features"] = "state+tomorrow";
+  reseal(header, payload);
   write_parts(path, header, payload);
   EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("unknown feature map \"state+tomorrow\""));
   EXPECT_THROW(load_model(path), InputError);
+  fs::remove(path);
+}
+
+TEST(ModelFile, TheChecksumCoversTheHeader) {
+  const Matrix x = random_rows(200, 24, 5);
+  const fs::path path = temp_model("header");
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  auto [header, payload] = read_parts(path);
+  header["x_standardizer"]["mean"][3] = 0.25;  // a changed standardiser, payload untouched
+  write_parts(path, header, payload);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("corrupted: the header's checksum does not match"));
+  for (const auto& [key, value] : {std::pair<const char*, nlohmann::json>{"version", 1.5}, {"payload_bytes", 122.5},
+                                   {"payload_bytes", -1}, {"payload_bytes", 2000000000}}) {
+    auto edited = read_parts(path).first;
+    edited[key] = value;
+    write_parts(path, edited, payload);
+    const std::string error = test::error_of([&] { load_model(path); });
+    EXPECT_THAT(error, HasSubstr(path.string())) << key;
+    EXPECT_FALSE(error.empty()) << key << " " << value.dump();
+  }
   fs::remove(path);
 }
 
@@ -92,7 +122,7 @@ TEST(ModelFile, VersionOneReadsAsTheStateMap) {
   const fs::path path = temp_model("v1");
   save_model(m, path);
   auto [header, payload] = read_parts(path);
-  for (const char* key : {"features", "features_version", "input_dim", "input_names"}) header.erase(key);
+  for (const char* key : {"features", "features_version", "input_dim", "input_names", "checksum"}) header.erase(key);
   header["version"] = 1;
   write_parts(path, header, payload);
   const Model back = load_model(path);
