@@ -1,0 +1,85 @@
+// Does the expert recover from the states a learned policy leads it to? The policy acts for k
+// steps while the expert watches (it is asked every step, so its plan and latches follow the
+// episode, as DAgger asks it), then the expert takes over. Prints, per k, the realistic success
+// from evaluation starts and how far the policy's actions were from the expert's labels.
+//   dicestack_handover_bench MODEL [--expert mpc|scripted] [--replan] [--episodes N] [--seed S]
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/parallel.hpp>
+#include <dicestack/learners/policy.hpp>
+
+using namespace dicestack;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: dicestack_handover_bench MODEL [--expert NAME] [--replan] [--episodes N] [--seed S]\n");
+    return 2;
+  }
+  std::string expert_name = "mpc";
+  bool replan = false;
+  int episodes = 100;
+  std::uint64_t seed = 1000;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--expert" && i + 1 < argc) expert_name = argv[++i];
+    else if (a == "--replan") replan = true;
+    else if (a == "--episodes" && i + 1 < argc) episodes = std::stoi(argv[++i]);
+    else if (a == "--seed" && i + 1 < argc) seed = std::stoull(argv[++i]);
+    else {
+      std::fprintf(stderr, "dicestack_handover_bench: unknown argument %s\n", a.c_str());
+      return 2;
+    }
+  }
+  try {
+    const auto model = std::make_shared<const Model>(load_model(argv[1]));
+    const WorldConfig world;
+    ExpertConfig config;
+    if (!replan) config.replan_interval = std::numeric_limits<int>::max();
+    std::printf("model %s, expert %s (%s), %d evaluation starts from seed %llu\n", argv[1], expert_name.c_str(),
+                replan ? "replanning" : "planning once", episodes, static_cast<unsigned long long>(seed));
+    std::printf("%12s %10s %8s %24s\n", "policy steps", "success", "walls", "|policy - label| / scale");
+    for (const int k : {0, 30, 60, 90, 120, 150, 180, 210, std::numeric_limits<int>::max()}) {
+      std::vector<int> success(static_cast<std::size_t>(episodes)), walls(success.size());
+      std::vector<double> gap(success.size());
+      std::vector<long> steps(success.size());
+      parallel_for(success.size(), 0, [&](std::size_t i, int) {
+        DiceEnv env(world);
+        auto expert = make_expert(expert_name, config);
+        const std::uint64_t s = evaluation_start_seed(seed, i);
+        std::vector<State> states{env.reset_to(random_start_state(world, s), s)};
+        std::vector<Action> applied;
+        expert->reset(s);
+        while (true) {
+          const Action label = expert->act(env);
+          Action a = label;
+          if (static_cast<int>(applied.size()) < k) {
+            a = model->act(History{states, applied});
+            for (std::size_t j = 0; j < kActionDim; ++j) gap[i] += std::abs(a[j] - label[j]) / world.action.scale[j];
+            ++steps[i];
+          }
+          const StepResult r = env.step(a);
+          applied.push_back(r.applied);
+          if (r.terminated || r.truncated) break;
+          states.push_back(r.observation);
+        }
+        success[i] = env.outcome().realistic_success();
+        walls[i] = env.outcome().wall_contact;
+      });
+      double g = 0.0;
+      long n = 0, ok = 0, wall = 0;
+      for (std::size_t i = 0; i < success.size(); ++i) g += gap[i], n += steps[i], ok += success[i], wall += walls[i];
+      std::printf("%12s %9.0f%% %7.0f%% %24.3f\n", k == std::numeric_limits<int>::max() ? "all" : std::to_string(k).c_str(),
+                  100.0 * ok / episodes, 100.0 * wall / episodes, n ? g / n : 0.0);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dicestack_handover_bench: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
