@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/dataset.hpp>
@@ -259,10 +260,14 @@ int run_leaderboard(LeaderboardOptions opt) {
   std::vector<std::pair<std::string, std::string>> combos;
   for (const auto& l : learners) {
     const LearnerInfo& info = LearnerRegistry::global().info(l);
-    for (const auto& f : opt.features.empty() ? std::vector<std::string>{info.default_features} : opt.features) {
+    // The paper profile's full picture: every learner with the bare state and with dart's map too.
+    std::vector<std::string> maps{info.default_features};
+    if (paper && info.default_features != "state") maps.insert(maps.begin(), "state");
+    if (paper && info.default_features == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
+    for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work
       if (info.state_features_only && f != "state") {
-        print_progress("note: " + l + " reads only the state; skipping features " + f);
+        if (!opt.features.empty()) print_progress("note: " + l + " reads only the state; skipping features " + f);
         continue;
       }
       if (opt.split == "rows" && f != "state")
@@ -329,9 +334,9 @@ int run_leaderboard(LeaderboardOptions opt) {
   }
   if (!partial.empty() && std::filesystem::exists(partial)) {
     try {
-      json p = json::parse(std::ifstream(partial));
+      json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
       if (p.value("meta", json()) == meta) done = p.value("rows", json::object());
-    } catch (const json::exception&) {
+    } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
     }
   }
 
@@ -448,8 +453,8 @@ void add_leaderboard_command(CLI::App& app) {
   cmd->add_option("--regressors", opt->regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
   cmd->add_option("--learners", opt->learners, "Learners (comma-separated; default: bc, dagger, dart)")->delimiter(',');
   cmd->add_option("--features", opt->features,
-                  "Feature maps (comma-separated): a row per learner and map it can read (default: each learner's own, "
-                  "see `dicestack learners`)")
+                  "Feature maps (comma-separated): a row per learner and map it can read (default: each learner's own; "
+                  "paper profile: state and dart's map for every learner that reads them)")
       ->delimiter(',');
   cmd->add_option("--option", opt->options, "key=value learner option (applied to the learners that have it); repeatable");
   cmd->add_option("--baselines", opt->baselines,

@@ -1,3 +1,4 @@
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/atomic_file.hpp>
 
 #include <signal.h>
@@ -44,15 +45,21 @@ std::string leftover_prefix(const fs::path& target, std::string_view tag) {
 Ownership Ownership::json_object(std::string what, std::string format, std::vector<std::string> legacy_keys) {
   return {std::move(what), [format = std::move(format), keys = std::move(legacy_keys)](const fs::path& p) {
             std::ifstream in(p, std::ios::binary);
-            const auto j = nlohmann::json::parse(in, nullptr, false);
-            return !j.is_discarded() && has_format(j, format, keys);
+            try {
+              return has_format(parse_json_limited<nlohmann::json>(in, p.string()), format, keys);
+            } catch (const std::exception&) {
+              return false;
+            }
           }};
 }
 
 Ownership Ownership::json_first_line(std::string what, std::string format) {
   return {std::move(what), [format = std::move(format)](const fs::path& p) {
-            const auto j = nlohmann::json::parse(first_line_of(p), nullptr, false);
-            return !j.is_discarded() && has_format(j, format, {});
+            try {
+              return has_format(parse_json_limited<nlohmann::json>(first_line_of(p), p.string()), format, {});
+            } catch (const std::exception&) {
+              return false;
+            }
           }};
 }
 

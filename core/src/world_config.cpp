@@ -1,3 +1,4 @@
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/world_config.hpp>
 
 #include <cmath>
@@ -245,7 +246,7 @@ void validate(const WorldConfig& config) {
 WorldConfig world_config_from_json(std::string_view text, std::string_view source) {
   json root;
   try {
-    root = json::parse(text);
+    root = parse_json_limited<json>(text, "world config " + std::string(source));
   } catch (const json::out_of_range& e) {
     // JSON has no NaN or infinity; the only way to write one is a number that overflows.
     throw ConfigError("world config " + std::string(source) + ": " + overflow_context(text, e.what()) +
@@ -286,8 +287,13 @@ void save_world_config(const WorldConfig& config, const std::filesystem::path& p
   static const json sections = json::parse(to_json(WorldConfig{}));
   const Ownership ours{"dicestack world config", [](const std::filesystem::path& p) {
                          std::ifstream in(p, std::ios::binary);
-                         const json j = json::parse(in, nullptr, false);
-                         if (j.is_discarded() || !j.is_object() || j.empty()) return false;
+                         json j;
+                         try {
+                           j = parse_json_limited<json>(in, p.string());
+                         } catch (const std::exception&) {
+                           return false;
+                         }
+                         if (!j.is_object() || j.empty()) return false;
                          for (const auto& [key, value] : j.items())
                            if (!sections.contains(key)) return false;
                          return true;

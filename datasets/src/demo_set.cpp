@@ -1,3 +1,4 @@
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
 #include <algorithm>
@@ -273,7 +274,7 @@ DemoSet read_demo_set(const fs::path& dir) {
   if (!fs::exists(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
   json meta;
   try {
-    meta = json::parse(read_file(meta_path));
+    meta = parse_json_limited<json>(read_file(meta_path), meta_path.string());
   } catch (const json::exception& e) {
     meta_error(meta_path, std::string("not valid JSON: ") + e.what());
   }
@@ -337,7 +338,11 @@ bool is_own_demo_set(const fs::path& dir, std::string* why) {
   json meta;
   if (fs::is_regular_file(fs::symlink_status(meta_path, ec))) {
     std::ifstream in(meta_path, std::ios::binary);
-    meta = json::parse(in, nullptr, false);
+    try {
+      meta = parse_json_limited<json>(in, meta_path.string());
+    } catch (const std::exception&) {
+      meta = json();
+    }
   }
   std::set<std::string> listed;
   const bool meta_ok = meta.is_object() && meta.value("format", json()) == json(kDemoFormat) && meta.contains("episodes") &&

@@ -1,3 +1,4 @@
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/learners/learner.hpp>
 
 #include <cctype>
@@ -143,7 +144,7 @@ nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& s
   if (!c.resume || c.checkpoint_dir.empty() || !fs::exists(c.checkpoint_dir / state_file)) return nullptr;
   const fs::path path = c.checkpoint_dir / state_file;
   try {
-    return nlohmann::json::parse(std::ifstream(path));
+    return parse_json_limited<nlohmann::json>(std::ifstream(path), path.string());
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
   }

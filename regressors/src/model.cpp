@@ -1,3 +1,4 @@
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include <cmath>
@@ -123,7 +124,7 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
   if (!std::getline(in, first) || first.empty()) throw InputError(where + "empty file; not a dicestack model");
   json h;
   try {
-    h = json::parse(first);
+    h = parse_json_limited<json>(first, path.string());
   } catch (const json::exception&) {
     throw InputError(where + "the first line is not a JSON header; not a dicestack model");
   }

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 
 namespace dicestack::detail {
 namespace {
@@ -22,9 +23,11 @@ using FloatJson = nlohmann::basic_json<std::map, std::vector, std::string, bool,
 XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_t outputs) {
   FloatJson j;
   try {
-    j = FloatJson::parse(text.begin(), text.end(), nullptr, true, false);
+    j = parse_json_limited<FloatJson>(text, "gbt payload");
   } catch (const FloatJson::exception& e) {
     fail(std::string("the payload is not xgboost's JSON model: ") + e.what());
+  } catch (const InputError& e) {
+    fail(e.what());
   }
   XgbForest f;
   if (outputs == 0 || outputs > kMaxOutputs)

@@ -46,6 +46,12 @@ TEST(WorldConfig, JsonRoundTripKeepsEveryField) {
   EXPECT_DOUBLE_EQ(back.cost.sigma[5], 0.25);
 }
 
+TEST(WorldConfig, DeepNestingIsRefusedNotCrashed) {
+  const std::string deep = "{\"physics\":" + std::string(200000, '[') + std::string(200000, ']') + "}";
+  EXPECT_THAT(error_of([&] { world_config_from_json(deep, "w.json"); }),
+              HasSubstr("world config w.json: JSON nested deeper than 64 levels"));
+}
+
 TEST(WorldConfig, MissingFieldIsNamed) {
   auto j = default_json();
   j["physics"].erase("substeps");

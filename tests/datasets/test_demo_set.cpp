@@ -35,6 +35,15 @@ TEST(DemoSet, ReadsAValidSet) {
   EXPECT_EQ(set.description, "tiny test set");
 }
 
+TEST(DemoSet, DeeplyNestedMetaIsRefusedNotCrashed) {
+  const fs::path dir = fs::temp_directory_path() / ("dicestack_deep_meta_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "meta.json") << "{\"format\":\"dicestack-demos\",\"version\":1,\"world\":"
+                                   << std::string(200000, '[') << std::string(200000, ']') << "}";
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }), HasSubstr("meta.json: JSON nested deeper than 64 levels"));
+  fs::remove_all(dir);
+}
+
 TEST(DemoSet, WriteThenReadIsExact) {
   DemoSet set = read_demo_set(kData / "good");
   set.episodes[0].states[1][5] = 0.1 + 0.2;  // not exactly representable in short decimal

@@ -116,6 +116,17 @@ TEST(ModelFile, TheChecksumCoversTheHeader) {
   fs::remove(path);
 }
 
+TEST(ModelFile, DeeplyNestedHeadersAreRefusedNotCrashed) {
+  const fs::path path = temp_model("deep");
+  std::ofstream(path) << "{\"format\":\"dicestack-model\",\"version\":" << std::string(200000, '[')
+                      << std::string(200000, ']') << "}\n";
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr(path.string() + ": JSON nested deeper than 64 levels"));
+  fs::remove(path);
+  auto r = RegressorRegistry::global().create("gbt");
+  EXPECT_THAT(test::error_of([&] { r->load_payload(std::string(100000, '[') + std::string(100000, ']'), 24, 3); }),
+              HasSubstr("JSON nested deeper than 64 levels"));
+}
+
 TEST(ModelFile, VersionOneReadsAsTheStateMap) {
   const Matrix x = random_rows(200, 24, 4);
   const Model m = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
