@@ -1,6 +1,7 @@
 #include <dicestack/regressors/registry.hpp>
 
 #include <dlfcn.h>
+#include <link.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -48,12 +49,24 @@ void RegressorRegistry::load_plugin(const std::filesystem::path& library) {
   void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw PluginError(who + ": cannot load: " + dlerror());
   using Entry = const DicestackPluginV1* (*)();
-  auto entry = reinterpret_cast<Entry>(dlsym(handle, "dicestack_plugin_v1"));
-  if (!entry) {
+  void* symbol = dlsym(handle, "dicestack_plugin_v1");
+  if (!symbol) {
     dlclose(handle);
     throw PluginError(who + ": not a dicestack plugin (no symbol dicestack_plugin_v1)");
   }
-  const DicestackPluginV1* p = entry();
+  // Calling a symbol that is data, not code, would crash: ask the dynamic linker what it is.
+  Dl_info info{};
+  void* extra = nullptr;
+  const bool found = dladdr1(symbol, &info, &extra, RTLD_DL_SYMENT) != 0;
+  const auto* elf = static_cast<const ElfW(Sym)*>(extra);
+  if (!found || !elf ||
+      (ELF64_ST_TYPE(elf->st_info) != STT_FUNC && ELF64_ST_TYPE(elf->st_info) != STT_GNU_IFUNC)) {
+    dlclose(handle);
+    throw PluginError(who + ": dicestack_plugin_v1 is not a function; not a dicestack plugin");
+  }
+  const DicestackPluginV1* p = reinterpret_cast<Entry>(symbol)();
+  if (p && (!p->dicestack_version || !p->stdlib || !p->register_regressors))
+    throw PluginError(who + ": its plugin record has a null field; not a dicestack plugin");
   const std::string ours = "ABI " + std::to_string(DICESTACK_PLUGIN_ABI_VERSION) + " (" DICESTACK_VERSION ", " +
                            DICESTACK_STDLIB_TAG + ")";
   if (!p || p->abi_version != DICESTACK_PLUGIN_ABI_VERSION || std::string(p->stdlib) != DICESTACK_STDLIB_TAG) {

@@ -209,6 +209,10 @@ TEST(Registry, PluginHandshakeRefusesWhatItCannotUse) {
   EXPECT_THROW(reg.load_plugin(DICESTACK_ABI99_PLUGIN), PluginError);
   EXPECT_THAT(test::error_of([&] { reg.load_plugin(DICESTACK_NOT_A_PLUGIN); }),
               HasSubstr("not a dicestack plugin (no symbol dicestack_plugin_v1)"));
+  EXPECT_THAT(test::error_of([&] { reg.load_plugin(DICESTACK_DATA_ENTRY); }),
+              HasSubstr("dicestack_plugin_v1 is not a function; not a dicestack plugin"));
+  EXPECT_THAT(test::error_of([&] { reg.load_plugin(DICESTACK_NULL_RECORD); }),
+              HasSubstr("its plugin record has a null field"));
   EXPECT_THAT(test::error_of([&] { reg.load_plugin(DICESTACK_DUPLICATE_PLUGIN); }),
               HasSubstr("regressor \"knn\" registered twice (built-in, and plugin "));
   const fs::path junk = fs::temp_directory_path() / "dicestack_not_a_library.so";
