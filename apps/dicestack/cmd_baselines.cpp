@@ -277,7 +277,7 @@ void add_rrt_command(CLI::App& app) {
   cmd->add_option("--extend-iterations", r.extend_iterations, "CMA-ES generations per extension")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--goal-bias", r.goal_bias, "Probability of growing towards the goal")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   cmd->add_option("--max-depth", r.max_depth_steps, "Nodes this many steps deep are not extended")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", r.seed, "Seed")->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed")->check(seed_check())->capture_default_str();
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the best path (a demonstration set) and rrt.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
@@ -299,7 +299,7 @@ void add_reinforce_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--learning-rate", r.learning_rate, "Adam step size")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", r.seed, "Seed")->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed")->check(seed_check())->capture_default_str();
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the greedy episode (a demonstration set) and reinforce.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
@@ -315,7 +315,7 @@ void add_optimise_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--evaluations", opt->optimiser.evaluations, "Budget of evaluations")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--sigma0", opt->optimiser.sigma0, "Initial step in x units ([-1, 1] per action)")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", opt->optimiser.seed, "Seed of the optimiser")->capture_default_str();
+  cmd->add_option("--seed", opt->optimiser.seed, "Seed of the optimiser")->check(seed_check())->capture_default_str();
   add_problem_options(*cmd, *opt);
   cmd->add_option("--out", opt->out, "Folder for the best sequence (a demonstration set) and optimise.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
@@ -334,7 +334,7 @@ void add_bench_optimise_command(CLI::App& bench) {
   cmd->add_option("--bayes-evaluations", opt->bayes_evaluations, "Budget for bayes (O(N^2) per evaluation)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--seed", opt->base.optimiser.seed, "Seed")->capture_default_str();
+  cmd->add_option("--seed", opt->base.optimiser.seed, "Seed")->check(seed_check())->capture_default_str();
   add_problem_options(*cmd, opt->base);
   cmd->add_flag("--json", opt->json, "Print a JSON list");
   cmd->callback([opt] { run_bench_optimise(*opt); });

@@ -234,7 +234,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--repeats", sim->repeats, "Measurements per figure (the median is reported)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--seed", sim->seed, "Seed of the random actions")->capture_default_str();
+  cmd->add_option("--seed", sim->seed, "Seed of the random actions")->check(seed_check())->capture_default_str();
   cmd->add_flag("--sleep", sim->sleep, "Also measure with body sleeping allowed, and compare outcomes");
   cmd->add_flag("--json", sim->json, "Print one JSON object");
   cmd->callback([sim] { run_sim(*sim); });
@@ -244,7 +244,7 @@ void add_bench_command(CLI::App& app) {
   snap->world.add_to(*cmd);
   cmd->add_option("--episodes", snap->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--follow", snap->follow, "Steps followed after the restore")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", snap->seed, "Seed")->capture_default_str();
+  cmd->add_option("--seed", snap->seed, "Seed")->check(seed_check())->capture_default_str();
   cmd->add_flag("--json", snap->json, "Print one JSON object");
   cmd->callback([snap] { run_snapshot(*snap); });
 

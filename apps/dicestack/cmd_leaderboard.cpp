@@ -465,7 +465,7 @@ void add_leaderboard_command(CLI::App& app) {
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row and training seed (default: 20 quick, 100 paper)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seeds", opt->seeds, "Training seeds per row")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "First seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "First seed")->check(seed_check())->capture_default_str();
   cmd->add_option("--profile", opt->profile, "quick or paper")->check(CLI::IsMember({"quick", "paper"}))->capture_default_str();
   cmd->add_option("--split", opt->split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25% of rows)")
       ->check(CLI::IsMember({"episodes", "rows"}))

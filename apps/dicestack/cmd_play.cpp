@@ -41,7 +41,7 @@ void add_play_command(CLI::App& app) {
       "episodes that end (success or time limit) are saved too");
   cmd->world.add_to(*sub);
   sub->add_option("--record", cmd->play.record, "Append every episode to this demonstration folder");
-  sub->add_option("--seed", cmd->play.seed, "Seed of the first start state")->capture_default_str();
+  sub->add_option("--seed", cmd->play.seed, "Seed of the first start state")->check(seed_check())->capture_default_str();
   sub->add_option("--start", cmd->start, "Start state: random (from the seed) or paper")
       ->check(CLI::IsMember({"random", "paper"}))
       ->capture_default_str();

@@ -93,7 +93,7 @@ void add_record_command(CLI::App& app) {
   opt->world.add_to(*cmd);
   cmd->add_option("--expert", opt->expert, "Expert name")->capture_default_str();
   cmd->add_option("--episodes", opt->episodes, "Episodes from random starts")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "Seed of the starts")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the starts")->check(seed_check())->capture_default_str();
   cmd->add_option("--out", opt->out, "Demonstration folder to write (missing, empty, or a dicestack set, which is replaced whole)")->required();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--noise", opt->noise,

@@ -203,7 +203,7 @@ void add_bench_regressors_command(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--regressors", opt->regressors, "Only these (comma-separated)")->delimiter(',');
   cmd->add_option("--set", opt->sets, "key=value parameter for the regressor(s); repeatable");
-  cmd->add_option("--seed", opt->seed, "Training seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Training seed")->check(seed_check())->capture_default_str();
   cmd->add_option("--calls", opt->calls, "predict_row calls timed")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print a JSON list");
   cmd->add_option("--export", opt->export_dir,

@@ -185,7 +185,7 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--episode", opt->episode, "Replay this episode CSV's actions from its first state")->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out, "FILE.mp4, FILE.avi or FILE.gif (video; GIF via giflib), FILE.png (last frame), or a folder (one PNG per frame)");
   cmd->add_option("--plot", opt->plot, "FILE.png: cup x, dice x and y, cup angle and velocities over time");
-  cmd->add_option("--seed", opt->seed, "Seed of the model's start state")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the model's start state")->check(seed_check())->capture_default_str();
   cmd->add_option("--initial-push", opt->push, "none, left or right")->check(CLI::IsMember({"none", "left", "right"}))->capture_default_str();
   cmd->callback([opt] { run_render(*opt); });
 }

@@ -79,7 +79,7 @@ void add_rollout_command(CLI::App& app) {
   auto opt = std::make_shared<RolloutOptions>();
   CLI::App* cmd = app.add_subcommand("rollout", "Run one episode with random or zero actions and report its outcome");
   opt->world.add_to(*cmd);
-  cmd->add_option("--seed", opt->seed, "Seed of the start state and the actions")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the start state and the actions")->check(seed_check())->capture_default_str();
   cmd->add_option("--start", opt->start, "Start state: random (from the seed) or paper")
       ->check(CLI::IsMember({"random", "paper"}))
       ->capture_default_str();

@@ -117,7 +117,7 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::IsMember({"episodes", "none"}))
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Model file to write")->required();
-  cmd->add_option("--seed", opt->seed, "Seed of every random choice")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of every random choice")->check(seed_check())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--checkpoint", opt->checkpoint,
                   "Folder for an iterative learner's checkpoints (default: MODEL.checkpoint); kept after the run");

@@ -76,4 +76,17 @@ std::filesystem::path DemosOption::resolve(const WorldConfig& world) const {
   return path;
 }
 
+CLI::Validator seed_check() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        const std::string max = "18446744073709551615";
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        const std::string trimmed = digits ? text.substr(std::min(text.find_first_not_of('0'), text.size() - 1)) : text;
+        if (!digits || trimmed.size() > max.size() || (trimmed.size() == max.size() && trimmed > max))
+          return "a seed is a whole number in [0, " + max + "], got \"" + text.substr(0, 40) + "\"";
+        return {};
+      },
+      "SEED");
+}
+
 }  // namespace dicestack::cli

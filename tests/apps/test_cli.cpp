@@ -59,6 +59,16 @@ TEST(Cli, UsageErrorsExitNonZero) {
   EXPECT_NE(run("rollout --steps -3").status, 0);
 }
 
+TEST(Cli, SeedsOutsideTheirRangeAreRefusedNotWrapped) {
+  for (const char* seed : {"-1", "18446744073709551616", "1e3", "3.5"}) {
+    const Process p = run(std::string("rollout --steps 1 --seed ") + seed);
+    EXPECT_NE(p.status, 0) << seed;
+    EXPECT_THAT(p.output, HasSubstr("a seed is a whole number in [0, 18446744073709551615]")) << seed;
+  }
+  EXPECT_EQ(run("rollout --steps 1 --seed 18446744073709551615").status, 0);
+  EXPECT_NE(run("evaluate --model x.dsm --seed -1").status, 0);
+}
+
 TEST(Cli, StateHashIsIdenticalAcrossProcessesAndMatchesThisOne) {
   const Process a = run("rollout --seed 9 --steps 300 --json");
   const Process b = run("rollout --seed 9 --steps 300 --json");
