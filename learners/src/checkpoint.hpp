@@ -28,8 +28,17 @@ void remove_old_best_models(const std::filesystem::path& dir, const std::string&
 /// The aggregated data a checkpoint state names.
 std::vector<Episode> load_checkpoint_data(const LearnContext& context, const nlohmann::json& state);
 
-/// The state of the last finished iteration, or null when there is none to resume from.
-nlohmann::json load_checkpoint_state(const LearnContext& context, const std::string& state_file);
+/// What a run was started with: regressor and its settings, feature map, seed, learner options
+/// but `extendable` (options a resumed run may change, e.g. DAgger's round count: more rounds
+/// continue the same run). Saved in every checkpoint state under "run"; a resumed run must match it.
+nlohmann::json run_settings(const LearnContext& context, const Params& learner_params,
+                            const std::vector<std::string>& extendable = {});
+
+/// The state of the last finished iteration, or null when there is none to resume from. Throws
+/// InputError naming each setting that differs from the checkpoint's "run" (with both values):
+/// resuming with other options would give a model that matches neither run.
+nlohmann::json load_checkpoint_state(const LearnContext& context, const std::string& state_file,
+                                     const nlohmann::json& run);
 
 /// A curve point for `model`: rolled out from the held-out demonstrations' first states, or
 /// from `fallback`'s when there are none.

@@ -52,7 +52,7 @@ class Dad final : public Learner {
     double best_deviation = 0.0;
     int best_iteration = 0, first = 1;
     std::size_t corrections = 0, filtered = 0;
-    if (const auto state = load_checkpoint_state(c, "dad.json"); !state.is_null()) {
+    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params())); !state.is_null()) {
       first = state.at("iteration").get<int>() + 1;
       data = load_checkpoint_data(c, state);
       result.curve = curve_from_json(state.at("curve"));
@@ -118,7 +118,7 @@ class Dad final : public Learner {
         fs::create_directories(c.checkpoint_dir);
         if (!model_ownership().recognises(c.checkpoint_dir / best_file)) save_model(*best, c.checkpoint_dir / best_file);
         save_checkpoint(c.checkpoint_dir, k,
-                        {{"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
+                        {{"run", run_settings(c, params())}, {"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
                          {"best_model", best_file}, {"best_deviation", best_deviation}, {"corrections_kept", corrections},
                          {"corrections_filtered", filtered}, {"curve", curve_to_json(result.curve)}},
                         "dad.json", c, data, "DaD data after iteration " + std::to_string(k));

@@ -32,7 +32,7 @@ class Dagger final : public Learner {
     std::shared_ptr<Model> model;
     LearnResult result;
     int first = 1;
-    if (const auto state = load_checkpoint_state(c, "dagger.json"); !state.is_null()) {
+    if (const auto state = load_checkpoint_state(c, "dagger.json", run_settings(c, params(), extendable())); !state.is_null()) {
       first = state.at("iteration").get<int>() + 1;
       data = load_checkpoint_data(c, state);
       result.curve = curve_from_json(state.at("curve"));
@@ -65,7 +65,7 @@ class Dagger final : public Learner {
       result.curve.push_back(measure_policy(model, c, c.demos, i, rows));
       if (!c.checkpoint_dir.empty())
         save_checkpoint(c.checkpoint_dir, i,
-                        {{"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
+                        {{"run", run_settings(c, params(), extendable())}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
                         "dagger.json", c, data, "DAgger aggregate after round " + std::to_string(i));
     }
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
@@ -87,6 +87,12 @@ class Dagger final : public Learner {
   }
 
  private:
+  // More rounds continue the same run under the exponential schedule (beta_i does not depend
+  // on the round count); the linear schedule's betas do.
+  std::vector<std::string> extendable() const {
+    return params().choice("schedule") == "exponential" ? std::vector<std::string>{"iterations"} : std::vector<std::string>{};
+  }
+
   double beta_at(int i, int iterations) const {
     if (params().choice("schedule") == "linear")
       return iterations <= 1 ? 1.0 : 1.0 - static_cast<double>(i - 1) / (iterations - 1);

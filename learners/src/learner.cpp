@@ -2,6 +2,7 @@
 #include <dicestack/learners/learner.hpp>
 
 #include <cctype>
+#include <algorithm>
 #include <fstream>
 
 #include <dicestack/core/atomic_file.hpp>
@@ -140,14 +141,45 @@ std::vector<Episode> load_checkpoint_data(const LearnContext& c, const nlohmann:
   return read_demo_set(c.checkpoint_dir / state.at("data").get<std::string>()).episodes;
 }
 
-nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file) {
+nlohmann::json run_settings(const LearnContext& c, const Params& learner_params,
+                            const std::vector<std::string>& extendable) {
+  std::string sets, options;
+  for (const auto& s : c.regressor_sets) sets += (sets.empty() ? "" : " ") + s;
+  for (const auto& [key, value] : learner_params.as_text())
+    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end())
+      options += (options.empty() ? "" : ", ") + key + "=" + value;
+  return {{"regressor", c.regressor},
+          {"regressor_sets", sets},
+          {"features", c.features},
+          {"seed", std::to_string(c.seed)},
+          {"learner_options", options},
+          {"demonstrations", std::to_string(c.demos.size())},
+          {"held_out", std::to_string(c.held_out.size())}};
+}
+
+nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file, const nlohmann::json& run) {
   if (!c.resume || c.checkpoint_dir.empty() || !fs::exists(c.checkpoint_dir / state_file)) return nullptr;
   const fs::path path = c.checkpoint_dir / state_file;
+  nlohmann::json state;
   try {
-    return parse_json_limited<nlohmann::json>(std::ifstream(path), path.string());
+    state = parse_json_limited<nlohmann::json>(std::ifstream(path), path.string());
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
   }
+  if (!state.is_object()) throw InputError(path.string() + ": not a checkpoint state (not a JSON object)");
+  if (state.contains("run")) {  // states written before runs were recorded have none to compare
+    std::string differences;
+    for (const auto& [key, value] : run.items()) {
+      const nlohmann::json saved = state["run"].value(key, nlohmann::json());
+      if (saved != value)
+        differences += (differences.empty() ? "" : "; ") + key + " " + saved.dump() + " in the checkpoint, " +
+                       value.dump() + " in this run";
+    }
+    if (!differences.empty())
+      throw InputError(path.string() + ": cannot resume a run made with other settings: " + differences +
+                       " (use the same settings, or another --checkpoint)");
+  }
+  return state;
 }
 
 CurvePoint measure_policy(const std::shared_ptr<const Model>& model, const LearnContext& c,

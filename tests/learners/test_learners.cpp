@@ -198,6 +198,18 @@ TEST(Dagger, ResumeEqualsUninterrupted) {
   EXPECT_EQ(resumed.model->predict(probe.x), whole.model->predict(probe.x));
   ASSERT_EQ(resumed.curve.size(), 3u);
   EXPECT_EQ(resumed.curve.back().dataset_rows, whole.curve.back().dataset_rows);
+  // Resuming with other options is refused, naming the setting and both values.
+  const std::string error = test::error_of([&] {
+    LearnerRegistry::global().create("dagger", {"iterations=4", "rollouts=3", "expert=scripted"})->learn(c);
+  });
+  EXPECT_THAT(error, ::testing::HasSubstr("dagger.json: cannot resume a run made with other settings: learner_options"));
+  EXPECT_THAT(error, ::testing::HasSubstr("rollouts=2"));
+  EXPECT_THAT(error, ::testing::HasSubstr("rollouts=3"));
+  c.seed += 1;
+  EXPECT_THAT(test::error_of([&] {
+                LearnerRegistry::global().create("dagger", {"iterations=4", "rollouts=2", "expert=scripted"})->learn(c);
+              }),
+              ::testing::HasSubstr("seed \"11\" in the checkpoint, \"12\" in this run"));
   std::filesystem::remove_all(dir);
 }
 
