@@ -44,8 +44,9 @@ std::vector<State> trajectory(const RenderOptions& opt, const WorldConfig& world
   ModelPolicy p(model);
   // The first start of `evaluate --seed S`, so a rendered rollout is one that evaluate counted.
   const std::uint64_t start = evaluation_start_seed(opt.seed, 0);
-  const Episode e =
-      rollout(env, p, random_start_state(world, start), start, StepSource::policy, {initial_push_from(opt.push)});
+  RolloutOptions options;
+  options.push = initial_push_from(opt.push);
+  const Episode e = rollout(env, p, random_start_state(world, start), start, StepSource::policy, options);
   const auto learner = model->record.find("learner");
   title = model->regressor().name() + " (" + (learner == model->record.end() ? "?" : learner->second) + "), seed " +
           std::to_string(opt.seed);

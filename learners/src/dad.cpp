@@ -7,6 +7,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/learners/corrector.hpp>
+#include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
 
 #include "checkpoint.hpp"
@@ -187,21 +188,18 @@ class Dad final : public Learner {
       const Episode& demo = targets[d];
       const std::size_t len = demo.size();
       const auto width = static_cast<std::size_t>(std::max(1.0, std::ceil(static_cast<double>(len) * window / windows)));
-      State s = env->reset_to(demo.states[0], demo.seed);
-      std::vector<Action> actions;
-      for (std::size_t t = 0; t + 1 < len; ++t) {
-        if (t % width == 0) {
-          Task task{d, t, {env->snapshot(), {}, {}}};
-          for (std::size_t j = t + 1; j < len && j <= t + width; ++j) task.problem.target.push_back(demo.states[j]);
-          per_demo[d].push_back(std::move(task));
-        }
-        Action a = model.act(s);
-        for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -world.action.limit[k], world.action.limit[k]);
-        actions.push_back(a);
-        const StepResult r = env->step(a);
-        s = r.observation;
-        if (r.terminated || r.truncated) break;
-      }
+      RolloutOptions options;
+      options.max_steps = len - 1;
+      options.before_step = [&](const DiceEnv& at, std::size_t t) {
+        if (t % width != 0) return;
+        Task task{d, t, {at.snapshot(), {}, {}}};
+        for (std::size_t j = t + 1; j < len && j <= t + width; ++j) task.problem.target.push_back(demo.states[j]);
+        per_demo[d].push_back(std::move(task));
+      };
+      ModelPolicy policy(std::shared_ptr<const Model>(&model, [](const Model*) {}));  // borrowed for this rollout
+      const std::vector<Action> actions =
+          len > 1 ? rollout(*env, policy, demo.states[0], demo.seed, StepSource::policy, options).actions
+                  : std::vector<Action>{};
       for (auto& task : per_demo[d])  // the policy's own actions, held at zero past its episode's end
         for (std::size_t j = 0; j < task.problem.target.size(); ++j)
           task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j] : Action{0.0, 0.0, 0.0});

@@ -7,7 +7,9 @@
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/policy.hpp>
 
 #include "checkpoint.hpp"
 
@@ -102,27 +104,38 @@ class Dagger final : public Learner {
   // One episode of the mixture policy; every visited state is labelled with the expert's action.
   // A step's source says who acted: the expert, or the learner ("policy").
   static Episode mixture_rollout(DiceEnv& env, Expert& expert, const Model* model, double beta, std::uint64_t seed) {
-    Episode e;
-    e.seed = seed;
+    MixturePolicy mixture(expert, env, model, beta);
+    Episode e = rollout(env, mixture, random_start_state(env.config(), seed), seed, StepSource::policy);
     e.origin = "dagger";
-    std::vector<Action> applied;
-    e.states.push_back(env.reset_to(random_start_state(env.config(), seed), seed));
-    expert.reset(seed);
-    Rng coin(derive_seed(seed, 7));
-    while (true) {
-      const Action label = expert.act(env);
-      const bool expert_acts = model == nullptr || coin.uniform() < beta;
-      const Action a = expert_acts ? label : model->act(History{e.states, applied});
-      e.actions.push_back(label);
-      e.sources.push_back(expert_acts ? StepSource::expert : StepSource::policy);
-      const StepResult r = env.step(a);
-      applied.push_back(r.applied);
-      if (r.terminated || r.truncated) break;
-      e.states.push_back(r.observation);
-    }
-    e.outcome = env.outcome();
     return e;
   }
+
+  // beta * expert + (1 - beta) * learner: a seeded coin per step chooses who acts; the expert
+  // is asked every step and its action is the label either way.
+  class MixturePolicy final : public Policy {
+   public:
+    MixturePolicy(Expert& expert, const DiceEnv& env, const Model* model, double beta)
+        : expert_(expert, env), model_(model), beta_(beta) {}
+    void reset(std::uint64_t seed) override {
+      expert_.reset(seed);
+      coin_ = Rng(derive_seed(seed, 7));
+    }
+    Action act(const History& h) override {
+      label_.label = expert_.act(h);
+      const bool expert_acts = model_ == nullptr || coin_.uniform() < beta_;
+      label_.source = expert_acts ? StepSource::expert : StepSource::policy;
+      return expert_acts ? label_.label : model_->act(h);
+    }
+    std::optional<Labelled> label() const override { return label_; }
+    std::string name() const override { return "dagger"; }
+
+   private:
+    ExpertPolicy expert_;
+    const Model* model_;
+    double beta_;
+    Rng coin_{0};
+    Labelled label_;
+  };
 };
 
 }  // namespace

@@ -32,17 +32,19 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
   e.states.push_back(env.reset_to(start, seed));
   policy.reset(seed);
   while (true) {
+    if (options.before_step) options.before_step(env, applied.size());
     Action a = policy.act(History{e.states, applied});
     if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
     for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
     Action executed = a;
     if (noisy)
       for (std::size_t k = 0; k < kActionDim; ++k) executed[k] += options.noise[k] * noise.normal();
-    e.actions.push_back(a);
-    e.sources.push_back(source);
+    const auto label = policy.label();
+    e.actions.push_back(label ? label->label : a);
+    e.sources.push_back(label ? label->source : source);
     const StepResult r = env.step(executed);
     applied.push_back(r.applied);
-    if (r.terminated || r.truncated) break;
+    if (r.terminated || r.truncated || applied.size() == options.max_steps) break;
     e.states.push_back(r.observation);
   }
   e.outcome = env.outcome();
@@ -107,7 +109,8 @@ EvalStats summarise(const std::vector<Episode>& eps, double policy_seconds, doub
 
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
                    int threads, InitialPush push, std::vector<Episode>* rollouts) {
-  const RolloutOptions options{push};
+  RolloutOptions options;
+  options.push = push;
   const int workers = resolve_threads(threads);
   std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));

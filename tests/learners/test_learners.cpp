@@ -71,7 +71,9 @@ TEST(Evaluate, RatesAgreeWithRollingOutByHand) {
   for (std::size_t i = 0; i < 5; ++i) {
     Swing p;
     const std::uint64_t seed = derive_seed(9, i);
-    const Episode e = rollout(env, p, random_start_state(c, seed), seed, StepSource::policy, {InitialPush::left});
+    RolloutOptions left;
+    left.push = InitialPush::left;
+    const Episode e = rollout(env, p, random_start_state(c, seed), seed, StepSource::policy, left);
     EXPECT_EQ(e.states, eps[i].states);
     walls += e.outcome.wall_contact;
     cup += e.outcome.dice_in_cup;

@@ -24,12 +24,18 @@ struct RolloutOptions {
   /// so an expert that simulates cannot foresee it.
   Action noise{0.0, 0.0, 0.0};
   std::uint64_t noise_seed = 0;
+  /// Stop after this many steps (0: at the world's time limit or success).
+  std::size_t max_steps = 0;
+  /// Called before each step's action is chosen, with the environment and the step index
+  /// (DaD snapshots the world there). May be empty.
+  std::function<void(const DiceEnv&, std::size_t)> before_step;
 };
 
-/// Runs `policy` from `start` until termination or the time limit and records the episode: the
-/// state before each action, the outcome, and per step the policy's action clipped to the
-/// world's limits (its clean label; without noise, exactly what the world applied). The policy's
-/// History holds the actions the world applied. `source` tags each step.
+/// The one rollout loop. Runs `policy` from `start` until termination, the time limit or
+/// options.max_steps, and records the episode: the state before each action, the outcome, and
+/// per step the policy's label() if it has one, else its action clipped to the world's limits
+/// (its clean label; without noise, exactly what the world applied), tagged `source`. The
+/// policy's History holds the actions the world applied.
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
                 const RolloutOptions& options = {});
 

@@ -5,6 +5,7 @@
 // read the environment it acts in (mpc simulates from its snapshot), a learned policy never does.
 // The environment clips every action to the world's limits.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <dicestack/core/env.hpp>
@@ -16,6 +17,13 @@
 
 namespace dicestack {
 
+/// What a rollout records for a step when it is not the action taken: DAgger's mixture takes the
+/// learner's action but records the expert's label.
+struct Labelled {
+  Action label{};
+  StepSource source = StepSource::expert;
+};
+
 /// Chooses an action after a history. `act` is called once per control step, in order, from
 /// one thread per policy object; `reset` starts an episode.
 class Policy {
@@ -24,6 +32,8 @@ class Policy {
   virtual void reset(std::uint64_t seed) { (void)seed; }
   virtual Action act(const History& history) = 0;
   virtual std::string name() const = 0;
+  /// The label of the step `act` just chose, if it differs from the action (default: none).
+  virtual std::optional<Labelled> label() const { return std::nullopt; }
 };
 
 /// A trained model acting on its own (thread-safe to share: each caller wraps it).
