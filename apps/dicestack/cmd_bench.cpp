@@ -44,20 +44,19 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // records each episode's outcome. Actions match bare_box2d_seconds draw for draw.
 double framework_seconds(const WorldConfig& config, const SimOptions& opt, int threads, std::vector<Outcome>* outcomes) {
   const State start = paper_start_state(config);
-  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(resolve_threads(threads)));
+  EnvPool envs(config, threads);
   if (outcomes) outcomes->assign(static_cast<std::size_t>(opt.episodes), Outcome{});
   const auto t0 = std::chrono::steady_clock::now();
   parallel_for(static_cast<std::size_t>(opt.episodes), threads, [&](std::size_t e, int worker) {
-    auto& env = envs[static_cast<std::size_t>(worker)];
-    if (!env) env.emplace(config);
-    env->reset_to(start);
+    DiceEnv& env = envs.at(worker);
+    env.reset_to(start);
     Rng rng(derive_seed(opt.seed, e));
     for (int t = 0; t < opt.steps; ++t) {
       Action a;
       for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng.uniform(-1.0, 1.0) * config.action.scale[k];
-      env->step(a);
+      env.step(a);
     }
-    if (outcomes) (*outcomes)[e] = env->outcome();
+    if (outcomes) (*outcomes)[e] = env.outcome();
   });
   return seconds_since(t0);
 }

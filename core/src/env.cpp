@@ -6,6 +6,7 @@
 
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/parallel.hpp>
 
 namespace dicestack {
 
@@ -86,6 +87,17 @@ Box<kActionDim> DiceEnv::action_space() const {
     box.low[k] = -box.high[k];
   }
   return box;
+}
+
+EnvPool::EnvPool(const WorldConfig& world, int threads)
+    : world_(world), envs_(static_cast<std::size_t>(resolve_threads(threads))) {
+  validate(world_);
+}
+
+DiceEnv& EnvPool::at(int worker) {
+  auto& env = envs_.at(static_cast<std::size_t>(worker));
+  if (!env) env.emplace(world_);
+  return *env;
 }
 
 }  // namespace dicestack

@@ -29,7 +29,7 @@ OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSetting
   world_.episode.max_steps = std::max(world_.episode.max_steps, settings.steps);
   start_ = paper_start_state(world_);
   goal_ = goal_state(world_);
-  envs_.resize(static_cast<std::size_t>(resolve_threads(threads)));
+  envs_.emplace(world_, threads);
 }
 
 std::vector<Action> OpenLoopProblem::actions(const double* x) const {
@@ -52,18 +52,15 @@ double OpenLoopProblem::run(DiceEnv& env, const double* x) const {
 }
 
 double OpenLoopProblem::cost(const double* x) {
-  if (!envs_[0]) envs_[0].emplace(world_);
   ++evaluations_;
-  return run(*envs_[0], x);
+  return run(envs_->at(0), x);
 }
 
 std::vector<double> OpenLoopProblem::cost_batch(const Eigen::MatrixXd& xs) {
   std::vector<double> out(static_cast<std::size_t>(xs.rows()));
   parallel_for(out.size(), threads_, [&](std::size_t i, int w) {
-    auto& env = envs_[static_cast<std::size_t>(w)];
-    if (!env) env.emplace(world_);
     const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
-    out[i] = run(*env, row.data());
+    out[i] = run(envs_->at(w), row.data());
   });
   evaluations_ += static_cast<int>(out.size());
   return out;

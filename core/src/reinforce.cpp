@@ -152,12 +152,8 @@ ReinforceResult reinforce(const WorldConfig& config, const ReinforceOptions& o,
   Eigen::VectorXd theta = net.params(), m = Eigen::VectorXd::Zero(theta.size()), v = m;
   Eigen::VectorXd baseline = Eigen::VectorXd::Zero(o.steps);
   bool baseline_set = false;
-  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(resolve_threads(o.threads)));
-  auto env_of = [&](int w) -> DiceEnv& {
-    auto& e = envs[static_cast<std::size_t>(w)];
-    if (!e) e.emplace(world);
-    return *e;
-  };
+  EnvPool envs(world, o.threads);
+  auto env_of = [&](int w) -> DiceEnv& { return envs.at(w); };
   for (int it = 1; it <= o.iterations; ++it) {
     std::vector<EpisodeTrace> traces(static_cast<std::size_t>(o.batch));
     parallel_for(traces.size(), o.threads, [&](std::size_t k, int w) {

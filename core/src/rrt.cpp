@@ -57,12 +57,8 @@ RrtResult rrt(const WorldConfig& config, const RrtOptions& o, const std::functio
   world.episode.max_steps = std::max(world.episode.max_steps, o.max_depth_steps + o.extend_steps);
   const auto t0 = std::chrono::steady_clock::now();
   const State goal = goal_state(world);
-  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(resolve_threads(o.threads)));
-  auto env_of = [&](int w) -> DiceEnv& {
-    auto& e = envs[static_cast<std::size_t>(w)];
-    if (!e) e.emplace(world);
-    return *e;
-  };
+  EnvPool envs(world, o.threads);
+  auto env_of = [&](int w) -> DiceEnv& { return envs.at(w); };
   RrtResult result;
   std::vector<Node> tree;
   {

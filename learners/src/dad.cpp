@@ -70,8 +70,7 @@ class Dad final : public Learner {
       best_deviation = result.curve.back().deviation;
     }
 
-    const auto workers = static_cast<std::size_t>(resolve_threads(c.threads));
-    std::vector<std::optional<DiceEnv>> envs(workers);
+    EnvPool envs(world, c.threads);
     const auto corrector = make_corrector(params().choice("corrector"),
                                           {static_cast<int>(params().integer("corrector_iterations")), params().real("sigma0"),
                                            static_cast<int>(params().integer("population"))});
@@ -82,15 +81,13 @@ class Dad final : public Learner {
           c.progress({phase, k, total, window, windows, done, of, (k - 1 + (of ? static_cast<double>(done) / of : 0.0)) / total});
       };
       report("rollouts", 0, 0);
-      const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, world, envs, c.threads);
+      const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, envs, c.threads);
 
       std::vector<Correction> fixes(tasks.size());
       std::atomic<int> finished{0};
       const std::uint64_t round_seed = derive_seed(c.seed, 1000003u + static_cast<std::uint64_t>(k));
       parallel_for(tasks.size(), c.threads, [&](std::size_t i, int w) {
-        auto& env = envs[static_cast<std::size_t>(w)];
-        if (!env) env.emplace(world);
-        fixes[i] = corrector->correct(*env, tasks[i].problem, derive_seed(round_seed, i));
+        fixes[i] = corrector->correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
         const int done = ++finished;
         if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
       });
@@ -180,11 +177,10 @@ class Dad final : public Learner {
   // Rolls the policy out from every target's first state and cuts its trajectory into windows
   // of w steps: each starts from the policy's world at that step, aims at the target's states.
   static std::vector<Task> policy_windows(const Model& model, const std::vector<Episode>& targets, int window, int windows,
-                                          const WorldConfig& world, std::vector<std::optional<DiceEnv>>& envs, int threads) {
+                                          EnvPool& envs, int threads) {
     std::vector<std::vector<Task>> per_demo(targets.size());
     parallel_for(targets.size(), threads, [&](std::size_t d, int w) {
-      auto& env = envs[static_cast<std::size_t>(w)];
-      if (!env) env.emplace(world);
+      DiceEnv& env = envs.at(w);
       const Episode& demo = targets[d];
       const std::size_t len = demo.size();
       const auto width = static_cast<std::size_t>(std::max(1.0, std::ceil(static_cast<double>(len) * window / windows)));
@@ -198,7 +194,7 @@ class Dad final : public Learner {
       };
       ModelPolicy policy(std::shared_ptr<const Model>(&model, [](const Model*) {}));  // borrowed for this rollout
       const std::vector<Action> actions =
-          len > 1 ? rollout(*env, policy, demo.states[0], demo.seed, StepSource::policy, options).actions
+          len > 1 ? rollout(env, policy, demo.states[0], demo.seed, StepSource::policy, options).actions
                   : std::vector<Action>{};
       for (auto& task : per_demo[d])  // the policy's own actions, held at zero past its episode's end
         for (std::size_t j = 0; j < task.problem.target.size(); ++j)

@@ -42,18 +42,16 @@ class Dagger final : public Learner {
     if (!data.empty()) model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
 
     const auto workers = static_cast<std::size_t>(resolve_threads(c.threads));
-    std::vector<std::optional<DiceEnv>> envs(workers);
+    EnvPool envs(c.world, c.threads);
     std::vector<std::unique_ptr<Expert>> experts(workers);
     for (int i = first; i <= iterations; ++i) {
       const double beta = beta_at(i, iterations);
       std::vector<Episode> fresh(static_cast<std::size_t>(rollouts));
       std::atomic<int> finished{0};
       parallel_for(fresh.size(), c.threads, [&](std::size_t k, int w) {
-        auto& env = envs[static_cast<std::size_t>(w)];
         auto& expert = experts[static_cast<std::size_t>(w)];
-        if (!env) env.emplace(c.world);
         if (!expert) expert = make_expert(expert_name, expert_config);
-        fresh[k] = mixture_rollout(*env, *expert, model.get(), beta,
+        fresh[k] = mixture_rollout(envs.at(w), *expert, model.get(), beta,
                                    training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
         const int done = ++finished;
         if (c.progress && w == 0)  // one thread reports

@@ -112,19 +112,18 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
   RolloutOptions options;
   options.push = push;
   const int workers = resolve_threads(threads);
-  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
+  EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
   std::vector<double> policy_seconds(static_cast<std::size_t>(workers), 0.0);
   std::vector<Episode> eps(static_cast<std::size_t>(episodes));
   const auto t0 = std::chrono::steady_clock::now();
   parallel_for(eps.size(), threads, [&](std::size_t i, int w) {
     const auto slot = static_cast<std::size_t>(w);
-    if (!envs[slot]) envs[slot].emplace(world);
     if (!policies[slot]) policies[slot] = make_policy();
     TimedPolicy timed(*policies[slot], policy_seconds[slot]);
     const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
     const State start = random_start_state(world, episode_seed);
-    eps[i] = rollout(*envs[slot], timed, start, episode_seed, StepSource::policy, options);
+    eps[i] = rollout(envs.at(w), timed, start, episode_seed, StepSource::policy, options);
   });
   double total_policy = 0.0;
   for (double s : policy_seconds) total_policy += s;
@@ -143,14 +142,11 @@ std::vector<Episode> rollouts_from_demos(const std::function<std::unique_ptr<Pol
   WorldConfig world = config;
   for (const auto& d : demos)
     world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 60);
-  const int workers = resolve_threads(threads);
-  std::vector<std::optional<DiceEnv>> envs(static_cast<std::size_t>(workers));
+  EnvPool envs(world, threads);
   std::vector<Episode> eps(demos.size());
   parallel_for(demos.size(), threads, [&](std::size_t i, int w) {
-    auto& env = envs[static_cast<std::size_t>(w)];
-    if (!env) env.emplace(world);
     const auto policy = make_policy(i);
-    eps[i] = rollout(*env, *policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
+    eps[i] = rollout(envs.at(w), *policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
   });
   return eps;
 }

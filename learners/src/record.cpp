@@ -24,19 +24,18 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
     options.noise[k] = noise[k] * world.action.scale[k];
   }
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
-  std::vector<std::optional<DiceEnv>> envs(workers);
+  EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Expert>> experts(workers);
   std::vector<Episode> out(static_cast<std::size_t>(std::max(0, episodes)));
   parallel_for(out.size(), threads, [&](std::size_t i, int w) {
-    auto& env = envs[static_cast<std::size_t>(w)];
+    DiceEnv& env = envs.at(w);
     auto& expert = experts[static_cast<std::size_t>(w)];
-    if (!env) env.emplace(world);
     if (!expert) expert = make_expert(name, config);
     const std::uint64_t s = training_start_seed(seed, i);
-    ExpertPolicy policy(*expert, *env);
+    ExpertPolicy policy(*expert, env);
     RolloutOptions o = options;
     o.noise_seed = derive_seed(s, 2);
-    out[i] = rollout(*env, policy, random_start_state(world, s), s, StepSource::expert, o);
+    out[i] = rollout(env, policy, random_start_state(world, s), s, StepSource::expert, o);
     out[i].origin = "expert " + name;
   });
   return out;

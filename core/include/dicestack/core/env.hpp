@@ -2,6 +2,8 @@
 // The dice-stacking task as a Gym-style environment: reset(seed) gives the first observation,
 // step(action) gives observation, reward, terminated, truncated and info.
 #include <cstdint>
+#include <optional>
+#include <vector>
 
 #include <dicestack/core/judge.hpp>
 #include <dicestack/core/rng.hpp>
@@ -80,6 +82,21 @@ class DiceEnv {
   State goal_;
   Outcome outcome_;
   Rng noise_{0};
+};
+
+/// One environment per worker of parallel_for (a DiceEnv is not thread-safe), each made on its
+/// worker's first use and kept for the rest of the run.
+class EnvPool {
+ public:
+  /// `threads` as parallel_for takes it (0 = all cores). Throws ConfigError for a bad config.
+  EnvPool(const WorldConfig& world, int threads);
+  /// The environment of worker `worker` (parallel_for's second argument).
+  DiceEnv& at(int worker);
+  const WorldConfig& world() const { return world_; }
+
+ private:
+  WorldConfig world_;
+  std::vector<std::optional<DiceEnv>> envs_;
 };
 
 }  // namespace dicestack

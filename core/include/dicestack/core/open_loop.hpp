@@ -48,7 +48,7 @@ class OpenLoopProblem {
   OpenLoopSettings settings_;
   State start_, goal_;
   int threads_;
-  std::vector<std::optional<DiceEnv>> envs_;
+  std::optional<EnvPool> envs_;  ///< made once the world is checked and stretched
   int evaluations_ = 0;
 };
 
