@@ -10,9 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/metrics.hpp>
 #include <dicestack/core/open_loop.hpp>

@@ -1,4 +1,3 @@
-#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/atomic_file.hpp>
 
 #include <signal.h>
@@ -13,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 
 namespace dicestack {
 namespace {

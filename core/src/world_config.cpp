@@ -1,4 +1,3 @@
-#include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/world_config.hpp>
 
 #include <cmath>
@@ -10,6 +9,7 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 
 namespace dicestack {
 namespace {

@@ -1,4 +1,3 @@
-#include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
 #include <algorithm>
@@ -8,14 +7,17 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/version.hpp>
 
 namespace dicestack {
@@ -123,18 +125,35 @@ json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
 template <class T>
 T meta_field(const json& j, const char* key, const fs::path& meta, const char* expected) {
   if (!j.contains(key)) meta_error(meta, std::string("missing \"") + key + "\"");
-  try {
-    return j.at(key).get<T>();
-  } catch (const json::exception&) {
-    meta_error(meta, std::string("\"") + key + "\" must be " + expected + ", got " + j.at(key).dump());
+  const json& v = j.at(key);
+  auto refuse = [&] {
+    meta_error(meta, std::string("\"") + key + "\" must be " + expected + ", got " + v.dump().substr(0, 40));
+  };
+  // Integers are never narrowed: 1.9, -1 or 4294967297 for an int are refused, not read as 1.
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    if (!v.is_number_integer()) refuse();
+    if (v.is_number_unsigned()) {
+      if (v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<T>::max())) refuse();
+    } else if (std::is_unsigned_v<T> || v.get<std::int64_t>() < static_cast<std::int64_t>(std::numeric_limits<T>::min())) {
+      refuse();
+    }
   }
+  try {
+    return v.get<T>();
+  } catch (const json::exception&) {
+    refuse();
+  }
+  return T{};
 }
 
 Outcome outcome_from(const json& j, const fs::path& meta, const std::string& file) {
   Outcome o;
   try {
-    o.steps = j.at("steps").get<int>();
-    o.dice_in_cup = j.at("dice_in_cup").get<int>();
+    o.steps = meta_field<int>(j, "steps", meta, "an integer");
+    o.dice_in_cup = meta_field<int>(j, "dice_in_cup", meta, "an integer in [0, 3]");
+    if (o.steps < 0 || o.dice_in_cup < 0 || o.dice_in_cup > static_cast<int>(kDiceCount))
+      meta_error(meta, "outcome of " + file + " has steps " + std::to_string(o.steps) + " and dice_in_cup " +
+                           std::to_string(o.dice_in_cup) + "; expected steps >= 0 and dice_in_cup in [0, 3]");
     o.stacked = j.at("stacked").get<bool>();
     o.wall_contact = j.at("wall_contact").get<bool>();
   } catch (const json::exception& e) {
@@ -297,6 +316,8 @@ DemoSet read_demo_set(const fs::path& dir) {
   std::set<std::string> listed;
   for (const auto& entry : meta["episodes"]) {
     const auto file = meta_field<std::string>(entry, "file", meta_path, "a string");
+    if (file.empty() || file.find_first_of("/\\") != std::string::npos || file == "." || file == "..")
+      meta_error(meta_path, "\"file\" must name a file inside the folder, got \"" + file.substr(0, 60) + "\"");
     if (!listed.insert(file).second) meta_error(meta_path, "lists " + file + " twice");
     const fs::path path = dir / file;
     if (!fs::exists(path)) meta_error(meta_path, "lists " + file + ", which does not exist");

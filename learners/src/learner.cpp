@@ -1,4 +1,3 @@
-#include <dicestack/core/json_depth.hpp>
 #include <dicestack/learners/learner.hpp>
 
 #include <cctype>
@@ -7,6 +6,7 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>

@@ -125,6 +125,12 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("no_meta"), HasSubstr("meta.json: missing; not a dicestack demonstration folder"));
   EXPECT_THAT(read_error("broken_meta"), HasSubstr("meta.json: not valid JSON"));
   EXPECT_THAT(read_error("bad_world"), HasSubstr("\"physics.substeps\""));
+  // Numbers are never narrowed, and a listed file never leaves the folder.
+  EXPECT_THAT(read_error("version_fraction"), HasSubstr("\"version\" must be an integer, got 1.9"));
+  EXPECT_THAT(read_error("version_huge"), HasSubstr("\"version\" must be an integer, got 4294967297"));
+  EXPECT_THAT(read_error("steps_fraction"), HasSubstr("\"steps\" must be an unsigned integer, got 3.5"));
+  EXPECT_THAT(read_error("seed_negative"), HasSubstr("\"seed\" must be an unsigned integer, got -1"));
+  EXPECT_THAT(read_error("file_escapes"), HasSubstr("\"file\" must name a file inside the folder, got \"../good/episode_0000.csv\""));
   EXPECT_THROW(read_demo_set(kData / "bad" / "nan"), InputError);
 }
 
