@@ -30,7 +30,7 @@ inline std::vector<Matrix> read_matrices(std::string_view in, std::size_t expect
   std::size_t at = 0;
   auto take = [&](void* p, std::size_t n) {
     if (in.size() - at < n) throw InputError(who + ": model payload is truncated");
-    std::memcpy(p, in.data() + at, n);
+    if (n > 0) std::memcpy(p, in.data() + at, n);  // an empty matrix's data() may be null
     at += n;
   };
   char magic[sizeof kMagic];
@@ -45,6 +45,10 @@ inline std::vector<Matrix> read_matrices(std::string_view in, std::size_t expect
     std::uint64_t shape[2];
     take(shape, sizeof shape);
     if (shape[0] > (1ULL << 32) || shape[1] > (1ULL << 20)) throw InputError(who + ": model payload has an absurd shape");
+    // The shape against the bytes present, before anything is allocated.
+    if (shape[1] > 0 && shape[0] > (in.size() - at) / sizeof(double) / shape[1])
+      throw InputError(who + ": model payload says " + std::to_string(shape[0]) + " x " + std::to_string(shape[1]) +
+                       " values, more than its " + std::to_string(in.size() - at) + " remaining bytes hold");
     Matrix m(static_cast<Eigen::Index>(shape[0]), static_cast<Eigen::Index>(shape[1]));
     take(m.data(), sizeof(double) * static_cast<std::size_t>(m.size()));
     if (!m.allFinite()) throw InputError(who + ": model payload holds NaN or infinity");

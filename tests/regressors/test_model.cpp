@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <unistd.h>
 
@@ -125,6 +126,19 @@ TEST(ModelFile, DeeplyNestedHeadersAreRefusedNotCrashed) {
   auto r = RegressorRegistry::global().create("gbt");
   EXPECT_THAT(test::error_of([&] { r->load_payload(std::string(100000, '[') + std::string(100000, ']'), 24, 3); }),
               HasSubstr("JSON nested deeper than 64 levels"));
+}
+
+TEST(ModelFile, MatrixPayloadShapesAreCheckedBeforeAllocating) {
+  const Matrix x = random_rows(100, 24, 6);
+  for (const char* name : {"linear_svr", "knn", "mlp"}) {
+    auto r = RegressorRegistry::global().create(name);
+    r->fit(x, labels(x), 1);
+    std::string payload = r->save_payload();
+    const std::uint64_t rows = 1ULL << 31;  // the first matrix's row count: 2^31 x cols doubles
+    std::memcpy(payload.data() + 16, &rows, sizeof rows);
+    auto back = RegressorRegistry::global().create(name);
+    EXPECT_THAT(test::error_of([&] { back->load_payload(payload, 24, 3); }), HasSubstr("remaining bytes hold")) << name;
+  }
 }
 
 TEST(ModelFile, VersionOneReadsAsTheStateMap) {
