@@ -3,10 +3,12 @@
 // episode, as DAgger asks it), then the expert takes over. Prints, per k, the realistic success
 // from evaluation starts and how far the policy's actions were from the expert's labels.
 //   dicestack_handover_bench MODEL [--expert mpc|scripted] [--replan] [--episodes N] [--seed S]
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <dicestack/core/expert.hpp>
@@ -25,18 +27,20 @@ int main(int argc, char** argv) {
   bool replan = false;
   int episodes = 100;
   std::uint64_t seed = 1000;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--expert" && i + 1 < argc) expert_name = argv[++i];
-    else if (a == "--replan") replan = true;
-    else if (a == "--episodes" && i + 1 < argc) episodes = std::stoi(argv[++i]);
-    else if (a == "--seed" && i + 1 < argc) seed = std::stoull(argv[++i]);
-    else {
-      std::fprintf(stderr, "dicestack_handover_bench: unknown argument %s\n", a.c_str());
-      return 2;
-    }
-  }
   try {
+    auto number = [](const std::string& text) {
+      if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+        throw std::invalid_argument("expected a whole number, got \"" + text + "\"");
+      return std::stoull(text);
+    };
+    for (int i = 2; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a == "--expert" && i + 1 < argc) expert_name = argv[++i];
+      else if (a == "--replan") replan = true;
+      else if (a == "--episodes" && i + 1 < argc) episodes = static_cast<int>(std::min(number(argv[++i]), 1000000ULL));
+      else if (a == "--seed" && i + 1 < argc) seed = number(argv[++i]);
+      else throw std::invalid_argument("unknown argument " + a);
+    }
     const auto model = std::make_shared<const Model>(load_model(argv[1]));
     const WorldConfig world;
     ExpertConfig config;

@@ -162,8 +162,15 @@ std::string file_marker(const std::string& format) {
 Ownership table_ownership(const std::string& format) {
   if (format == "json") return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"});
   if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1});
-  const std::string marker = file_marker(format);
-  return Ownership::first_line("dicestack leaderboard (" + format + ")", {marker.substr(0, marker.size() - 1)});
+  // md and latex: our marker line, or the header line tables had before the marker.
+  const std::string marker = file_marker(format), what = "dicestack leaderboard (" + format + ")";
+  return {what, [marker = marker.substr(0, marker.size() - 1), format](const std::filesystem::path& p) {
+            std::ifstream in(p, std::ios::binary);
+            std::string first;
+            std::getline(in, first);
+            const std::string old = format == "latex" ? "% dicestack " : "dicestack ";
+            return first == marker || (first.rfind(old, 0) == 0 && first.find(" leaderboard: ") != std::string::npos);
+          }};
 }
 
 Ownership partial_ownership() {
@@ -270,6 +277,7 @@ int run_leaderboard(LeaderboardOptions opt) {
         if (!opt.features.empty()) print_progress("note: " + l + " reads only the state; skipping features " + f);
         continue;
       }
+      if (opt.split == "rows" && f != "state" && opt.features.empty()) continue;  // a default map that needs episodes
       if (opt.split == "rows" && f != "state")
         throw ConfigError("features \"" + f + "\" read an episode's history; --split rows shuffles the rows: use --split episodes");
       combos.emplace_back(l, f);

@@ -109,8 +109,8 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--learner", opt->learner, "Learner: bc, dagger, dad, dart (see `dicestack learners`)")->capture_default_str();
   cmd->add_option("--option", opt->options, "key=value option of the learner; repeatable");
   cmd->add_option("--features", opt->features,
-                  "Feature map the policy reads: state, state+clock, state+clock+start, state+history (default: the "
-                  "learner's, see `dicestack learners`)");
+                  "Feature map the policy reads: state, state+clock, state+clock+start, state+history, "
+                  "state+clock+start_state (default: the learner's, see `dicestack learners`)");
   cmd->add_option("--split", opt->split,
                   "episodes: train on episodes i % 5 != 4, report test error and give the rest to learners as "
                   "held-out demonstrations; none: all")

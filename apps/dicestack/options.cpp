@@ -80,10 +80,11 @@ CLI::Validator seed_check() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {
         const std::string max = "18446744073709551615";
-        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
-        const std::string trimmed = digits ? text.substr(std::min(text.find_first_not_of('0'), text.size() - 1)) : text;
-        if (!digits || trimmed.size() > max.size() || (trimmed.size() == max.size() && trimmed > max))
-          return "a seed is a whole number in [0, " + max + "], got \"" + text.substr(0, 40) + "\"";
+        // Digits only, and no leading zero: CLI11 2.1 would read "010" as octal 8.
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos &&
+                            (text.size() == 1 || text[0] != '0');
+        if (!digits || text.size() > max.size() || (text.size() == max.size() && text > max))
+          return "a seed is a whole number in [0, " + max + "] without leading zeros, got \"" + text.substr(0, 40) + "\"";
         return {};
       },
       "SEED");

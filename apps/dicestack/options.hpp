@@ -19,8 +19,8 @@ struct WorldOption {
   WorldConfig load() const;
 };
 
-/// `--seed`: a whole number in [0, 2^64 - 1], written in digits (CLI11 alone reads -1 and
-/// 2^64 as 2^64 - 1).
+/// `--seed`: a whole number in [0, 2^64 - 1], written in digits without leading zeros (CLI11
+/// alone reads -1 and 2^64 as 2^64 - 1, and "010" as octal).
 CLI::Validator seed_check();
 
 /// Prints a JSON object or a human-readable text on stdout.

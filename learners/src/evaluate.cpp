@@ -74,6 +74,7 @@ class TimedPolicy final : public Policy {
     return a;
   }
   std::string name() const override { return inner_.name(); }
+  std::optional<Labelled> label() const override { return inner_.label(); }
 
  private:
   Policy& inner_;

@@ -154,7 +154,8 @@ nlohmann::json run_settings(const LearnContext& c, const Params& learner_params,
           {"seed", std::to_string(c.seed)},
           {"learner_options", options},
           {"demonstrations", std::to_string(c.demos.size())},
-          {"held_out", std::to_string(c.held_out.size())}};
+          {"held_out", std::to_string(c.held_out.size())},
+          {"world", std::to_string(fnv1a(to_json(c.world)))}};
 }
 
 nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file, const nlohmann::json& run) {
@@ -167,6 +168,8 @@ nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& s
     throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
   }
   if (!state.is_object()) throw InputError(path.string() + ": not a checkpoint state (not a JSON object)");
+  if (state.contains("run") && !state["run"].is_object())
+    throw InputError(path.string() + ": not a checkpoint state (\"run\" is not an object)");
   if (state.contains("run")) {  // states written before runs were recorded have none to compare
     std::string differences;
     for (const auto& [key, value] : run.items()) {

@@ -11,6 +11,7 @@
 #include <opencv2/ml.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
 #include <dicestack/regressors/regressor.hpp>
 
 namespace dicestack::opencv {
@@ -50,7 +51,7 @@ template <class T>
 std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, const std::string& who) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(payload);
+    j = parse_json_limited<nlohmann::json>(payload, who + ": model payload");
   } catch (const nlohmann::json::exception&) {
     throw InputError(who + ": model payload is not the expected JSON");
   }

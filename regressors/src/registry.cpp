@@ -65,13 +65,15 @@ void RegressorRegistry::load_plugin(const std::filesystem::path& library) {
     throw PluginError(who + ": dicestack_plugin_v1 is not a function; not a dicestack plugin");
   }
   const DicestackPluginV1* p = reinterpret_cast<Entry>(symbol)();
-  if (p && (!p->dicestack_version || !p->stdlib || !p->register_regressors))
+  // The ABI version first: another ABI's record may have another layout.
+  if (p && p->abi_version == DICESTACK_PLUGIN_ABI_VERSION && (!p->dicestack_version || !p->stdlib || !p->register_regressors))
     throw PluginError(who + ": its plugin record has a null field; not a dicestack plugin");
   const std::string ours = "ABI " + std::to_string(DICESTACK_PLUGIN_ABI_VERSION) + " (" DICESTACK_VERSION ", " +
                            DICESTACK_STDLIB_TAG + ")";
   if (!p || p->abi_version != DICESTACK_PLUGIN_ABI_VERSION || std::string(p->stdlib) != DICESTACK_STDLIB_TAG) {
-    const std::string theirs = p ? "ABI " + std::to_string(p->abi_version) + " (" + p->dicestack_version + ", " +
-                                       p->stdlib + ")"
+    auto text = [](const char* t) { return std::string(t ? t : "?"); };
+    const std::string theirs = p ? "ABI " + std::to_string(p->abi_version) + " (" + text(p->dicestack_version) + ", " +
+                                       text(p->stdlib) + ")"
                                  : "an unknown ABI";
     throw PluginError(who + ": built for dicestack " + theirs + "; this is " + ours +
                       " - rebuild it with find_package(dicestack " DICESTACK_STRINGIFY(DICESTACK_VERSION_MAJOR) "." DICESTACK_STRINGIFY(DICESTACK_VERSION_MINOR) ")");

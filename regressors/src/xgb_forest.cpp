@@ -1,6 +1,7 @@
 #include "xgb_forest.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <map>
 #include <string>
@@ -17,6 +18,23 @@ namespace {
 using FloatJson = nlohmann::basic_json<std::map, std::vector, std::string, bool, std::int64_t, std::uint64_t, float>;
 
 [[noreturn]] void fail(const std::string& what) { throw InputError("gbt: " + what); }
+
+// An integer from the payload: a float (1.5, 1e30) is refused, never converted.
+std::int64_t integer(const FloatJson& v, const std::string& what) {
+  if (!v.is_number_integer() || (v.is_number_unsigned() && v.get<std::uint64_t>() > (std::uint64_t{1} << 62)))
+    fail(what + " is not an integer index, got " + v.dump().substr(0, 40));
+  return v.get<std::int64_t>();
+}
+
+// A count xgboost stores as text ("3"): digits only, the whole string.
+std::uint64_t count_text(const FloatJson& v, const std::string& what) {
+  const std::string text = v.get<std::string>();
+  std::uint64_t out = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size())
+    fail(what + " is not a count, got \"" + text.substr(0, 40) + "\"");
+  return out;
+}
 
 }  // namespace
 
@@ -40,10 +58,10 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
     if (learner.at("objective").at("name").get<std::string>() != "reg:squarederror")
       fail("the model's objective is not reg:squarederror");
     const auto& param = learner.at("learner_model_param");
-    const unsigned long targets = std::stoul(param.at("num_target").get<std::string>());
+    const auto targets = count_text(param.at("num_target"), "num_target");
     if (targets != outputs)
       fail("the model has " + std::to_string(targets) + " targets, the header says " + std::to_string(outputs));
-    if (std::stoul(param.at("num_feature").get<std::string>()) != inputs)
+    if (count_text(param.at("num_feature"), "num_feature") != inputs)
       fail("the model reads " + param.at("num_feature").get<std::string>() + " features, the header says " +
            std::to_string(inputs));
     f.base_score_ = std::stof(param.at("base_score").get<std::string>());
@@ -57,7 +75,7 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
       fail("tree_info lists " + std::to_string(info.size()) + " trees, the model holds " + std::to_string(trees.size()));
     for (std::size_t t = 0; t < trees.size(); ++t) {
       const std::string where = "tree " + std::to_string(t) + ": ";
-      const auto target = info[t].get<std::int64_t>();
+      const auto target = integer(info[t], where + "tree_info");
       if (target < 0 || static_cast<std::size_t>(target) >= outputs)
         fail(where + "target " + std::to_string(target) + " is not below " + std::to_string(outputs));
       const auto& tree = trees[t];
@@ -83,16 +101,17 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
         if (seen[static_cast<std::size_t>(i)]) fail(at + "reached twice; not a tree");
         seen[static_cast<std::size_t>(i)] = 1;
         if (depth > 64) fail(at + "deeper than 64");
-        const auto l = left[static_cast<std::size_t>(i)].get<std::int64_t>();
-        const auto r = right[static_cast<std::size_t>(i)].get<std::int64_t>();
+        const auto l = integer(left[static_cast<std::size_t>(i)], at + "left child");
+        const auto r = integer(right[static_cast<std::size_t>(i)], at + "right child");
+        integer(dleft[static_cast<std::size_t>(i)], at + "default_left");
         const float v = value[static_cast<std::size_t>(i)].get<float>();
         if (!std::isfinite(v)) fail(at + "value is not finite");
         if (l == -1 && r == -1) continue;
         for (const auto c : {l, r})
           if (c <= 0 || c >= static_cast<std::int64_t>(n))
             fail(at + "child " + std::to_string(c) + " is out of range (the tree has " + std::to_string(n) + " nodes)");
-        if (type[static_cast<std::size_t>(i)].get<int>() != 0) fail(at + "categorical splits are not supported");
-        const auto k = feature[static_cast<std::size_t>(i)].get<std::int64_t>();
+        if (integer(type[static_cast<std::size_t>(i)], at + "split_type") != 0) fail(at + "categorical splits are not supported");
+        const auto k = integer(feature[static_cast<std::size_t>(i)], at + "split index");
         if (k < 0 || static_cast<std::size_t>(k) >= inputs)
           fail(at + "splits on feature " + std::to_string(k) + " of " + std::to_string(inputs));
         stack.emplace_back(l, depth + 1);
@@ -106,7 +125,7 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
         const auto [i, slot] = queue[q];
         Node& node = f.nodes_[slot];
         node.value = value[i].get<float>();
-        const auto l = left[i].get<std::int64_t>();
+        const auto l = left[i].get<std::int64_t>();  // checked by the walk above
         if (l == -1) continue;
         const auto children = f.nodes_.size();
         node.left = static_cast<std::int32_t>(children);
@@ -122,7 +141,7 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
     }
   } catch (const FloatJson::exception& e) {
     fail(std::string("malformed xgboost model: ") + e.what());
-  } catch (const std::logic_error& e) {  // std::stoul / std::stof on a bad number
+  } catch (const std::logic_error& e) {  // std::stof on a bad base_score
     fail(std::string("malformed xgboost model parameter: ") + e.what());
   }
   return f;

@@ -60,7 +60,7 @@ TEST(Cli, UsageErrorsExitNonZero) {
 }
 
 TEST(Cli, SeedsOutsideTheirRangeAreRefusedNotWrapped) {
-  for (const char* seed : {"-1", "18446744073709551616", "1e3", "3.5"}) {
+  for (const char* seed : {"-1", "18446744073709551616", "1e3", "3.5", "010"}) {
     const Process p = run(std::string("rollout --steps 1 --seed ") + seed);
     EXPECT_NE(p.status, 0) << seed;
     EXPECT_THAT(p.output, HasSubstr("a seed is a whole number in [0, 18446744073709551615]")) << seed;
@@ -316,6 +316,19 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   EXPECT_EQ(rows[1]["features"], "state+clock");
   EXPECT_EQ(rows[2]["learner"], "dad");
   EXPECT_EQ(rows[2]["features"], "state");
+}
+
+TEST(CliLearning, RowSplitLeavesOutDefaultMapsThatNeedEpisodes) {
+  // dart's default map reads the episode's clock and start: under --split rows its row is left
+  // out (the paper's Table I protocol still runs); a map named with --features is refused.
+  Process p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr --learners bc,dart --split rows "
+                  "--episodes 1 --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output)["rows"].size(), 2u);  // bc, playback
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr --learners bc --features state+clock "
+          "--split rows --episodes 1");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("--split rows shuffles the rows"));
 }
 
 TEST(CliLearning, RecordWithNoiseRecordsTheCleanActionsAndSaysSo) {

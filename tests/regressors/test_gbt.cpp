@@ -85,6 +85,12 @@ TEST(Gbt, EditedPayloadsAreRefusedBeforeAnyWalk) {
                 t["right_children"][1] = t["right_children"][0];
               }),
               HasSubstr("reached twice; not a tree"));
+  EXPECT_THAT(load_edited([&](nlohmann::json& j) { tree(j, 2)["left_children"][0] = 1.5; }),
+              HasSubstr("gbt: tree 2: node 0: left child is not an integer index, got 1.5"));
+  EXPECT_THAT(load_edited([&](nlohmann::json& j) { tree(j, 2)["right_children"][0] = 1e30; }),
+              HasSubstr("right child is not an integer index"));
+  EXPECT_THAT(load_edited([&](nlohmann::json& j) { j["learner"]["learner_model_param"]["num_target"] = "-3"; }),
+              HasSubstr("num_target is not a count, got \"-3\""));
   EXPECT_THAT(load_edited([&](nlohmann::json& j) { tree(j, 0)["split_indices"][0] = 999; }),
               HasSubstr("gbt: tree 0: node 0: splits on feature 999 of 27"));
   EXPECT_THAT(load_edited([&](nlohmann::json& j) { j["learner"]["gradient_booster"]["model"]["tree_info"][4] = 7; }),

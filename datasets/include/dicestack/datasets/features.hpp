@@ -18,7 +18,10 @@ namespace dicestack {
 /// states[0] (the start) .. states[t] (the current one), and the t actions the world applied.
 struct History {
   std::span<const State> states;   ///< t + 1 states; never empty
-  std::span<const Action> actions; ///< t actions (may be empty when the caller does not track them)
+  /// t actions (may be empty when the caller does not track them). In rollouts the actions the
+  /// world applied; in training rows (make_dataset) the recorded labels, which differ under DART
+  /// noise and DAgger: no built-in map reads them for that reason.
+  std::span<const Action> actions;
   /// Step index of the current state (0 at the start).
   std::size_t t() const { return states.size() - 1; }
   const State& current() const { return states.back(); }
@@ -52,6 +55,7 @@ class FeatureMap {
 ///  - "state+clock+start": + t, the start's cup x and the start's mean die x
 ///  - "state+history": + the previous state (the start repeated at t = 0): the last step's
 ///    velocity changes, which carry the previous action
+///  - "state+clock+start_state": + t and the whole start state (dart's default)
 /// Throws ConfigError for another name, listing these.
 const FeatureMap& feature_map(std::string_view name);
 
