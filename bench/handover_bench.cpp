@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
     const auto model = std::make_shared<const Model>(load_model(argv[1]));
     const WorldConfig world;
     ExpertConfig config;
-    if (!replan) config.replan_interval = std::numeric_limits<int>::max();
+    config.replan = replan;
     std::printf("model %s, expert %s (%s), %d evaluation starts from seed %llu\n", argv[1], expert_name.c_str(),
                 replan ? "replanning" : "planning once", episodes, static_cast<unsigned long long>(seed));
     std::printf("%12s %10s %8s %24s\n", "policy steps", "success", "walls", "|policy - label| / scale");

@@ -1,8 +1,6 @@
 // `dicestack record`: demonstrations from an automatic expert (docs/expert.md).
 #include <chrono>
 #include <cstdio>
-#include <limits>
-
 #include <nlohmann/json.hpp>
 
 #include <dicestack/datasets/demo_set.hpp>
@@ -31,7 +29,7 @@ int run_record(const RecordOptions& opt) {
   const WorldConfig world = opt.world.load();
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
-  if (opt.no_replan) expert.replan_interval = std::numeric_limits<int>::max();
+  expert.replan = !opt.no_replan;
   std::vector<Episode> eps = record_expert(opt.expert, expert, world, opt.episodes, opt.seed, opt.threads,
                                          {opt.noise, opt.noise, opt.noise});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -118,11 +118,13 @@ std::vector<fs::path> dead_leftovers(const fs::path& target, std::string_view ta
   return out;
 }
 
-AtomicFile::AtomicFile(fs::path path, const Ownership& owner) : path_(std::move(path)) {
+AtomicFile::AtomicFile(fs::path path, const Ownership& owner, Leftovers leftovers) : path_(std::move(path)) {
   check_replaceable(path_, owner);
-  for (const auto& old : dead_leftovers(path_, "tmp")) {
-    std::error_code ignored;
-    if (fs::is_regular_file(old, ignored)) fs::remove(old, ignored);
+  if (leftovers == Leftovers::clean) {
+    for (const auto& old : dead_leftovers(path_, "tmp")) {
+      std::error_code ignored;
+      if (fs::is_regular_file(old, ignored)) fs::remove(old, ignored);
+    }
   }
   tmp_ = temporary_sibling(path_, "tmp");
   out_.open(tmp_, std::ios::binary | std::ios::trunc);

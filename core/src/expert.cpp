@@ -115,7 +115,8 @@ class MpcExpert final : public Expert {
     const int index = t - predicted_from_;
     const bool on_track = plan_.valid() && index >= 0 && index < static_cast<int>(predicted_.size()) &&
                           same_state(predicted_[static_cast<std::size_t>(index)], s);
-    const bool fresh = !plan_.valid() || t < last_replan_ || t - last_replan_ >= config_.replan_interval;
+    const bool fresh =
+        !plan_.valid() || (config_.replan && (t < last_replan_ || t - last_replan_ >= config_.replan_interval));
     if (!on_track && fresh) replan(env);
     return plan_.act(s, t);
   }

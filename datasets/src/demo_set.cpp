@@ -76,8 +76,8 @@ std::string number_text(double v) {
 
 Ownership episode_csv_ownership();
 
-void write_episode_csv(const Episode& e, const fs::path& path) {
-  AtomicFile file(path, episode_csv_ownership());
+void write_episode_csv(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftovers) {
+  AtomicFile file(path, episode_csv_ownership(), leftovers);
   auto& out = file.stream();
   const auto columns = episode_csv_columns();
   for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
@@ -409,7 +409,7 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
     files.push_back(episode_file_name(i));
   }
   replace_folder(dir, [&](const fs::path& tmp) {
-    for (std::size_t i = 0; i < set.episodes.size(); ++i) write_episode_csv(set.episodes[i], tmp / files[i]);
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) write_episode_csv(set.episodes[i], tmp / files[i], AtomicFile::Leftovers::skip);
     AtomicFile meta(tmp / "meta.json", meta_ownership());
     meta.stream() << meta_json(set, files).dump(2) << '\n';
     meta.commit();
@@ -435,7 +435,7 @@ std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Epi
     std::string file;
     do file = episode_file_name(next++);
     while (fs::exists(dir / file));
-    write_episode_csv(e, dir / file);
+    write_episode_csv(e, dir / file, AtomicFile::Leftovers::clean);
     e.name = fs::path(file).stem().string();
     added.push_back(e.name);
     files.push_back(file);

@@ -1,6 +1,5 @@
 #include <atomic>
 #include <cmath>
-#include <limits>
 #include <optional>
 
 #include <dicestack/core/error.hpp>
@@ -29,7 +28,7 @@ class Dagger final : public Learner {
     ExpertConfig expert_config;
     // Without replanning, mpc's labels are a function of the start, the step and the state: the
     // same on and off its own path (docs/learners.md).
-    if (!params().boolean("replan")) expert_config.replan_interval = std::numeric_limits<int>::max();
+    expert_config.replan = params().boolean("replan");
     std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
     std::shared_ptr<Model> model;
     LearnResult result;

@@ -1,5 +1,3 @@
-#include <limits>
-
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/learners/learner.hpp>
@@ -27,7 +25,7 @@ class Dart final : public Learner {
     ExpertConfig expert;
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
-    if (!params().boolean("replan")) expert.replan_interval = std::numeric_limits<int>::max();
+    expert.replan = params().boolean("replan");
     auto recorded = record_expert(params().choice("expert"), expert, c.world, episodes, c.seed, c.threads, fraction);
     int successes = 0;
     const bool successes_only = params().boolean("successes_only");

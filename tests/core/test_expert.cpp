@@ -6,6 +6,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/rng.hpp>
 
 #include "helpers.hpp"
 
@@ -31,6 +32,35 @@ TEST(Expert, BothExpertsStackFromThePaperStartWithoutTouchingAWall) {
     EXPECT_FALSE(e.outcome.wall_contact) << name;
     EXPECT_LT(e.outcome.steps, WorldConfig{}.episode.max_steps) << name;
   }
+}
+
+// The actions mpc chooses while someone else's (noisy) actions move the world.
+std::vector<Action> mpc_labels_under_noise(const ExpertConfig& config) {
+  WorldConfig w;
+  w.episode.max_steps = 120;
+  DiceEnv env(w);
+  auto expert = make_expert("mpc", config);
+  env.reset_to(random_start_state(w, 21), 21);
+  expert->reset(21);
+  Rng noise(5);
+  std::vector<Action> labels;
+  for (int t = 0; t < 120; ++t) {
+    Action a = expert->act(env);
+    labels.push_back(a);
+    for (std::size_t k = 0; k < kActionDim; ++k) a[k] += 0.1 * w.action.scale[k] * noise.normal();
+    env.step(a);
+  }
+  return labels;
+}
+
+TEST(Expert, MpcWithoutReplanningKeepsTheFirstPlan) {
+  ExpertConfig once;
+  once.replan = false;
+  ExpertConfig never_due;  // the same by another road: a replanning interval no episode reaches
+  never_due.replan_interval = 1 << 30;
+  const auto a = mpc_labels_under_noise(once);
+  EXPECT_EQ(a, mpc_labels_under_noise(never_due));
+  EXPECT_NE(a, mpc_labels_under_noise(ExpertConfig{}));  // replanning under noise answers otherwise
 }
 
 TEST(Expert, MpcStacksFromRandomStarts) {

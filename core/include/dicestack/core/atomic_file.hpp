@@ -48,9 +48,14 @@ bool process_is_running(long pid);
 /// Several AtomicFiles (this or other processes) may write one path at once; the last commit wins.
 class AtomicFile {
  public:
-  /// Checks `owner` (check_replaceable), removes dead runs' leftovers of `path`, then opens a
-  /// temporary sibling (temporary_sibling(path, "tmp")) for binary writing. Throws InputError.
-  AtomicFile(std::filesystem::path path, const Ownership& owner);
+  /// Whether to look for dead runs' leftovers of the path first (a scan of its folder): not
+  /// inside a scratch folder this process just made, where a scan per file would cost O(n^2).
+  enum class Leftovers { clean, skip };
+
+  /// Checks `owner` (check_replaceable), removes dead runs' leftovers of `path` (unless
+  /// Leftovers::skip), then opens a temporary sibling (temporary_sibling(path, "tmp")) for
+  /// binary writing. Throws InputError.
+  AtomicFile(std::filesystem::path path, const Ownership& owner, Leftovers leftovers = Leftovers::clean);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;

@@ -49,6 +49,9 @@ struct ExpertConfig {
   /// "mpc": off its predicted trajectory, re-check and re-search the plan at most once per this
   /// many steps and follow the current plan's feedback in between (cheap DAgger labels), >= 1.
   int replan_interval = 10;
+  /// "mpc": false chooses the plan once, at the episode's first step, and only tracks it after:
+  /// its actions are then a function of the start, the step and the state (DART's labels).
+  bool replan = true;
   double search_spread = 0.03;    ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
 };
 
