@@ -162,7 +162,7 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
       }
     }();
     if (version >= 2) {
-      const int fv = h.at("features_version").get<int>();
+      const auto fv = static_cast<int>(header_count(h, "features_version", 1000, where));
       if (fv != features.version())
         throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
                          " differs from this dicestack's (" + std::to_string(features.version()) + ")");
