@@ -300,6 +300,18 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   p = run("evaluate --model " + model.string() + " --episodes 2 --json", false);
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start_state");
+  // --save-rollouts writes the rollouts as a set, and refuses a user's folder.
+  const auto rollouts = std::filesystem::temp_directory_path() / ("dicestack_cli_rollouts_" + std::to_string(getpid()));
+  p = run("evaluate --model " + model.string() + " --episodes 2 --save-rollouts " + rollouts.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(run("dataset info " + rollouts.string()).output, HasSubstr("episodes 2"));
+  std::filesystem::remove_all(rollouts);
+  std::filesystem::create_directories(rollouts);
+  { std::ofstream(rollouts / "notes.txt") << "mine"; }
+  p = run("evaluate --model " + model.string() + " --episodes 1 --save-rollouts " + rollouts.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_TRUE(std::filesystem::exists(rollouts / "notes.txt"));
+  std::filesystem::remove_all(rollouts);
   p = run("train --demos " + kTinyDemos + " --regressor knn --features state+tomorrow --out " + model.string());
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown feature map \"state+tomorrow\""));
