@@ -49,7 +49,10 @@ State random_start_state(const WorldConfig& config, std::uint64_t seed) {
     probe.set_state(s);
     if (!probe.has_overlaps()) return s;
   }
-  throw ConfigError("randomization: no start without overlapping shapes in 1000 draws; reduce randomization ranges");
+  throw ConfigError(
+      "world config: no start without overlapping shapes in 1000 draws: the cup (cup.start_anchor, cup.start_angle) "
+      "overlaps the dice (dice.start_x, dice.start_y) or the walls at most draws of randomization.shift, cup_lift and "
+      "cup_tilt");
 }
 
 State goal_state(const WorldConfig& config) {

@@ -12,8 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string short_hash(const std::string& text) {
-  const std::uint64_t h = fnv1a(text);
+std::string short_hash(std::uint64_t h) {
   char hex[9];
   std::snprintf(hex, sizeof hex, "%08llx", static_cast<unsigned long long>(h >> 32));
   return hex;
@@ -43,7 +42,7 @@ fs::path cache_dir() {
 }
 
 fs::path human_demo_set(const WorldConfig& world) {
-  const fs::path dir = cache_dir() / ("human-" + short_hash(to_json(world)));
+  const fs::path dir = cache_dir() / ("human-" + short_hash(world_hash(world)));
   if (!fs::exists(dir / "meta.json")) write_demo_set(import_cupdice(data_dir() / "cupdice", world), dir);
   return dir;
 }

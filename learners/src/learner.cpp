@@ -155,7 +155,7 @@ nlohmann::json run_settings(const LearnContext& c, const Params& learner_params,
           {"learner_options", options},
           {"demonstrations", std::to_string(c.demos.size())},
           {"held_out", std::to_string(c.held_out.size())},
-          {"world", std::to_string(fnv1a(to_json(c.world)))}};
+          {"world", std::to_string(world_hash(c.world))}};
 }
 
 nlohmann::json load_checkpoint_state(const LearnContext& c, const std::string& state_file, const nlohmann::json& run) {

@@ -87,7 +87,7 @@ TEST(WorldConfig, OutOfRangeFieldIsNamedWithValue) {
   EXPECT_THAT(error_for(j), HasSubstr("field \"physics.substeps\" must be in [1, 1000], got 0"));
   j = default_json();
   j["cup"]["radius"] = -0.05;
-  EXPECT_THAT(error_for(j), HasSubstr("field \"cup.radius\" must be > 0, got -0.05"));
+  EXPECT_THAT(error_for(j), HasSubstr("field \"cup.radius\" must be in (0, 100], got -0.05"));
   j = default_json();
   j["dice"]["corner_cut"] = 0.3;
   EXPECT_THAT(error_for(j), HasSubstr("dice.corner_cut"));
@@ -112,6 +112,83 @@ TEST(WorldConfig, ValidateRejectsBadStructs) {
   c = WorldConfig{};
   c.judge.success_hold_steps = 0;
   EXPECT_THROW(validate(c), ConfigError);
+}
+
+TEST(WorldConfig, ImpossiblePhysicsIsRefusedNamingTheField) {
+  auto j = default_json();
+  j["physics"]["gravity"] = {0.0, -1e30};
+  EXPECT_THAT(error_for(j), HasSubstr("field \"physics.gravity[1]\" must be in [-100, 100], got -1e+30"));
+  j = default_json();
+  j["dice"]["mass"] = 1e-300;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"dice.mass\" must be in [0.001, 1000], got 1e-300"));
+  j = default_json();
+  j["cup"]["friction"] = 1e9;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"cup.friction\" must be in [0, 10]"));
+}
+
+TEST(WorldConfig, DiceMustStartInsideTheWallsAndApart) {
+  auto j = default_json();
+  j["dice"]["start_x"] = {4.08, 4.51, 8.5};  // the shift of 0.5 pushes die 2 into the right wall
+  EXPECT_THAT(error_for(j), HasSubstr("field \"dice.start_x[2]\" puts die 2 outside the walls"));
+  j = default_json();
+  j["dice"]["start_x"] = {4.08, 4.30, 4.93};
+  EXPECT_THAT(error_for(j), HasSubstr("field \"dice.start_x[1]\" overlaps die 0"));
+  j = default_json();
+  j["dice"]["start_y"] = 0.9;  // inside the table
+  EXPECT_THAT(error_for(j), HasSubstr("field \"dice.start_y\" puts the dice outside the walls"));
+  j = default_json();
+  j["dice"]["half_size"] = 100.0;
+  j["dice"]["corner_cut"] = 1.0;
+  EXPECT_THAT(error_for(j), HasSubstr("puts die 0 outside the walls"));
+}
+
+TEST(WorldConfig, TheCupMustStartInsideTheWallsAtEveryShiftLiftAndTilt) {
+  auto j = default_json();
+  j["cup"]["start_anchor"] = {4.0, 6.0};  // the lift of 0.2 reaches the ceiling
+  EXPECT_THAT(error_for(j), HasSubstr("field \"cup.start_anchor\" puts the cup outside the walls"));
+  j = default_json();
+  j["randomization"]["shift"] = 4.0;
+  EXPECT_THAT(error_for(j), HasSubstr("outside the walls"));
+}
+
+TEST(WorldConfig, WritesVersionTwoAndReadsVersionOne) {
+  const auto j = default_json();
+  EXPECT_EQ(j.at("format"), "dicestack-world");
+  EXPECT_EQ(j.at("version"), 2);
+  auto v1 = j;  // version 1: no marker, the same fields
+  v1.erase("format");
+  v1.erase("version");
+  EXPECT_EQ(to_json(world_config_from_json(v1.dump(), "v1.json")), to_json(WorldConfig{}));
+}
+
+TEST(WorldConfig, NewerOrMalformedVersionsAreRefused) {
+  auto j = default_json();
+  j["version"] = 3;
+  EXPECT_THAT(error_for(j), HasSubstr("w.json: format version 3 is newer than this dicestack reads (2); upgrade dicestack"));
+  j["version"] = 1.5;
+  EXPECT_THAT(error_for(j), HasSubstr("field \"version\" must be a positive integer, got 1.5"));
+  j = default_json();
+  j["format"] = "dicestack-model";
+  EXPECT_THAT(error_for(j), HasSubstr("field \"format\" must be \"dicestack-world\""));
+  j = default_json();
+  j.erase("version");
+  EXPECT_THAT(error_for(j), HasSubstr("field \"version\" is missing"));
+}
+
+TEST(WorldConfig, LongValuesAreCutInMessages) {
+  auto j = default_json();
+  j["dice"]["mass"] = std::string(100000, 'x');
+  const std::string msg = error_for(j);
+  EXPECT_THAT(msg, HasSubstr("field \"dice.mass\" must be a number"));
+  EXPECT_LT(msg.size(), 300u);
+}
+
+TEST(WorldConfig, HashIsTheWorldsIdentityNotItsFileFormat) {
+  // The value every cache name and checkpoint recorded before the format had a version.
+  EXPECT_EQ(world_hash(WorldConfig{}) >> 32, 0x3f53a1beULL);
+  WorldConfig c;
+  c.dice.mass = 2.0;
+  EXPECT_NE(world_hash(c), world_hash(WorldConfig{}));
 }
 
 }  // namespace

@@ -122,15 +122,22 @@ struct WorldConfig {
 };
 
 /// Throws ConfigError naming the first field that is out of range, e.g.
-/// `world config: field "physics.substeps" must be >= 1, got 0`.
+/// `world config: field "physics.substeps" must be >= 1, got 0`, or whose start does not fit:
+/// dice and cup inside the walls and the dice apart at every shift, jitter, lift and tilt.
 void validate(const WorldConfig& config);
 
-/// Parses JSON text; every field must be present, of the right type, finite and in range.
-/// `source` names the text in messages (a path, or "<string>"). Throws ConfigError.
+/// Parses JSON text; every field must be present, of the right type, finite and in range, and
+/// the start must fit inside the walls. Reads format versions 1 (no marker) and 2 ("format":
+/// "dicestack-world", "version": 2); docs/formats.md. `source` names the text in messages (a
+/// path, or "<string>"). Throws ConfigError.
 WorldConfig world_config_from_json(std::string_view text, std::string_view source = "<string>");
 
-/// Pretty-printed JSON holding every field.
+/// Pretty-printed JSON holding the format marker, the version and every field.
 std::string to_json(const WorldConfig& config);
+
+/// FNV-1a of the fields alone (not the format version): the world's identity in cache names,
+/// checkpoints and snapshots, unchanged when only the file format moves on.
+std::uint64_t world_hash(const WorldConfig& config);
 
 /// Reads a JSON file; throws InputError if unreadable, ConfigError if invalid.
 WorldConfig load_world_config(const std::filesystem::path& path);
