@@ -2,7 +2,9 @@
 // What the iterative learners (DAgger, DaD) share: the checkpoint of a finished iteration (the
 // aggregated data as a demonstration folder, then a small JSON state that points at it) and
 // the measurement of a policy that goes into the learning curve.
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,10 +15,9 @@
 namespace dicestack {
 
 nlohmann::json curve_to_json(const std::vector<CurvePoint>& curve);
-std::vector<CurvePoint> curve_from_json(const nlohmann::json& json);
 
-/// Writes `data` to dir/data-<iteration>, then `state` (plus "iteration" and "data") to
-/// dir/<state_file> (with "format": "dicestack-checkpoint"), both atomically and in that order,
+/// Writes `data` to dir/data-<iteration>, then `state` (plus "format": "dicestack-checkpoint",
+/// "version", "iteration" and "data") to dir/<state_file>, both atomically and in that order,
 /// then removes older data-<integer> folders that are dicestack demonstration sets (never a
 /// user's data-notes/): the state always names complete data of its own iteration.
 void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::json state, const std::string& state_file,
@@ -25,20 +26,43 @@ void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::
 /// Removes DaD's earlier best-<integer>.model files in `dir` that are dicestack models, except `keep`.
 void remove_old_best_models(const std::filesystem::path& dir, const std::string& keep);
 
-/// The aggregated data a checkpoint state names.
-std::vector<Episode> load_checkpoint_data(const LearnContext& context, const nlohmann::json& state);
-
 /// What a run was started with: regressor and its settings, feature map, seed, learner options
 /// but `extendable` (options a resumed run may change, e.g. DAgger's round count: more rounds
 /// continue the same run). Saved in every checkpoint state under "run"; a resumed run must match it.
 nlohmann::json run_settings(const LearnContext& context, const Params& learner_params,
                             const std::vector<std::string>& extendable = {});
 
-/// The state of the last finished iteration, or null when there is none to resume from. Throws
-/// InputError naming each setting that differs from the checkpoint's "run" (with both values):
-/// resuming with other options would give a model that matches neither run.
-nlohmann::json load_checkpoint_state(const LearnContext& context, const std::string& state_file,
-                                     const nlohmann::json& run);
+/// A checkpoint state as read back: the common fields checked, the learner's own fields read
+/// through checked accessors that throw InputError naming the file and the field.
+class CheckpointState {
+ public:
+  CheckpointState(std::filesystem::path path, nlohmann::json json);
+
+  int iteration() const { return iteration_; }
+  const std::vector<CurvePoint>& curve() const { return curve_; }
+  /// The aggregated data the state names (dir/data-<iteration>).
+  std::vector<Episode> data() const;
+
+  std::int64_t integer(const std::string& key, std::int64_t lo, std::int64_t hi) const;
+  double number(const std::string& key) const;
+  /// A file name inside the checkpoint folder (no separator, not "." or "..").
+  std::filesystem::path file(const std::string& key) const;
+
+ private:
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+  std::filesystem::path path_;
+  nlohmann::json json_;
+  int iteration_ = 0;
+  std::vector<CurvePoint> curve_;
+};
+
+/// The state of the last finished iteration, or nothing when there is none to resume from.
+/// Throws InputError for a state that is not ours, of a newer version or malformed, and naming
+/// each setting that differs from the checkpoint's "run" (with both values): resuming with
+/// other options would give a model that matches neither run.
+std::optional<CheckpointState> load_checkpoint_state(const LearnContext& context, const std::string& state_file,
+                                                     const nlohmann::json& run);
 
 /// A curve point for `model`: rolled out from the held-out demonstrations' first states, or
 /// from `fallback`'s when there are none.

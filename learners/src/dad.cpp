@@ -53,15 +53,15 @@ class Dad final : public Learner {
     double best_deviation = 0.0;
     int best_iteration = 0, first = 1;
     std::size_t corrections = 0, filtered = 0;
-    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params())); !state.is_null()) {
-      first = state.at("iteration").get<int>() + 1;
-      data = load_checkpoint_data(c, state);
-      result.curve = curve_from_json(state.at("curve"));
-      best_iteration = state.at("best_iteration");
-      best_deviation = state.at("best_deviation");
-      best = std::make_shared<Model>(load_model(c.checkpoint_dir / state.at("best_model").get<std::string>(), *c.registry));
-      corrections = state.at("corrections_kept");
-      filtered = state.at("corrections_filtered");
+    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params()))) {
+      first = state->iteration() + 1;
+      data = state->data();
+      result.curve = state->curve();
+      best_iteration = static_cast<int>(state->integer("best_iteration", 0, state->iteration()));
+      best_deviation = state->number("best_deviation");
+      best = std::make_shared<Model>(load_model(c.checkpoint_dir / state->file("best_model"), *c.registry));
+      corrections = static_cast<std::size_t>(state->integer("corrections_kept", 0, INT64_MAX));
+      filtered = static_cast<std::size_t>(state->integer("corrections_filtered", 0, INT64_MAX));
     }
     std::shared_ptr<Model> model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
     if (first == 1) {

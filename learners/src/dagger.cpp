@@ -33,10 +33,10 @@ class Dagger final : public Learner {
     std::shared_ptr<Model> model;
     LearnResult result;
     int first = 1;
-    if (const auto state = load_checkpoint_state(c, "dagger.json", run_settings(c, params(), extendable())); !state.is_null()) {
-      first = state.at("iteration").get<int>() + 1;
-      data = load_checkpoint_data(c, state);
-      result.curve = curve_from_json(state.at("curve"));
+    if (const auto state = load_checkpoint_state(c, "dagger.json", run_settings(c, params(), extendable()))) {
+      first = state->iteration() + 1;
+      data = state->data();
+      result.curve = state->curve();
     }
     if (!data.empty()) model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
 

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/dataset.hpp>
@@ -228,6 +230,42 @@ TEST(Checkpoint, CleanupRemovesOnlyOurOwnOlderDataFolders) {
   EXPECT_TRUE(std::filesystem::exists(c.checkpoint_dir / "data-7" / "notes.txt")) << "not a dicestack set: kept";
   EXPECT_FALSE(std::filesystem::exists(c.checkpoint_dir / "data-1")) << "our own older data is removed";
   EXPECT_EQ(read_demo_set(c.checkpoint_dir / "data-2").episodes.size(), 4u);
+  std::filesystem::remove_all(c.checkpoint_dir);
+}
+
+TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
+  LearnContext c = small_context(2);
+  c.checkpoint_dir = std::filesystem::temp_directory_path() / ("dicestack_checkpoint_edit_" + std::to_string(getpid()));
+  std::filesystem::remove_all(c.checkpoint_dir);
+  const std::vector<std::string> options{"iterations=1", "rollouts=2", "beta=1", "include_demos=false", "expert=scripted"};
+  LearnerRegistry::global().create("dagger", options)->learn(c);
+  const auto path = c.checkpoint_dir / "dagger.json";
+  nlohmann::json saved;
+  std::ifstream(path) >> saved;
+  EXPECT_EQ(saved.at("version"), 2);
+  c.resume = true;
+  auto resume_with = [&](const nlohmann::json& state) {
+    { std::ofstream(path) << state.dump(); }
+    return test::error_of([&] { LearnerRegistry::global().create("dagger", options)->learn(c); });
+  };
+  auto edited = [&](const std::string& pointer, const nlohmann::json& value) {
+    nlohmann::json j = saved;
+    j[nlohmann::json::json_pointer(pointer)] = value;
+    return resume_with(j);
+  };
+  using ::testing::HasSubstr;
+  EXPECT_THAT(edited("/version", 3), HasSubstr("dagger.json: format version 3 is newer than this dicestack reads (2)"));
+  EXPECT_THAT(edited("/version", 1.5), HasSubstr("dagger.json: field \"version\" must be an integer"));
+  EXPECT_THAT(edited("/iteration", "one"), HasSubstr("field \"iteration\" must be an integer in [0, 1000000], got \"one\""));
+  EXPECT_THAT(edited("/iteration", -1), HasSubstr("field \"iteration\""));
+  EXPECT_THAT(edited("/data", "../../etc"), HasSubstr("field \"data\" must be a file name inside the checkpoint folder"));
+  EXPECT_THAT(edited("/data", "data-7"), HasSubstr("field \"data\" must name this iteration's folder \"data-1\""));
+  EXPECT_THAT(edited("/curve/0/deviation", "x"), HasSubstr("field \"curve[0].deviation\" must be a finite number"));
+  EXPECT_THAT(edited("/curve", 5), HasSubstr("field \"curve\" must be an array"));
+  EXPECT_THAT(edited("/format", "dicestack-model"), HasSubstr("dagger.json: not a checkpoint state"));
+  nlohmann::json v1 = saved;  // version 1: the same state without "version"
+  v1.erase("version");
+  EXPECT_EQ(resume_with(v1), "");
   std::filesystem::remove_all(c.checkpoint_dir);
 }
 

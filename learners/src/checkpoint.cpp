@@ -1,0 +1,190 @@
+#include "checkpoint.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/evaluate.hpp>
+
+namespace dicestack {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormat = "dicestack-checkpoint";
+// 1: the same fields without "version" (and, before the marker, without "format"); 2: adds "version".
+constexpr int kVersion = 2;
+
+// "data-<digits>" or "best-<digits>.model" (suffix empty or ".model").
+bool numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
+  if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0) return false;
+  if (name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) return false;
+  for (std::size_t i = prefix.size(); i < name.size() - suffix.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
+  return true;
+}
+
+std::string excerpt(const json& j) {
+  const std::string text = j.dump();
+  return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+}
+
+}  // namespace
+
+json curve_to_json(const std::vector<CurvePoint>& curve) {
+  json out = json::array();
+  for (const auto& p : curve)
+    out.push_back({{"iteration", p.iteration}, {"window", p.window}, {"dataset_rows", p.dataset_rows},
+                   {"deviation", p.deviation}, {"stacked_rate", p.stacked_rate},
+                   {"realistic_success_rate", p.realistic_success_rate}, {"dice_in_cup_mean", p.dice_in_cup_mean}});
+  return out;
+}
+
+void save_checkpoint(const fs::path& dir, int iteration, json state, const std::string& state_file,
+                     const LearnContext& c, const std::vector<Episode>& data, const std::string& description) {
+  fs::create_directories(dir);
+  DemoSet set;
+  set.world = c.world;
+  set.description = description;
+  set.provenance = "dicestack " + description + ", seed " + std::to_string(c.seed) + ", regressor " + c.regressor;
+  set.episodes = data;
+  const std::string folder = "data-" + std::to_string(iteration);
+  write_demo_set(set, dir / folder);
+  state["format"] = kFormat;
+  state["version"] = kVersion;
+  state["iteration"] = iteration;
+  state["data"] = folder;
+  AtomicFile f(dir / state_file, Ownership::json_object("dicestack checkpoint state", kFormat, {"iteration", "data"}));
+  f.stream() << state.dump();
+  f.commit();
+  for (const auto& entry : fs::directory_iterator(dir)) {  // older iterations' data, now unreferenced
+    const std::string name = entry.path().filename().string();
+    if (name != folder && numbered(name, "data-", "") && is_own_demo_set(entry.path())) fs::remove_all(entry.path());
+  }
+}
+
+void remove_old_best_models(const fs::path& dir, const std::string& keep) {
+  const Ownership model = model_ownership();
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name != keep && numbered(name, "best-", ".model") && entry.is_regular_file() && model.recognises(entry.path()))
+      fs::remove(entry.path());
+  }
+}
+
+json run_settings(const LearnContext& c, const Params& learner_params, const std::vector<std::string>& extendable) {
+  std::string sets, options;
+  for (const auto& s : c.regressor_sets) sets += (sets.empty() ? "" : " ") + s;
+  for (const auto& [key, value] : learner_params.as_text())
+    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end())
+      options += (options.empty() ? "" : ", ") + key + "=" + value;
+  return {{"regressor", c.regressor},
+          {"regressor_sets", sets},
+          {"features", c.features},
+          {"seed", std::to_string(c.seed)},
+          {"learner_options", options},
+          {"demonstrations", std::to_string(c.demos.size())},
+          {"held_out", std::to_string(c.held_out.size())},
+          {"world", std::to_string(world_hash(c.world))}};
+}
+
+CheckpointState::CheckpointState(fs::path path, json state) : path_(std::move(path)), json_(std::move(state)) {
+  // States written before the marker (dicestack 0.3) hold "iteration" and "data" without it.
+  const bool marked = json_.is_object() && json_.value("format", json()) == kFormat;
+  if (!marked && !(json_.is_object() && !json_.contains("format") && json_.contains("iteration") && json_.contains("data")))
+    throw InputError(path_.string() + ": not a checkpoint state (no \"format\": \"" + kFormat + "\")");
+  const std::int64_t version = json_.contains("version") ? integer("version", 1, INT64_MAX) : 1;
+  if (version > kVersion)
+    throw InputError(path_.string() + ": format version " + std::to_string(version) + " is newer than this dicestack reads (" +
+                     std::to_string(kVersion) + "); upgrade dicestack");
+  iteration_ = static_cast<int>(integer("iteration", 0, 1'000'000));
+  if (file("data").string() != "data-" + std::to_string(iteration_))
+    fail("data", "must name this iteration's folder \"data-" + std::to_string(iteration_) + "\"");
+  if (!json_.contains("curve") || !json_["curve"].is_array()) fail("curve", "must be an array");
+  for (std::size_t i = 0; i < json_["curve"].size(); ++i) {
+    const json& p = json_["curve"][i];
+    const std::string at = "curve[" + std::to_string(i) + "]";
+    auto get = [&](const char* key, bool whole) {
+      const json v = p.is_object() ? p.value(key, json()) : json();
+      if (!v.is_number() || !std::isfinite(v.get<double>()) || (whole && (!v.is_number_integer() || v.get<std::int64_t>() < 0)))
+        fail(at + "." + key, std::string("must be a ") + (whole ? "non-negative integer" : "finite number") + ", got " + excerpt(v));
+      return v;
+    };
+    curve_.push_back({get("iteration", true).get<int>(), get("window", true).get<int>(),
+                      get("dataset_rows", true).get<std::size_t>(), get("deviation", false).get<double>(),
+                      get("stacked_rate", false).get<double>(), get("realistic_success_rate", false).get<double>(),
+                      get("dice_in_cup_mean", false).get<double>()});
+  }
+}
+
+void CheckpointState::fail(const std::string& key, const std::string& what) const {
+  throw InputError(path_.string() + ": field \"" + key + "\" " + what);
+}
+
+std::int64_t CheckpointState::integer(const std::string& key, std::int64_t lo, std::int64_t hi) const {
+  const json v = json_.value(key, json());
+  if (!v.is_number_integer() || (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX)) ||
+      v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi)
+    fail(key, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + excerpt(v));
+  return v.get<std::int64_t>();
+}
+
+double CheckpointState::number(const std::string& key) const {
+  const json v = json_.value(key, json());
+  if (!v.is_number() || !std::isfinite(v.get<double>())) fail(key, "must be a finite number, got " + excerpt(v));
+  return v.get<double>();
+}
+
+fs::path CheckpointState::file(const std::string& key) const {
+  const json v = json_.value(key, json());
+  if (!v.is_string()) fail(key, "must be a file name, got " + excerpt(v));
+  const std::string name = v.get<std::string>();
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name.find('\0') != std::string::npos)
+    fail(key, "must be a file name inside the checkpoint folder, got " + excerpt(v));
+  return name;
+}
+
+std::vector<Episode> CheckpointState::data() const { return read_demo_set(path_.parent_path() / file("data")).episodes; }
+
+std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, const std::string& state_file, const json& run) {
+  if (!c.resume || c.checkpoint_dir.empty() || !fs::exists(c.checkpoint_dir / state_file)) return std::nullopt;
+  const fs::path path = c.checkpoint_dir / state_file;
+  json state;
+  try {
+    state = parse_json_limited<json>(std::ifstream(path), path.string());
+  } catch (const json::exception& e) {
+    throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
+  }
+  CheckpointState checked(path, state);
+  if (state.contains("run") && !state["run"].is_object())
+    throw InputError(path.string() + ": field \"run\" must be an object");
+  if (state.contains("run")) {  // states written before runs were recorded have none to compare
+    std::string differences;
+    for (const auto& [key, value] : run.items()) {
+      const json saved = state["run"].value(key, json());
+      if (saved != value)
+        differences += (differences.empty() ? "" : "; ") + key + " " + excerpt(saved) + " in the checkpoint, " +
+                       value.dump() + " in this run";
+    }
+    if (!differences.empty())
+      throw InputError(path.string() + ": cannot resume a run made with other settings: " + differences +
+                       " (use the same settings, or another --checkpoint)");
+  }
+  return checked;
+}
+
+CurvePoint measure_policy(const std::shared_ptr<const Model>& model, const LearnContext& c,
+                          const std::vector<Episode>& fallback, int iteration, std::size_t rows) {
+  const auto& demos = c.held_out.empty() ? fallback : c.held_out;
+  const Tracking t = track_demos([&] { return std::make_unique<ModelPolicy>(model); }, demos, c.world, c.threads);
+  return {iteration, 0, rows, t.deviation, t.stats.stacked.value, t.stats.realistic_success.value, t.stats.dice_in_cup_mean};
+}
+
+}  // namespace dicestack
