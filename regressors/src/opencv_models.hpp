@@ -47,8 +47,11 @@ std::string save_all(const std::vector<cv::Ptr<T>>& models) {
   return j.dump();
 }
 
+/// Reads the models of a payload; `check`, if given, sees each model's file first (with its
+/// index) and throws for counts OpenCV's reader would silently pad or cut.
 template <class T>
-std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, const std::string& who) {
+std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, const std::string& who,
+                                 const std::function<void(const cv::FileNode&, std::size_t)>& check = {}) {
   nlohmann::json j;
   try {
     j = parse_json_limited<nlohmann::json>(payload, who + ": model payload");
@@ -62,6 +65,7 @@ std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, 
     if (!text.is_string()) throw InputError(who + ": model payload holds a non-text model");
     models.push_back(guarded(who, [&] {
       cv::FileStorage fs(text.get<std::string>(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+      if (check) check(fs.root(), models.size());
       cv::Ptr<T> m = T::create();
       m->read(fs.root());
       if (!m->isTrained()) throw InputError(who + ": a stored model is empty");

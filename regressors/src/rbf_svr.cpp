@@ -1,3 +1,5 @@
+#include <cmath>
+
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/regressors/registry.hpp>
 
@@ -67,9 +69,10 @@ class RbfSvr final : public Regressor {
       k.sv.resize(sv.rows, sv.cols);
       for (int i = 0; i < sv.rows; ++i)
         for (int j = 0; j < sv.cols; ++j) k.sv(i, j) = sv.at<float>(i, j);
-      k.alpha.resize(sv.rows);
+      // Coefficient i belongs to support vector index[i] (the identity in OpenCV's regression).
+      k.alpha = Eigen::VectorXf::Zero(sv.rows);
       alpha.convertTo(alpha, CV_32F);
-      for (int i = 0; i < sv.rows; ++i) k.alpha[i] = alpha.at<float>(0, index.empty() ? i : index.at<int>(0, i));
+      for (int i = 0; i < alpha.cols; ++i) k.alpha[index.empty() ? i : index.at<int>(0, i)] += alpha.at<float>(0, i);
       k.sv_norm2 = k.sv.rowwise().squaredNorm();
       kernels_.push_back(std::move(k));
     }
@@ -90,9 +93,59 @@ class RbfSvr final : public Regressor {
     }
   }
   std::string do_save() const override { return opencv::save_all(models_); }
-  void do_load(std::string_view payload, std::size_t, std::size_t outputs) override {
-    models_ = opencv::load_all<cv::ml::SVM>(payload, outputs, name());
+  void do_load(std::string_view payload, std::size_t inputs, std::size_t outputs) override {
+    auto models = opencv::load_all<cv::ml::SVM>(payload, outputs, name(), [&](const cv::FileNode& root, std::size_t j) {
+      check_counts(root, j);
+    });
+    for (std::size_t j = 0; j < models.size(); ++j) check_loaded(*models[j], j, inputs);
+    models_ = std::move(models);
     prepare();
+  }
+
+  // The counts the file states against the lists it holds: OpenCV pads a short coefficient
+  // list with zeros and ignores extra support vectors.
+  void check_counts(const cv::FileNode& root, std::size_t j) const {
+    const std::string who = name() + ": model payload, model " + std::to_string(j) + ": ";
+    const cv::FileNode sv = root["support_vectors"], df = root["decision_functions"];
+    if (!root["sv_total"].isInt() || !sv.isSeq() || static_cast<std::size_t>(static_cast<int>(root["sv_total"])) != sv.size())
+      throw InputError(who + "\"sv_total\" must be an integer equal to the number of support vectors (" +
+                       std::to_string(sv.size()) + ")");
+    if (!df.isSeq() || df.size() != 1) throw InputError(who + "must hold one decision function");
+    const cv::FileNode f = df[0];
+    if (!f["sv_count"].isInt() || !f["alpha"].isSeq() || static_cast<int>(f["sv_count"]) != static_cast<int>(sv.size()) ||
+        f["alpha"].size() != sv.size())
+      throw InputError(who + "\"sv_count\" and \"alpha\" must both count the " + std::to_string(sv.size()) +
+                       " support vectors");
+  }
+
+  // What prepare() and the kernel sum rely on, checked against the counts OpenCV read: an
+  // epsilon-SVR with an RBF kernel, support vectors as wide as the input, one coefficient per
+  // support vector, indices in range, every number finite.
+  void check_loaded(const cv::ml::SVM& m, std::size_t j, std::size_t inputs) const {
+    const std::string who = name() + ": model payload, model " + std::to_string(j) + ": ";
+    if (m.getType() != cv::ml::SVM::EPS_SVR || m.getKernelType() != cv::ml::SVM::RBF)
+      throw InputError(who + "is not an epsilon-SVR with an RBF kernel");
+    const double gamma = m.getGamma();
+    if (!std::isfinite(gamma) || gamma <= 0.0) throw InputError(who + "gamma must be a positive finite number");
+    const cv::Mat sv = m.getSupportVectors();
+    if (sv.empty() || sv.type() != CV_32F || sv.cols != static_cast<int>(inputs))
+      throw InputError(who + "holds " + std::to_string(sv.cols) + "-wide support vectors, expected " + std::to_string(inputs));
+    if (!cv::checkRange(sv)) throw InputError(who + "holds a support vector with NaN or infinity");
+    cv::Mat alpha, index;
+    const double rho = opencv::guarded(name(), [&] { return m.getDecisionFunction(0, alpha, index); });
+    if (!std::isfinite(rho)) throw InputError(who + "rho must be finite");
+    if (alpha.empty() || alpha.rows != 1 || (alpha.type() != CV_64F && alpha.type() != CV_32F))
+      throw InputError(who + "holds no coefficient row");
+    // A regression's single decision function uses every support vector once.
+    const int count = sv.rows;
+    if (alpha.cols != count || (!index.empty() && (index.rows != 1 || index.cols != count || index.type() != CV_32S)))
+      throw InputError(who + "holds " + std::to_string(alpha.cols) + " coefficients for " + std::to_string(count) +
+                       " support vectors");
+    for (int i = 0; !index.empty() && i < index.cols; ++i)
+      if (index.at<int>(0, i) < 0 || index.at<int>(0, i) >= sv.rows)
+        throw InputError(who + "support vector index " + std::to_string(index.at<int>(0, i)) + " is out of range (" +
+                         std::to_string(sv.rows) + " vectors)");
+    if (!cv::checkRange(alpha)) throw InputError(who + "holds a coefficient with NaN or infinity");
   }
 
   std::vector<cv::Ptr<cv::ml::SVM>> models_;

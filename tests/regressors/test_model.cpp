@@ -141,6 +141,47 @@ TEST(ModelFile, MatrixPayloadShapesAreCheckedBeforeAllocating) {
   }
 }
 
+TEST(ModelFile, RbfSvrPayloadCountsAreChecked) {
+  const Matrix x = random_rows(40, 4, 9);
+  auto r = RegressorRegistry::global().create("rbf_svr");
+  r->fit(x, labels(x), 1);
+  const std::string payload = r->save_payload();
+  auto load = [&](const std::string& text, std::size_t inputs) {
+    return test::error_of([&] { RegressorRegistry::global().create("rbf_svr")->load_payload(text, inputs, 3); });
+  };
+  EXPECT_EQ(load(payload, 4), "");
+  EXPECT_THAT(load(payload, 24), HasSubstr("rbf_svr: model payload, model 0: holds 4-wide support vectors, expected 24"));
+  // Each YAML model edited inside its JSON string: counts that disagree with what follows.
+  auto edited = [&](const std::string& from, const std::string& to) {
+    nlohmann::json j = nlohmann::json::parse(payload);
+    std::string yaml = j["models"][0];
+    const auto at = yaml.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+    j["models"][0] = yaml;
+    return load(j.dump(), 4);
+  };
+  const auto sv_count = [&] {
+    const std::string yaml = nlohmann::json::parse(payload)["models"][0];
+    const auto at = yaml.find("sv_count: ");
+    return yaml.substr(at, yaml.find('\n', at) - at);
+  }();
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {sv_count, "sv_count: 2"}, {sv_count, "sv_count: 100000"}, {"var_count: 4", "var_count: 3"},
+           {"var_count: 4", "var_count: 9"}, {"kernel:\n   type: RBF", "kernel:\n   type: LINEAR"},
+           {"svmType: EPS_SVR", "svmType: NU_SVR"}}) {
+    const std::string error = edited(from, to);
+    EXPECT_THAT(error, HasSubstr("rbf_svr")) << from << " -> " << to;
+  }
+  const std::string sv_total = [&] {
+    const std::string yaml = nlohmann::json::parse(payload)["models"][0];
+    const auto at = yaml.find("sv_total: ");
+    return yaml.substr(at, yaml.find('\n', at) - at);
+  }();
+  EXPECT_THAT(edited(sv_total, "sv_total: 100000"), HasSubstr("rbf_svr"));
+  EXPECT_THAT(edited(sv_total, "sv_total: 1"), HasSubstr("rbf_svr"));
+}
+
 TEST(ModelFile, VersionOneReadsAsTheStateMap) {
   const Matrix x = random_rows(200, 24, 4);
   const Model m = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
