@@ -18,9 +18,11 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 const fs::path kData = fs::path(DICESTACK_TEST_DATA);
+// The bad-input corpus (tests/corpus): each demonstration case's set is in <case>/set.
+const fs::path kBadSets = fs::path(DICESTACK_SOURCE_DIR) / "tests" / "corpus" / "demos";
 
 std::string read_error(const std::string& bad) {
-  return test::error_of([&] { read_demo_set(kData / "bad" / bad); });
+  return test::error_of([&] { read_demo_set(kBadSets / bad / "set"); });
 }
 
 TEST(DemoSet, ReadsAValidSet) {
@@ -131,7 +133,7 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("steps_fraction"), HasSubstr("\"steps\" must be an unsigned integer, got 3.5"));
   EXPECT_THAT(read_error("seed_negative"), HasSubstr("\"seed\" must be an unsigned integer, got -1"));
   EXPECT_THAT(read_error("file_escapes"), HasSubstr("\"file\" must name a file inside the folder, got \"../good/episode_0000.csv\""));
-  EXPECT_THROW(read_demo_set(kData / "bad" / "nan"), InputError);
+  EXPECT_THROW(read_demo_set(kBadSets / "nan" / "set"), InputError);
 }
 
 fs::path unique_dir(const std::string& name) {
