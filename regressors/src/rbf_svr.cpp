@@ -1,3 +1,6 @@
+#include <cmath>
+#include <set>
+
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/regressors/registry.hpp>
 
@@ -5,6 +8,44 @@
 
 namespace dicestack {
 namespace {
+
+// A stored model, checked before OpenCV's SVM::read sees it: that reader trusts its counts (a
+// negative sv_count resizes a vector to 2^64 - 1 entries, a large var_count allocates
+// gigabytes) and reads keys an RBF epsilon-SVR never has (class weights as whole matrices).
+void check_stored_svm(const cv::FileNode& n, std::size_t inputs, const std::string& where) {
+  auto fail = [&](const std::string& what) { throw InputError(where + ": " + what); };
+  auto is_number = [](const cv::FileNode& v) { return v.isInt() || v.isReal(); };
+  if (!n.isMap()) fail("is not an OpenCV model");
+  static const std::set<std::string> known{"format", "svmType", "kernel", "C", "p", "term_criteria",
+                                           "var_count", "sv_total", "support_vectors", "decision_functions"};
+  for (const auto& key : n.keys())
+    if (!known.contains(key)) fail("has \"" + key.substr(0, 40) + "\", which an RBF epsilon-SVR never has");
+  if (n["svmType"].string() != "EPS_SVR") fail("\"svmType\" must be EPS_SVR");
+  const cv::FileNode kernel = n["kernel"];
+  if (!kernel.isMap() || kernel["type"].string() != "RBF" || !is_number(kernel["gamma"]))
+    fail("\"kernel\" must be RBF with a gamma");
+  if (!n["var_count"].isInt() || static_cast<int>(n["var_count"]) != static_cast<int>(inputs))
+    fail("\"var_count\" must be " + std::to_string(inputs) + " (the header's input width)");
+  const cv::FileNode svs = n["support_vectors"];
+  const int total = n["sv_total"].isInt() ? static_cast<int>(n["sv_total"]) : -1;
+  if (!svs.isSeq() || total < 1 || svs.size() != static_cast<std::size_t>(total))
+    fail("\"sv_total\" must be the number of support vectors listed (at least 1)");
+  for (const auto& sv : svs) {
+    if (!sv.isSeq() || sv.size() != inputs) fail("a support vector does not hold " + std::to_string(inputs) + " numbers");
+    for (const auto& v : sv)
+      if (!is_number(v)) fail("a support vector holds something that is not a number");
+  }
+  const cv::FileNode dfs = n["decision_functions"];
+  if (!dfs.isSeq() || dfs.size() != 1) fail("\"decision_functions\" must hold exactly one function");
+  const cv::FileNode df = dfs[0];
+  if (!df.isMap() || !df["sv_count"].isInt() || static_cast<int>(df["sv_count"]) != total || !is_number(df["rho"]))
+    fail("the decision function must have sv_count = sv_total and a rho");
+  const cv::FileNode alpha = df["alpha"];
+  if (!alpha.isSeq() || alpha.size() != static_cast<std::size_t>(total))
+    fail("the decision function must hold one alpha per support vector");
+  for (const auto& v : alpha)
+    if (!is_number(v)) fail("an alpha is not a number");
+}
 
 class RbfSvr final : public Regressor {
  public:
@@ -43,7 +84,7 @@ class RbfSvr final : public Regressor {
       });
     });
     models_ = std::move(models);
-    prepare();
+    prepare(static_cast<std::size_t>(x.cols()));
   }
 
   // OpenCV evaluates the kernel sample by sample; the same float sum over the support vectors
@@ -56,14 +97,29 @@ class RbfSvr final : public Regressor {
     float gamma = 0.0f;
   };
 
-  void prepare() {
-    kernels_.clear();
-    for (const auto& m : models_) {
+  // Also checks what a stored model gave OpenCV: shapes, and finite numbers within float range.
+  void prepare(std::size_t inputs) {
+    std::vector<Kernel> kernels;
+    for (std::size_t o = 0; o < models_.size(); ++o) opencv::guarded(name() + ": model " + std::to_string(o), [&] {
+      const cv::ml::SVM& m = *models_[o];
+      auto fail = [&](const std::string& what) { throw InputError(name() + ": model " + std::to_string(o) + ": " + what); };
       Kernel k;
-      const cv::Mat sv = m->getSupportVectors();
+      const cv::Mat sv = m.getSupportVectors();
+      if (sv.type() != CV_32F || sv.rows < 1 || sv.cols != static_cast<int>(inputs) || !cv::checkRange(sv))
+        fail("support vectors must be finite " + std::to_string(inputs) + "-wide rows");
       cv::Mat alpha, index;
-      k.rho = static_cast<float>(m->getDecisionFunction(0, alpha, index));
-      k.gamma = static_cast<float>(m->getGamma());
+      const double rho = m.getDecisionFunction(0, alpha, index), gamma = m.getGamma();
+      auto is_float = [](double v) { return std::isfinite(v) && std::abs(v) <= 3e38; };
+      if (!is_float(rho) || !is_float(gamma) || !(gamma > 0.0)) fail("rho and gamma must be finite and gamma > 0");
+      if (alpha.type() != CV_64F || alpha.total() != static_cast<std::size_t>(sv.rows) ||
+          (!index.empty() && (index.type() != CV_32S || index.total() != alpha.total())))
+        fail("the decision function must hold one alpha per support vector");
+      for (std::size_t i = 0; i < alpha.total(); ++i)
+        if (!is_float(alpha.at<double>(0, static_cast<int>(i))) ||
+            (!index.empty() && (index.at<int>(0, static_cast<int>(i)) < 0 || index.at<int>(0, static_cast<int>(i)) >= sv.rows)))
+          fail("alpha " + std::to_string(i) + " or its support vector index is out of range");
+      k.rho = static_cast<float>(rho);
+      k.gamma = static_cast<float>(gamma);
       k.sv.resize(sv.rows, sv.cols);
       for (int i = 0; i < sv.rows; ++i)
         for (int j = 0; j < sv.cols; ++j) k.sv(i, j) = sv.at<float>(i, j);
@@ -71,8 +127,9 @@ class RbfSvr final : public Regressor {
       alpha.convertTo(alpha, CV_32F);
       for (int i = 0; i < sv.rows; ++i) k.alpha[i] = alpha.at<float>(0, index.empty() ? i : index.at<int>(0, i));
       k.sv_norm2 = k.sv.rowwise().squaredNorm();
-      kernels_.push_back(std::move(k));
-    }
+      kernels.push_back(std::move(k));
+    });
+    kernels_ = std::move(kernels);
   }
 
   void do_predict_row(std::span<const double> x, std::span<double> y) const override {
@@ -90,9 +147,11 @@ class RbfSvr final : public Regressor {
     }
   }
   std::string do_save() const override { return opencv::save_all(models_); }
-  void do_load(std::string_view payload, std::size_t, std::size_t outputs) override {
-    models_ = opencv::load_all<cv::ml::SVM>(payload, outputs, name());
-    prepare();
+  void do_load(std::string_view payload, std::size_t inputs, std::size_t outputs) override {
+    models_ = opencv::load_all<cv::ml::SVM>(payload, outputs, name(), [&](const cv::FileNode& n, const std::string& where) {
+      check_stored_svm(n, inputs, where);
+    });
+    prepare(inputs);
   }
 
   std::vector<cv::Ptr<cv::ml::SVM>> models_;
