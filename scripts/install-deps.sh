@@ -22,6 +22,7 @@ packages=(
   libgif-dev              # GIF output of `dicestack render`
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xdotool            # the headless test of `dicestack play`
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ and libFuzzer
 )
 
 if [ "${1:-}" = "--python" ]; then

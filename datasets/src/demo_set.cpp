@@ -223,17 +223,19 @@ std::vector<std::string> episode_csv_columns() {
 }
 
 Episode read_episode_csv(const fs::path& file) {
-  const std::string text = read_file(file);
-  const std::string where = file.string();
+  return parse_episode_csv(read_file(file), file.string(), file.stem().string());
+}
+
+Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name) {
   const auto columns = episode_csv_columns();
   Episode e;
-  e.name = file.stem().string();
+  e.name = std::move(name);
   std::vector<std::string_view> fields;
   std::size_t line_no = 0, pos = 0;
   while (pos < text.size()) {
     const auto nl = text.find('\n', pos);
-    const std::string_view line(text.data() + pos, (nl == std::string::npos ? text.size() : nl) - pos);
-    pos = nl == std::string::npos ? text.size() : nl + 1;
+    const std::string_view line = text.substr(pos, (nl == std::string_view::npos ? text.size() : nl) - pos);
+    pos = nl == std::string_view::npos ? text.size() : nl + 1;
     ++line_no;
     const std::string prefix = where + ":" + std::to_string(line_no) + ": ";
     if (trim(line).empty()) {
@@ -253,7 +255,7 @@ Episode read_episode_csv(const fs::path& file) {
     }
     if (fields.size() != kColumns)
       throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
-                       std::to_string(kColumns) + (nl == std::string::npos ? " (truncated last line?)" : ""));
+                       std::to_string(kColumns) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
     std::array<double, kColumns - 1> values{};
     for (std::size_t c = 0; c + 1 < kColumns; ++c) {
       const std::string_view f = trim(fields[c]);
@@ -287,13 +289,10 @@ Episode read_episode_csv(const fs::path& file) {
   return e;
 }
 
-DemoSet read_demo_set(const fs::path& dir) {
-  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder of demonstrations");
-  const fs::path meta_path = dir / "meta.json";
-  if (!fs::exists(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
+DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
   json meta;
   try {
-    meta = parse_json_limited<json>(read_file(meta_path), meta_path.string());
+    meta = parse_json_limited<json>(text, meta_path.string());
   } catch (const json::exception& e) {
     meta_error(meta_path, std::string("not valid JSON: ") + e.what());
   }
@@ -307,29 +306,51 @@ DemoSet read_demo_set(const fs::path& dir) {
   if (version < 1) meta_error(meta_path, "format version " + std::to_string(version) + " is not valid");
   if (!meta.contains("world")) meta_error(meta_path, "missing \"world\"");
 
-  DemoSet set;
-  set.world = world_config_from_json(meta["world"].dump(), meta_path.string() + " \"world\"");
-  set.description = meta.value("description", "");
-  set.provenance = meta.value("provenance", "");
+  DemoMeta out;
+  out.world = world_config_from_json(meta["world"].dump(), meta_path.string() + " \"world\"");
+  out.description = meta.value("description", "");
+  out.provenance = meta.value("provenance", "");
   if (!meta.contains("episodes") || !meta["episodes"].is_array()) meta_error(meta_path, "\"episodes\" must be a list");
 
   std::set<std::string> listed;
   for (const auto& entry : meta["episodes"]) {
-    const auto file = meta_field<std::string>(entry, "file", meta_path, "a string");
-    if (file.empty() || file.find_first_of("/\\") != std::string::npos || file == "." || file == "..")
-      meta_error(meta_path, "\"file\" must name a file inside the folder, got \"" + file.substr(0, 60) + "\"");
-    if (!listed.insert(file).second) meta_error(meta_path, "lists " + file + " twice");
-    const fs::path path = dir / file;
-    if (!fs::exists(path)) meta_error(meta_path, "lists " + file + ", which does not exist");
-    Episode e = read_episode_csv(path);
+    DemoMetaEntry e;
+    e.file = meta_field<std::string>(entry, "file", meta_path, "a string");
+    if (e.file.empty() || e.file.find_first_of("/\\") != std::string::npos || e.file == "." || e.file == "..")
+      meta_error(meta_path, "\"file\" must name a file inside the folder, got \"" + e.file.substr(0, 60) + "\"");
+    if (!listed.insert(e.file).second) meta_error(meta_path, "lists " + e.file + " twice");
     e.seed = meta_field<std::uint64_t>(entry, "seed", meta_path, "an unsigned integer");
     e.origin = entry.value("origin", "");
-    const auto steps = meta_field<std::size_t>(entry, "steps", meta_path, "an unsigned integer");
-    if (steps != e.size())
-      meta_error(meta_path, "says " + file + " has " + std::to_string(steps) + " steps; the file has " +
+    e.steps = meta_field<std::size_t>(entry, "steps", meta_path, "an unsigned integer");
+    if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + e.file);
+    e.outcome = outcome_from(entry["outcome"], meta_path, e.file);
+    out.episodes.push_back(std::move(e));
+  }
+  return out;
+}
+
+DemoSet read_demo_set(const fs::path& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder of demonstrations");
+  const fs::path meta_path = dir / "meta.json";
+  if (!fs::exists(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
+  DemoMeta meta = parse_demo_meta(read_file(meta_path), meta_path);
+
+  DemoSet set;
+  set.world = meta.world;
+  set.description = std::move(meta.description);
+  set.provenance = std::move(meta.provenance);
+  std::set<std::string> listed;
+  for (auto& entry : meta.episodes) {
+    listed.insert(entry.file);
+    const fs::path path = dir / entry.file;
+    if (!fs::exists(path)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
+    Episode e = read_episode_csv(path);
+    e.seed = entry.seed;
+    e.origin = std::move(entry.origin);
+    if (entry.steps != e.size())
+      meta_error(meta_path, "says " + entry.file + " has " + std::to_string(entry.steps) + " steps; the file has " +
                                 std::to_string(e.size()));
-    if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + file);
-    e.outcome = outcome_from(entry["outcome"], meta_path, file);
+    e.outcome = entry.outcome;
     for (std::size_t t = 0; t < e.size(); ++t)
       for (std::size_t k = 0; k < kActionDim; ++k)
         if (std::abs(e.actions[t][k]) > set.world.action.limit[k])

@@ -36,6 +36,7 @@ class Mlp final : public Regressor {
   };
 
   void do_fit(const Matrix& x, const Matrix& y, std::uint64_t seed) override {
+    check_width(static_cast<std::size_t>(x.cols()), static_cast<std::size_t>(y.cols()));
     const auto n = x.rows();
     const int hidden = static_cast<int>(params().integer("layers")), width = static_cast<int>(params().integer("width"));
     Rng rng(seed);
@@ -139,7 +140,16 @@ class Mlp final : public Regressor {
     return payload::write_matrices(ptrs);
   }
 
+  // predict_row keeps its rows in kMaxWidth-wide buffers on the stack.
+  void check_width(std::size_t inputs, std::size_t outputs) const {
+    constexpr auto most = static_cast<std::size_t>(kMaxWidth);
+    if (inputs > most || outputs > most)
+      throw InputError(name() + ": " + std::to_string(inputs) + " input dimensions and " + std::to_string(outputs) +
+                       " outputs; at most " + std::to_string(kMaxWidth) + " of each are supported");
+  }
+
   void do_load(std::string_view text, std::size_t input_dim, std::size_t output_dim) override {
+    check_width(input_dim, output_dim);
     const auto count = 2 * static_cast<std::size_t>(params().integer("layers") + 1);
     const auto m = payload::read_matrices(text, count, name());
     std::vector<Layer> layers;

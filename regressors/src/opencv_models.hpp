@@ -47,11 +47,12 @@ std::string save_all(const std::vector<cv::Ptr<T>>& models) {
   return j.dump();
 }
 
-/// Reads the models of a payload; `check`, if given, sees each model's file first (with its
-/// index) and throws for counts OpenCV's reader would silently pad or cut.
+/// Reads save_all's payload: `outputs` OpenCV YAML models. `check` sees each model's parsed
+/// YAML (and "<who>: model <i>" for its messages) before OpenCV reads it: OpenCV's readers trust
+/// the counts they find, so a caller checks them against what the text holds.
 template <class T>
 std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, const std::string& who,
-                                 const std::function<void(const cv::FileNode&, std::size_t)>& check = {}) {
+                                 const std::function<void(const cv::FileNode&, const std::string&)>& check) {
   nlohmann::json j;
   try {
     j = parse_json_limited<nlohmann::json>(payload, who + ": model payload");
@@ -62,13 +63,16 @@ std::vector<cv::Ptr<T>> load_all(std::string_view payload, std::size_t outputs, 
     throw InputError(who + ": model payload must hold " + std::to_string(outputs) + " models");
   std::vector<cv::Ptr<T>> models;
   for (const auto& text : j["models"]) {
-    if (!text.is_string()) throw InputError(who + ": model payload holds a non-text model");
-    models.push_back(guarded(who, [&] {
+    const std::string where = who + ": model " + std::to_string(models.size());
+    if (!text.is_string()) throw InputError(where + " is not text");
+    // Only the YAML save_yaml writes; OpenCV would also parse XML, JSON and base64 blocks.
+    if (text.get_ref<const std::string&>().rfind("%YAML:1.0\n", 0) != 0) throw InputError(where + " is not OpenCV YAML");
+    models.push_back(guarded(where, [&] {
       cv::FileStorage fs(text.get<std::string>(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
-      if (check) check(fs.root(), models.size());
+      check(fs.root(), where);
       cv::Ptr<T> m = T::create();
       m->read(fs.root());
-      if (!m->isTrained()) throw InputError(who + ": a stored model is empty");
+      if (!m->isTrained()) throw InputError(where + " is empty");
       return m;
     }));
   }

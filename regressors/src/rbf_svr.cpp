@@ -1,4 +1,5 @@
 #include <cmath>
+#include <set>
 
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/regressors/registry.hpp>
@@ -7,6 +8,44 @@
 
 namespace dicestack {
 namespace {
+
+// A stored model, checked before OpenCV's SVM::read sees it: that reader trusts its counts (a
+// negative sv_count resizes a vector to 2^64 - 1 entries, a large var_count allocates
+// gigabytes) and reads keys an RBF epsilon-SVR never has (class weights as whole matrices).
+void check_stored_svm(const cv::FileNode& n, std::size_t inputs, const std::string& where) {
+  auto fail = [&](const std::string& what) { throw InputError(where + ": " + what); };
+  auto is_number = [](const cv::FileNode& v) { return v.isInt() || v.isReal(); };
+  if (!n.isMap()) fail("is not an OpenCV model");
+  static const std::set<std::string> known{"format", "svmType", "kernel", "C", "p", "term_criteria",
+                                           "var_count", "sv_total", "support_vectors", "decision_functions"};
+  for (const auto& key : n.keys())
+    if (!known.contains(key)) fail("has \"" + key.substr(0, 40) + "\", which an RBF epsilon-SVR never has");
+  if (n["svmType"].string() != "EPS_SVR") fail("\"svmType\" must be EPS_SVR");
+  const cv::FileNode kernel = n["kernel"];
+  if (!kernel.isMap() || kernel["type"].string() != "RBF" || !is_number(kernel["gamma"]))
+    fail("\"kernel\" must be RBF with a gamma");
+  if (!n["var_count"].isInt() || static_cast<int>(n["var_count"]) != static_cast<int>(inputs))
+    fail("\"var_count\" must be " + std::to_string(inputs) + " (the header's input width)");
+  const cv::FileNode svs = n["support_vectors"];
+  const int total = n["sv_total"].isInt() ? static_cast<int>(n["sv_total"]) : -1;
+  if (!svs.isSeq() || total < 1 || svs.size() != static_cast<std::size_t>(total))
+    fail("\"sv_total\" must be the number of support vectors listed (at least 1)");
+  for (const auto& sv : svs) {
+    if (!sv.isSeq() || sv.size() != inputs) fail("a support vector does not hold " + std::to_string(inputs) + " numbers");
+    for (const auto& v : sv)
+      if (!is_number(v)) fail("a support vector holds something that is not a number");
+  }
+  const cv::FileNode dfs = n["decision_functions"];
+  if (!dfs.isSeq() || dfs.size() != 1) fail("\"decision_functions\" must hold exactly one function");
+  const cv::FileNode df = dfs[0];
+  if (!df.isMap() || !df["sv_count"].isInt() || static_cast<int>(df["sv_count"]) != total || !is_number(df["rho"]))
+    fail("the decision function must have sv_count = sv_total and a rho");
+  const cv::FileNode alpha = df["alpha"];
+  if (!alpha.isSeq() || alpha.size() != static_cast<std::size_t>(total))
+    fail("the decision function must hold one alpha per support vector");
+  for (const auto& v : alpha)
+    if (!is_number(v)) fail("an alpha is not a number");
+}
 
 class RbfSvr final : public Regressor {
  public:
@@ -45,7 +84,7 @@ class RbfSvr final : public Regressor {
       });
     });
     models_ = std::move(models);
-    prepare();
+    prepare(static_cast<std::size_t>(x.cols()));
   }
 
   // OpenCV evaluates the kernel sample by sample; the same float sum over the support vectors
@@ -58,24 +97,39 @@ class RbfSvr final : public Regressor {
     float gamma = 0.0f;
   };
 
-  void prepare() {
-    kernels_.clear();
-    for (const auto& m : models_) {
+  // Also checks what a stored model gave OpenCV: shapes, and finite numbers within float range.
+  void prepare(std::size_t inputs) {
+    std::vector<Kernel> kernels;
+    for (std::size_t o = 0; o < models_.size(); ++o) opencv::guarded(name() + ": model " + std::to_string(o), [&] {
+      const cv::ml::SVM& m = *models_[o];
+      auto fail = [&](const std::string& what) { throw InputError(name() + ": model " + std::to_string(o) + ": " + what); };
       Kernel k;
-      const cv::Mat sv = m->getSupportVectors();
+      const cv::Mat sv = m.getSupportVectors();
+      if (sv.type() != CV_32F || sv.rows < 1 || sv.cols != static_cast<int>(inputs) || !cv::checkRange(sv))
+        fail("support vectors must be finite " + std::to_string(inputs) + "-wide rows");
       cv::Mat alpha, index;
-      k.rho = static_cast<float>(m->getDecisionFunction(0, alpha, index));
-      k.gamma = static_cast<float>(m->getGamma());
+      const double rho = m.getDecisionFunction(0, alpha, index), gamma = m.getGamma();
+      auto is_float = [](double v) { return std::isfinite(v) && std::abs(v) <= 3e38; };
+      if (!is_float(rho) || !is_float(gamma) || !(gamma > 0.0)) fail("rho and gamma must be finite and gamma > 0");
+      if (alpha.type() != CV_64F || alpha.total() != static_cast<std::size_t>(sv.rows) ||
+          (!index.empty() && (index.type() != CV_32S || index.total() != alpha.total())))
+        fail("the decision function must hold one alpha per support vector");
+      for (std::size_t i = 0; i < alpha.total(); ++i)
+        if (!is_float(alpha.at<double>(0, static_cast<int>(i))) ||
+            (!index.empty() && (index.at<int>(0, static_cast<int>(i)) < 0 || index.at<int>(0, static_cast<int>(i)) >= sv.rows)))
+          fail("alpha " + std::to_string(i) + " or its support vector index is out of range");
+      k.rho = static_cast<float>(rho);
+      k.gamma = static_cast<float>(gamma);
       k.sv.resize(sv.rows, sv.cols);
       for (int i = 0; i < sv.rows; ++i)
         for (int j = 0; j < sv.cols; ++j) k.sv(i, j) = sv.at<float>(i, j);
-      // Coefficient i belongs to support vector index[i] (the identity in OpenCV's regression).
-      k.alpha = Eigen::VectorXf::Zero(sv.rows);
+      k.alpha.resize(sv.rows);
       alpha.convertTo(alpha, CV_32F);
-      for (int i = 0; i < alpha.cols; ++i) k.alpha[index.empty() ? i : index.at<int>(0, i)] += alpha.at<float>(0, i);
+      for (int i = 0; i < sv.rows; ++i) k.alpha[i] = alpha.at<float>(0, index.empty() ? i : index.at<int>(0, i));
       k.sv_norm2 = k.sv.rowwise().squaredNorm();
-      kernels_.push_back(std::move(k));
-    }
+      kernels.push_back(std::move(k));
+    });
+    kernels_ = std::move(kernels);
   }
 
   void do_predict_row(std::span<const double> x, std::span<double> y) const override {
@@ -94,58 +148,10 @@ class RbfSvr final : public Regressor {
   }
   std::string do_save() const override { return opencv::save_all(models_); }
   void do_load(std::string_view payload, std::size_t inputs, std::size_t outputs) override {
-    auto models = opencv::load_all<cv::ml::SVM>(payload, outputs, name(), [&](const cv::FileNode& root, std::size_t j) {
-      check_counts(root, j);
+    models_ = opencv::load_all<cv::ml::SVM>(payload, outputs, name(), [&](const cv::FileNode& n, const std::string& where) {
+      check_stored_svm(n, inputs, where);
     });
-    for (std::size_t j = 0; j < models.size(); ++j) check_loaded(*models[j], j, inputs);
-    models_ = std::move(models);
-    prepare();
-  }
-
-  // The counts the file states against the lists it holds: OpenCV pads a short coefficient
-  // list with zeros and ignores extra support vectors.
-  void check_counts(const cv::FileNode& root, std::size_t j) const {
-    const std::string who = name() + ": model payload, model " + std::to_string(j) + ": ";
-    const cv::FileNode sv = root["support_vectors"], df = root["decision_functions"];
-    if (!root["sv_total"].isInt() || !sv.isSeq() || static_cast<std::size_t>(static_cast<int>(root["sv_total"])) != sv.size())
-      throw InputError(who + "\"sv_total\" must be an integer equal to the number of support vectors (" +
-                       std::to_string(sv.size()) + ")");
-    if (!df.isSeq() || df.size() != 1) throw InputError(who + "must hold one decision function");
-    const cv::FileNode f = df[0];
-    if (!f["sv_count"].isInt() || !f["alpha"].isSeq() || static_cast<int>(f["sv_count"]) != static_cast<int>(sv.size()) ||
-        f["alpha"].size() != sv.size())
-      throw InputError(who + "\"sv_count\" and \"alpha\" must both count the " + std::to_string(sv.size()) +
-                       " support vectors");
-  }
-
-  // What prepare() and the kernel sum rely on, checked against the counts OpenCV read: an
-  // epsilon-SVR with an RBF kernel, support vectors as wide as the input, one coefficient per
-  // support vector, indices in range, every number finite.
-  void check_loaded(const cv::ml::SVM& m, std::size_t j, std::size_t inputs) const {
-    const std::string who = name() + ": model payload, model " + std::to_string(j) + ": ";
-    if (m.getType() != cv::ml::SVM::EPS_SVR || m.getKernelType() != cv::ml::SVM::RBF)
-      throw InputError(who + "is not an epsilon-SVR with an RBF kernel");
-    const double gamma = m.getGamma();
-    if (!std::isfinite(gamma) || gamma <= 0.0) throw InputError(who + "gamma must be a positive finite number");
-    const cv::Mat sv = m.getSupportVectors();
-    if (sv.empty() || sv.type() != CV_32F || sv.cols != static_cast<int>(inputs))
-      throw InputError(who + "holds " + std::to_string(sv.cols) + "-wide support vectors, expected " + std::to_string(inputs));
-    if (!cv::checkRange(sv)) throw InputError(who + "holds a support vector with NaN or infinity");
-    cv::Mat alpha, index;
-    const double rho = opencv::guarded(name(), [&] { return m.getDecisionFunction(0, alpha, index); });
-    if (!std::isfinite(rho)) throw InputError(who + "rho must be finite");
-    if (alpha.empty() || alpha.rows != 1 || (alpha.type() != CV_64F && alpha.type() != CV_32F))
-      throw InputError(who + "holds no coefficient row");
-    // A regression's single decision function uses every support vector once.
-    const int count = sv.rows;
-    if (alpha.cols != count || (!index.empty() && (index.rows != 1 || index.cols != count || index.type() != CV_32S)))
-      throw InputError(who + "holds " + std::to_string(alpha.cols) + " coefficients for " + std::to_string(count) +
-                       " support vectors");
-    for (int i = 0; !index.empty() && i < index.cols; ++i)
-      if (index.at<int>(0, i) < 0 || index.at<int>(0, i) >= sv.rows)
-        throw InputError(who + "support vector index " + std::to_string(index.at<int>(0, i)) + " is out of range (" +
-                         std::to_string(sv.rows) + " vectors)");
-    if (!cv::checkRange(alpha)) throw InputError(who + "holds a coefficient with NaN or infinity");
+    prepare(inputs);
   }
 
   std::vector<cv::Ptr<cv::ml::SVM>> models_;

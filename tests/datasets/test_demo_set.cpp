@@ -37,6 +37,31 @@ TEST(DemoSet, ReadsAValidSet) {
   EXPECT_EQ(set.description, "tiny test set");
 }
 
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(DemoSet, TextEntryPointsReadWhatTheFileReadersRead) {
+  const Episode from_file = read_episode_csv(kData / "good" / "episode_0000.csv");
+  const Episode from_text = parse_episode_csv(slurp(kData / "good" / "episode_0000.csv"), "in memory", "e0");
+  EXPECT_EQ(from_text.name, "e0");
+  EXPECT_EQ(from_text.states, from_file.states);
+  EXPECT_EQ(from_text.actions, from_file.actions);
+  EXPECT_EQ(from_text.sources, from_file.sources);
+  EXPECT_THAT(test::error_of([] { parse_episode_csv("t,cup_x\n", "in memory", "e"); }),
+              HasSubstr("in memory:1: header has 2 columns"));
+
+  const DemoMeta meta = parse_demo_meta(slurp(kData / "good" / "meta.json"), "m.json");
+  ASSERT_EQ(meta.episodes.size(), 2u);
+  EXPECT_EQ(meta.episodes[1].file, "episode_0001.csv");
+  EXPECT_EQ(meta.episodes[1].seed, 1u);
+  EXPECT_EQ(meta.episodes[1].steps, 3u);
+  EXPECT_EQ(meta.episodes[0].origin, "hand-made");
+  EXPECT_EQ(meta.description, "tiny test set");
+  EXPECT_THAT(test::error_of([] { parse_demo_meta("[]", "m.json"); }), HasSubstr("m.json: must be a JSON object"));
+}
+
 TEST(DemoSet, DeeplyNestedMetaIsRefusedNotCrashed) {
   const fs::path dir = fs::temp_directory_path() / ("dicestack_deep_meta_" + std::to_string(getpid()));
   fs::create_directories(dir);

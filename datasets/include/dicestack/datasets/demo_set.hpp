@@ -2,8 +2,10 @@
 // The on-disk demonstration format: a folder with one CSV per episode (header naming every
 // column: t, the 24 state names, dvx, dvy, dw, source) and a versioned meta.json (format,
 // units, world config, provenance, per-episode outcomes). Opens in any spreadsheet or pandas.
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <dicestack/core/world_config.hpp>
@@ -35,6 +37,34 @@ DemoSet read_demo_set(const std::filesystem::path& dir);
 
 /// Reads one episode CSV (name = the file stem). Throws InputError as read_demo_set does.
 Episode read_episode_csv(const std::filesystem::path& file);
+
+/// What read_episode_csv does with a file's text, for callers that hold the text (the fuzzer,
+/// tests): `where` starts every message ("where:line: ..."), `name` becomes Episode::name. Checks
+/// the header, every row and value; seed, outcome and origin stay empty (meta.json has them).
+/// Throws InputError.
+Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name);
+
+/// One entry of meta.json's "episodes" list.
+struct DemoMetaEntry {
+  std::string file;      ///< a file name inside the set's folder (no separators, not "." or "..")
+  std::uint64_t seed = 0;
+  std::size_t steps = 0;  ///< rows the file must have
+  std::string origin;
+  Outcome outcome;
+};
+
+/// What a set's meta.json says, checked on its own (no episode file is opened).
+struct DemoMeta {
+  WorldConfig world;
+  std::string description;
+  std::string provenance;
+  std::vector<DemoMetaEntry> episodes;  ///< in the file's order; each file named once
+};
+
+/// Parses meta.json's text as read_demo_set does: format and version, the world config, and
+/// every episode entry (file name, seed, steps, outcome; integers never narrowed). `where` (the
+/// path) starts every message. Throws InputError, or ConfigError for a bad "world".
+DemoMeta parse_demo_meta(std::string_view text, const std::filesystem::path& where);
 
 /// True when `dir` is a demonstration set dicestack wrote, so one of our writers may replace or
 /// remove it: meta.json parses with "format": "dicestack-demos" and every entry is meta.json, an
