@@ -146,6 +146,11 @@ T meta_field(const json& j, const char* key, const fs::path& meta, const char* e
   return T{};
 }
 
+// An optional text field: absent is "", anything but a string is refused.
+std::string optional_text(const json& j, const char* key, const fs::path& meta) {
+  return j.contains(key) ? meta_field<std::string>(j, key, meta, "a string") : std::string();
+}
+
 Outcome outcome_from(const json& j, const fs::path& meta, const std::string& file) {
   Outcome o;
   try {
@@ -154,8 +159,8 @@ Outcome outcome_from(const json& j, const fs::path& meta, const std::string& fil
     if (o.steps < 0 || o.dice_in_cup < 0 || o.dice_in_cup > static_cast<int>(kDiceCount))
       meta_error(meta, "outcome of " + file + " has steps " + std::to_string(o.steps) + " and dice_in_cup " +
                            std::to_string(o.dice_in_cup) + "; expected steps >= 0 and dice_in_cup in [0, 3]");
-    o.stacked = j.at("stacked").get<bool>();
-    o.wall_contact = j.at("wall_contact").get<bool>();
+    o.stacked = meta_field<bool>(j, "stacked", meta, "true or false");
+    o.wall_contact = meta_field<bool>(j, "wall_contact", meta, "true or false");
   } catch (const json::exception& e) {
     meta_error(meta, "outcome of " + file + " is malformed: " + e.what());
   }
@@ -249,7 +254,7 @@ Episode parse_episode_csv(std::string_view text, const std::string& where, std::
                          std::to_string(kColumns) + " (t, 24 state names, dvx, dvy, dw, source)");
       for (std::size_t c = 0; c < kColumns; ++c)
         if (trim(fields[c]) != columns[c])
-          throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c])) +
+          throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
                            "\", expected \"" + columns[c] + "\"");
       continue;
     }
@@ -262,7 +267,8 @@ Episode parse_episode_csv(std::string_view text, const std::string& where, std::
       double v = 0.0;
       const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
       if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
-        throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f) + "\" is not a number");
+        throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
+                         (f.size() > 40 ? "...\"" : "\"") + " is not a number");
       if (!std::isfinite(v))
         throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
                          "; demonstrations must be finite");
@@ -308,8 +314,8 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
 
   DemoMeta out;
   out.world = world_config_from_json(meta["world"].dump(), meta_path.string() + " \"world\"");
-  out.description = meta.value("description", "");
-  out.provenance = meta.value("provenance", "");
+  out.description = optional_text(meta, "description", meta_path);
+  out.provenance = optional_text(meta, "provenance", meta_path);
   if (!meta.contains("episodes") || !meta["episodes"].is_array()) meta_error(meta_path, "\"episodes\" must be a list");
 
   std::set<std::string> listed;
@@ -320,7 +326,7 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
       meta_error(meta_path, "\"file\" must name a file inside the folder, got \"" + e.file.substr(0, 60) + "\"");
     if (!listed.insert(e.file).second) meta_error(meta_path, "lists " + e.file + " twice");
     e.seed = meta_field<std::uint64_t>(entry, "seed", meta_path, "an unsigned integer");
-    e.origin = entry.value("origin", "");
+    e.origin = optional_text(entry, "origin", meta_path);
     e.steps = meta_field<std::size_t>(entry, "steps", meta_path, "an unsigned integer");
     if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + e.file);
     e.outcome = outcome_from(entry["outcome"], meta_path, e.file);

@@ -17,7 +17,7 @@ std::string_view to_string(StepSource source) {
 StepSource step_source_from(std::string_view text) {
   for (auto s : {StepSource::human, StepSource::expert, StepSource::policy, StepSource::correction})
     if (to_string(s) == text) return s;
-  throw InputError("\"" + std::string(text) + "\" is not one of human, expert, policy, correction");
+  throw InputError("\"" + std::string(text.substr(0, 40)) + (text.size() > 40 ? "..." : "") + "\" is not one of human, expert, policy, correction");
 }
 
 void check_episode(const Episode& e) {

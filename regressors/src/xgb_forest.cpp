@@ -73,6 +73,10 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
     const auto& info = model.at("tree_info");
     if (!trees.is_array() || !info.is_array() || trees.size() != info.size())
       fail("tree_info lists " + std::to_string(info.size()) + " trees, the model holds " + std::to_string(trees.size()));
+    // xgboost reads this count when it loads the model; it must agree with the trees present.
+    if (count_text(model.at("gbtree_model_param").at("num_trees"), "num_trees") != trees.size())
+      fail("num_trees says " + model.at("gbtree_model_param").at("num_trees").dump().substr(0, 40) + ", the model holds " +
+           std::to_string(trees.size()) + " trees");
     for (std::size_t t = 0; t < trees.size(); ++t) {
       const std::string where = "tree " + std::to_string(t) + ": ";
       const auto target = integer(info[t], where + "tree_info");

@@ -127,7 +127,7 @@ def demo_cases():
     cases = [
         ("empty_csv", "an episode file of zero bytes", with_episode(ep, lambda t: ""), f"{ep}"),
         ("duplicate_column", "a header naming cup_x twice",
-         with_episode(ep, lambda t: replace_line(t, 0, t.split("\n")[0].replace("cup_y", "cup_x"))), f"{ep}:1: column 2 is \"cup_x\""),
+         with_episode(ep, lambda t: replace_line(t, 0, t.split("\n")[0].replace("cup_y", "cup_x"))), f"{ep}:1: column 3 is \"cup_x\", expected \"cup_y\""),
         ("t_starts_at_one", "the first row's step is 1", with_episode(ep, lambda t: replace_cell(t, 1, 0, "1")),
          f"{ep}:2: column \"t\" is 1, expected 0"),
         ("t_fraction", "a step number 0.5", with_episode(ep, lambda t: replace_cell(t, 1, 0, "0.5")), f"{ep}:2: column \"t\""),
@@ -157,15 +157,15 @@ def demo_cases():
         ("file_absolute", "an episode file given as an absolute path",
          with_meta(lambda m: m["episodes"][0].update(file="/etc/passwd")), "\"file\" must name a file inside the folder"),
         ("file_not_csv", "an episode file that is not a .csv",
-         with_meta(lambda m: m["episodes"][0].update(file="meta.json")), "\"file\""),
+         with_meta(lambda m: m["episodes"][0].update(file="meta.json")), "meta.json:1: header has 1 columns"),
         ("seed_huge", "a seed beyond 2^64", with_meta(lambda m: m["episodes"][0].update(seed=18446744073709551616)),
          "\"seed\" must be an unsigned integer"),
         ("steps_negative", "a negative step count", with_meta(lambda m: m["episodes"][0].update(steps=-4)),
          "\"steps\" must be an unsigned integer, got -4"),
         ("outcome_wrong_type", "an outcome flag that is text",
-         with_meta(lambda m: m["episodes"][0]["outcome"].update(stacked="yes")), "\"stacked\""),
+         with_meta(lambda m: m["episodes"][0]["outcome"].update(stacked="yes")), "\"stacked\" must be true or false"),
         ("description_not_text", "a description that is a number", with_meta(lambda m: m.update(description=5)),
-         "\"description\""),
+         "\"description\" must be a string"),
         ("episode_is_folder", "an episode file that is a folder",
          {**{k: v for k, v in good_set().items() if k != "set/" + ep}, "set/" + ep: None}, ep),
     ]
@@ -273,7 +273,7 @@ def fit_models():
                        check=True, capture_output=True)
         for name, sets in SMALL.items():
             out = os.path.join(tmp, name + ".dsm")
-            demos = recorded if name == "rbf_svr" else GOOD
+            demos = recorded if name in ("rbf_svr", "gbt") else GOOD
             args = [EXE, "train", "--regressor", name, "--demos", demos, "--out", out]
             for s in sets:
                 args += ["--set", s]
@@ -351,9 +351,11 @@ def model_cases():
         ("mlp_nan", "mlp: a NaN weight", payload_edit("mlp", lambda p: p[:-8] + struct.pack("<d", float("nan"))), "mlp"),
         ("random_forest_garbage", "random_forest: text instead of trees", payload_edit("random_forest", lambda p: b"hello"), "random_forest"),
         ("random_forest_cut", "random_forest: half a payload", payload_edit("random_forest", lambda p: p[: len(p) // 2]), "random_forest"),
+        ("gbt_leaf_count", "gbt: tree_info shorter than the trees", gbt_edit(lambda m: m["tree_info"].pop()), "gbt"),
         ("gbt_child", "gbt: a child index out of range", gbt_edit(lambda m: m["trees"][0]["left_children"].__setitem__(0, 99999)), "gbt"),
         ("gbt_split", "gbt: a split on input 10,000", gbt_edit(lambda m: m["trees"][0]["split_indices"].__setitem__(0, 10000)), "gbt"),
         ("gbt_tree_count", "gbt: a tree count of 2^31", gbt_edit(lambda m: m["gbtree_model_param"].update(num_trees="2147483647")), "gbt"),
+        ("gbt_leaf_value", "gbt: a NaN-like leaf (1e999)", payload_edit("gbt", lambda p: p.replace(b'"base_weights":[', b'"base_weights":[1e999,', 1)), "gbt"),
         ("gbt_not_json", "gbt: a payload that is not JSON", payload_edit("gbt", lambda p: b"{\"learner\": "), "gbt"),
         ("rbf_svr_width", "rbf_svr: support vectors 3 wide", yaml_edit("rbf_svr", "var_count: 24", "var_count: 3"), "rbf_svr"),
         ("rbf_svr_sv_total", "rbf_svr: sv_total beyond the vectors", yaml_edit("rbf_svr", "sv_total: ", "sv_total: 9"), "rbf_svr"),
@@ -428,7 +430,7 @@ def plugin_and_argument_cases():
         ("seed_negative", "rollout --seed -1", "--seed"),
         ("seed_too_big", "rollout --seed 18446744073709551616", "--seed"),
         ("seed_leading_zero", "rollout --seed 007", "--seed"),
-        ("episodes_zero", "evaluate --model {case}/none.dsm --episodes 0", "--episodes"),
+        ("episodes_zero", "record --expert scripted --episodes 0 --seed 0 --out {case}/set", "--episodes"),
         ("unknown_feature_map", "train --regressor knn --features state+future --demos {source}/tests/datasets/data/good --out {case}/m.dsm", "state+future"),
         ("unknown_regressor_set", "train --regressor knn --set kk=3 --demos {source}/tests/datasets/data/good --out {case}/m.dsm", "kk"),
         ("bad_option_value", "train --regressor knn --learner dagger --option iterations=many --demos {source}/tests/datasets/data/good --out {case}/m.dsm", "iterations"),
