@@ -273,6 +273,8 @@ std::string to_json(const WorldConfig& config) {
   return root.dump(2) + "\n";
 }
 
+std::uint64_t config_hash(const WorldConfig& config) { return fnv1a(to_json(config)); }
+
 WorldConfig load_world_config(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open world config");

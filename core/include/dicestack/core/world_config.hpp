@@ -132,6 +132,10 @@ WorldConfig world_config_from_json(std::string_view text, std::string_view sourc
 /// Pretty-printed JSON holding every field.
 std::string to_json(const WorldConfig& config);
 
+/// FNV-1a of to_json(config): equal exactly for configs with equal JSON. Pairs a snapshot with
+/// the world it was taken in.
+std::uint64_t config_hash(const WorldConfig& config);
+
 /// Reads a JSON file; throws InputError if unreadable, ConfigError if invalid.
 WorldConfig load_world_config(const std::filesystem::path& path);
 
