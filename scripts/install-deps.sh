@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages dicestack builds and tests with. Idempotent: when every
 # package is already installed it changes nothing and does not touch the network.
-# `--python` adds scikit-learn and XGBoost's Python package, for bench/compare_python.py.
+# The Python package (python/) and its tests need pybind11, numpy, pytest, scikit-learn and
+# matplotlib; `--python` adds XGBoost's Python package, for bench/compare_python.py.
 set -euo pipefail
 
 packages=(
@@ -23,10 +24,12 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xdotool            # the headless test of `dicestack play`
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ and libFuzzer
+  pybind11-dev python3-dev python3-numpy   # `import dicestack` (python/)
+  python3-pytest python3-sklearn python3-matplotlib  # its tests and examples
 )
 
 if [ "${1:-}" = "--python" ]; then
-  packages+=(python3-sklearn python3-xgboost)
+  packages+=(python3-xgboost)
 elif [ $# -gt 0 ]; then
   echo "install-deps: unknown argument '$1' (the only option is --python)" >&2
   exit 2

@@ -7,7 +7,11 @@ cd "$(dirname "$0")/.."
 mode="${1:-run}"
 
 bash scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DDICESTACK_WERROR=ON
+# The Python package is built for Debian's interpreter, which owns pybind11, numpy and pytest,
+# whatever `python3` comes first on PATH.
+python_args=()
+if [ -x /usr/bin/python3 ]; then python_args=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DDICESTACK_WERROR=ON "${python_args[@]}"
 cmake --build build -j 2
 
 case "$mode" in

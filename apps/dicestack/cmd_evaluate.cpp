@@ -1,13 +1,11 @@
 // `dicestack evaluate`: roll a trained policy out from N random starts and report what it
 // achieved, with 95% Wilson intervals; with --demos, also its eq. 9 errors.
 #include <cstdio>
+#include <optional>
 
-#include <nlohmann/json.hpp>
-
-#include <dicestack/datasets/dataset.hpp>
-#include <dicestack/datasets/metrics.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/report.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -25,8 +23,6 @@ struct EvaluateOptions {
   bool json = false;
 };
 
-nlohmann::json rate_json(const Rate& r) { return {r.value, r.low, r.high}; }
-
 int run_evaluate(const EvaluateOptions& opt) {
   const WorldConfig world = opt.world.load();
   auto model = std::make_shared<const Model>(load_model(opt.model));
@@ -43,33 +39,11 @@ int run_evaluate(const EvaluateOptions& opt) {
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
   }
-  nlohmann::json j{{"model", opt.model.string()},
-                   {"regressor", model->regressor().name()},
-                   {"features", model->features().name()},
-                   {"episodes", s.episodes},
-                   {"seed", opt.seed},
-                   {"initial_push", opt.push},
-                   {"dice_in_cup_mean", s.dice_in_cup_mean},
-                   {"dice_in_cup_3_rate", s.dice_in_cup_3.value},
-                   {"stacked_rate", s.stacked.value},
-                   {"wall_contact_rate", s.wall_contact.value},
-                   {"realistic_success_rate", s.realistic_success.value},
-                   {"stacked_rate_ci95", rate_json(s.stacked)},
-                   {"wall_contact_rate_ci95", rate_json(s.wall_contact)},
-                   {"realistic_success_rate_ci95", rate_json(s.realistic_success)},
-                   {"mean_episode_length", s.mean_length},
-                   {"us_per_step", s.policy_us_per_step},
-                   {"seconds", s.seconds}};
-  if (!opt.demos.empty()) {
-    const DemoSet set = read_demo_set(opt.demos);
-    const Split split = split_by_episode(set.episodes, model->features());
-    const auto sigma = column_sigma(split.train.y);
-    j["train_error"] = scaled_l1_error(split.train.y, model->predict(split.train.x), sigma);
-    if (split.test.rows() > 0) j["test_error"] = scaled_l1_error(split.test.y, model->predict(split.test.x), sigma);
-    j["split"] = split.description;
-  }
+  std::optional<ModelErrors> errors;
+  if (!opt.demos.empty()) errors = model_errors(*model, read_demo_set(opt.demos).episodes);
   if (opt.json) {
-    print_line(j.dump());
+    print_line(evaluation_json({opt.model.string(), opt.seed, opt.push}, *model, s,
+                               errors ? &*errors : nullptr));
     return 0;
   }
   char line[512];
@@ -83,10 +57,10 @@ int run_evaluate(const EvaluateOptions& opt) {
                 100 * s.wall_contact.value, 100 * s.wall_contact.low, 100 * s.wall_contact.high, s.dice_in_cup_mean,
                 100 * s.dice_in_cup_3.value, s.mean_length, s.policy_us_per_step);
   print_line(line);
-  if (j.contains("train_error"))
-    print_line("  train error " + std::to_string(j["train_error"].get<double>()) +
-               (j.contains("test_error") ? ", test error " + std::to_string(j["test_error"].get<double>()) : "") + " (" +
-               j["split"].get<std::string>() + ")");
+  if (errors)
+    print_line("  train error " + std::to_string(errors->train_error) +
+               (errors->test_error ? ", test error " + std::to_string(*errors->test_error) : "") + " (" + errors->split +
+               ")");
   return 0;
 }
 

@@ -1,12 +1,9 @@
 // `dicestack train`: a learner turns demonstrations and a regressor into a model file.
-#include <chrono>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
 
-#include <dicestack/datasets/dataset.hpp>
-#include <dicestack/datasets/metrics.hpp>
-#include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/train.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include "cli.hpp"
@@ -30,29 +27,22 @@ int run_train(const TrainOptions& opt) {
   const WorldConfig world = opt.world.load();
   check_replaceable(opt.out, model_ownership());  // refuse a user's file before any work
   const auto dir = opt.demos.resolve(world);
-  const DemoSet set = read_demo_set(dir);
-  const auto learner = LearnerRegistry::global().create(opt.learner, opt.options);
-  RegressorRegistry::global().info(opt.regressor);  // unknown names fail before any work
-  const FeatureMap& features =
-      feature_map(opt.features.empty() ? LearnerRegistry::global().info(opt.learner).default_features : opt.features);
-  std::vector<Episode> train = set.episodes, test;
-  if (opt.split == "episodes") {
-    train.clear();
-    for (std::size_t i = 0; i < set.episodes.size(); ++i) (is_test_episode(i) ? test : train).push_back(set.episodes[i]);
-  }
-  LearnContext c;
-  c.demos = train;
-  c.held_out = test;
-  c.world = world;
-  c.regressor = opt.regressor;
-  c.regressor_sets = opt.sets;
-  c.features = features.name();
-  c.seed = opt.seed;
-  c.threads = opt.threads;
-  c.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
-  c.resume = opt.resume;
+  TrainRequest request;
+  request.world = world;
+  request.demos = read_demo_set(dir).episodes;
+  request.demos_name = dir.string();
+  request.regressor = opt.regressor;
+  request.regressor_sets = opt.sets;
+  request.learner = opt.learner;
+  request.learner_options = opt.options;
+  request.features = opt.features;
+  request.split = opt.split;
+  request.seed = opt.seed;
+  request.threads = opt.threads;
+  request.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
+  request.resume = opt.resume;
   ProgressBar bar;
-  c.progress = [&](const Progress& p) {
+  request.progress = [&](const Progress& p) {
     std::string text = opt.learner + " " + opt.regressor + ": iteration " + std::to_string(p.iteration) + "/" +
                        std::to_string(p.iterations);
     if (p.windows > 0) text += ", window " + std::to_string(p.window) + "/" + std::to_string(p.windows);
@@ -60,37 +50,22 @@ int run_train(const TrainOptions& opt) {
     if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
     bar.update(p.fraction, text);
   };
-  const auto t0 = std::chrono::steady_clock::now();
-  LearnResult r = learner->learn(c);
+  const TrainReport r = train_model(request);
   bar.finish();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.model->record["learner"] = opt.learner;
-  r.model->record["learner_options"] = learner->params().summary();
-  r.model->record["demos"] = dir.string();
-  r.model->record["split"] = opt.split;
-  r.model->record["seed"] = std::to_string(opt.seed);
-  save_model(*r.model, opt.out);
+  save_model(*r.result.model, opt.out);
   const std::filesystem::path curve_path = opt.out.string() + ".curve.csv";
-  if (!r.curve.empty()) write_curve_csv(r.curve, curve_path);
-  const Dataset train_d = make_dataset(train, features);
-  const auto sigma = column_sigma(train_d.y);
-  const double train_error = scaled_l1_error(train_d.y, r.model->predict(train_d.x), sigma);
-  double test_error = -1.0;
-  if (!test.empty()) {
-    const Dataset test_d = make_dataset(test, features);
-    test_error = scaled_l1_error(test_d.y, r.model->predict(test_d.x), sigma);
-  }
+  if (!r.result.curve.empty()) write_curve_csv(r.result.curve, curve_path);
   if (opt.json) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
-                     {"features", features.name()}, {"seconds", seconds},        {"train_error", train_error}};
-    if (test_error >= 0) j["test_error"] = test_error;
-    if (!r.curve.empty()) j["curve"] = curve_path.string();
+                     {"features", r.features},    {"seconds", r.seconds},   {"train_error", r.train_error}};
+    if (r.test_error) j["test_error"] = *r.test_error;
+    if (!r.result.curve.empty()) j["curve"] = curve_path.string();
     print_line(j.dump());
   } else {
     char line[256];
     std::snprintf(line, sizeof line, "trained %s with %s in %.2f s: train error %.3f%s -> %s", opt.regressor.c_str(),
-                  opt.learner.c_str(), seconds, train_error,
-                  test_error >= 0 ? (", test error " + std::to_string(test_error).substr(0, 5)).c_str() : "",
+                  opt.learner.c_str(), r.seconds, r.train_error,
+                  r.test_error ? (", test error " + std::to_string(*r.test_error).substr(0, 5)).c_str() : "",
                   opt.out.string().c_str());
     print_line(line);
   }

@@ -6,8 +6,7 @@
 
 #include <unistd.h>
 
-#include <dicestack/datasets/builtin.hpp>
-#include <dicestack/learners/record.hpp>
+#include <dicestack/learners/train.hpp>
 
 namespace dicestack::cli {
 
@@ -70,11 +69,7 @@ void DemosOption::add_to(CLI::App& app) {
                  "recordings, converted)");
 }
 
-std::filesystem::path DemosOption::resolve(const WorldConfig& world) const {
-  if (path.empty() || (path == "builtin" && !std::filesystem::exists(path))) return builtin_demo_set(world);
-  if (path == "human" && !std::filesystem::exists(path)) return human_demo_set(world);
-  return path;
-}
+std::filesystem::path DemosOption::resolve(const WorldConfig& world) const { return resolve_demo_set(path, world); }
 
 CLI::Validator seed_check() {
   return CLI::Validator(

@@ -8,6 +8,8 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 
+#include "byte_io.hpp"
+
 namespace dicestack {
 
 DiceEnv::DiceEnv(const WorldConfig& config) : world_(config), goal_(goal_state(config)) {}
@@ -58,6 +60,52 @@ void DiceEnv::restore(const EnvSnapshot& snapshot) {
   world_.restore(snapshot.world);
   outcome_ = snapshot.outcome;
   noise_ = snapshot.noise;
+}
+
+namespace {
+
+constexpr std::uint32_t kEnvSnapshotMarker = 0x44454e56;  // "DENV"
+constexpr std::uint32_t kEnvSnapshotVersion = 1;
+
+}  // namespace
+
+std::string to_bytes(const EnvSnapshot& snapshot) {
+  detail::ByteWriter w;
+  w.put(kEnvSnapshotMarker);
+  w.put(kEnvSnapshotVersion);
+  w.put_bytes(snapshot.world.to_bytes());
+  const Outcome& o = snapshot.outcome;
+  w.put<std::int32_t>(o.steps);
+  w.put<std::int32_t>(o.dice_in_cup);
+  w.put<std::int32_t>(o.dice_in_cup_now);
+  w.put<std::uint8_t>(o.stacked);
+  w.put<std::uint8_t>(o.wall_contact);
+  w.put<std::int32_t>(o.stacked_steps);
+  for (std::uint64_t word : snapshot.noise.words()) w.put(word);
+  return w.finish();
+}
+
+EnvSnapshot env_snapshot_from_bytes(std::string_view bytes) {
+  detail::ByteReader r(bytes, "environment snapshot bytes");
+  if (r.get<std::uint32_t>() != kEnvSnapshotMarker) r.fail("not a dicestack environment snapshot (or another byte order)");
+  const auto version = r.get<std::uint32_t>();
+  if (version != kEnvSnapshotVersion)
+    r.fail("version " + std::to_string(version) + ", this dicestack reads " + std::to_string(kEnvSnapshotVersion));
+  EnvSnapshot s;
+  s.world = WorldSnapshot::from_bytes(r.get_bytes());
+  constexpr std::int32_t kMaxInt = std::numeric_limits<std::int32_t>::max();
+  const int dice = static_cast<int>(kDiceCount);
+  s.outcome.steps = r.get_in<std::int32_t>(0, kMaxInt, "outcome steps");
+  s.outcome.dice_in_cup = r.get_in<std::int32_t>(0, dice, "outcome dice_in_cup");
+  s.outcome.dice_in_cup_now = r.get_in<std::int32_t>(0, dice, "outcome dice_in_cup_now");
+  s.outcome.stacked = r.get_in<std::uint8_t>(0, 1, "outcome stacked") != 0;
+  s.outcome.wall_contact = r.get_in<std::uint8_t>(0, 1, "outcome wall_contact") != 0;
+  s.outcome.stacked_steps = r.get_in<std::int32_t>(0, kMaxInt, "outcome stacked_steps");
+  std::array<std::uint64_t, 4> words{};
+  for (auto& word : words) word = r.get<std::uint64_t>();
+  s.noise = Rng::from_words(words);
+  r.expect_end();
+  return s;
 }
 
 Box<kStateDim> DiceEnv::observation_space() const {

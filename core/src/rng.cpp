@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <dicestack/core/error.hpp>
+
 namespace dicestack {
 namespace {
 
@@ -38,6 +40,14 @@ std::uint64_t Rng::next() {
   s_[2] ^= t;
   s_[3] = rotl(s_[3], 45);
   return result;
+}
+
+Rng Rng::from_words(const std::array<std::uint64_t, 4>& words) {
+  if (words[0] == 0 && words[1] == 0 && words[2] == 0 && words[3] == 0)
+    throw InputError("random generator state: all four words are zero");
+  Rng rng(0);
+  for (std::size_t i = 0; i < 4; ++i) rng.s_[i] = words[i];
+  return rng;
 }
 
 double Rng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }

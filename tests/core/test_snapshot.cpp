@@ -109,6 +109,51 @@ TEST(Snapshot, BareStateRestoreIsDeterministic) {
 TEST(Snapshot, EmptySnapshotIsRejected) {
   World w{WorldConfig{}};
   EXPECT_THROW(w.restore(WorldSnapshot{}), InputError);
+  EXPECT_THROW(WorldSnapshot{}.to_bytes(), InputError);
+}
+
+// Snapshot -> bytes -> snapshot continues like the original, outcome and noise stream included.
+TEST(Snapshot, BytesRoundTripIsExact) {
+  WorldConfig c;
+  c.physics.action_noise = 0.2;
+  DiceEnv env(c);
+  env.reset(6);
+  const auto actions = test::random_actions(c, 7, 90);
+  for (int t = 0; t < 45; ++t) env.step(actions[static_cast<std::size_t>(t)]);
+  const std::string bytes = to_bytes(env.snapshot());
+  EXPECT_EQ(to_bytes(env_snapshot_from_bytes(bytes)), bytes);
+  for (int t = 45; t < 90; ++t) env.step(actions[static_cast<std::size_t>(t)]);
+  DiceEnv other(c);
+  other.restore(env_snapshot_from_bytes(bytes));
+  EXPECT_EQ(other.t(), 45);
+  for (int t = 45; t < 90; ++t) other.step(actions[static_cast<std::size_t>(t)]);
+  EXPECT_TRUE(bit_equal(other.get_state(), env.get_state()));
+  EXPECT_EQ(other.outcome().steps, env.outcome().steps);
+  EXPECT_EQ(other.outcome().dice_in_cup, env.outcome().dice_in_cup);
+  EXPECT_EQ(other.outcome().wall_contact, env.outcome().wall_contact);
+}
+
+TEST(Snapshot, DamagedBytesAreRefused) {
+  DiceEnv env{WorldConfig{}};
+  env.reset(1);
+  env.step({0.5, 0.0, 0.1});
+  const std::string bytes = to_bytes(env.snapshot());
+  EXPECT_THROW(env_snapshot_from_bytes(""), InputError);
+  EXPECT_THROW(env_snapshot_from_bytes(bytes.substr(0, bytes.size() / 2)), InputError);
+  for (std::size_t at : {std::size_t{0}, std::size_t{9}, bytes.size() / 2, bytes.size() - 1}) {
+    std::string damaged = bytes;
+    damaged[at] = static_cast<char>(damaged[at] ^ 0x40);
+    EXPECT_THROW(env_snapshot_from_bytes(damaged), InputError) << "byte " << at;
+  }
+  EXPECT_THROW(WorldSnapshot::from_bytes(bytes), InputError);  // an environment record is not a world's
+  try {
+    std::string damaged = bytes;
+    damaged[20] = static_cast<char>(damaged[20] ^ 1);
+    env_snapshot_from_bytes(damaged);
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // step(action) gives observation, reward, terminated, truncated and info.
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <dicestack/core/judge.hpp>
@@ -41,6 +43,13 @@ struct EnvSnapshot {
   Outcome outcome;
   Rng noise{0};
 };
+
+/// The snapshot as a self-checking byte record (WorldSnapshot::to_bytes plus the outcome and
+/// the noise stream): restores exactly into an environment of the same config and build.
+/// Throws InputError for an empty snapshot.
+std::string to_bytes(const EnvSnapshot& snapshot);
+/// Reads to_bytes()'s record; throws InputError naming what is wrong.
+EnvSnapshot env_snapshot_from_bytes(std::string_view bytes);
 
 /// One episode at a time of the dice-stacking task. Not thread-safe; use one per thread.
 class DiceEnv {

@@ -1,6 +1,7 @@
 #pragma once
 // Seeded randomness with results that do not depend on the standard library's distributions
 // (std::normal_distribution differs between implementations; ours must not).
+#include <array>
 #include <cstdint>
 
 namespace dicestack {
@@ -23,6 +24,12 @@ class Rng {
   std::uint64_t below(std::uint64_t n);
   /// Standard normal (Box–Muller, no cached second value so the state is just four words).
   double normal();
+
+  /// The generator's four state words, to serialise it (environment snapshots).
+  std::array<std::uint64_t, 4> words() const { return {s_[0], s_[1], s_[2], s_[3]}; }
+  /// A generator continuing from words() exactly. Throws InputError for all-zero words (a
+  /// state xoshiro256** never reaches).
+  static Rng from_words(const std::array<std::uint64_t, 4>& words);
 
  private:
   std::uint64_t s_[4];

@@ -2,6 +2,8 @@
 // The Box2D scene of the dice-stacking task and one control step of it. Box2D types never leave
 // core/: everything here is SI and our own types (STYLE 9).
 #include <memory>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <dicestack/core/types.hpp>
@@ -24,6 +26,15 @@ class WorldSnapshot {
   const State& state() const;
   /// False for a default-constructed snapshot.
   bool valid() const { return data_ != nullptr; }
+
+  /// The snapshot as a self-checking byte record (marker, version, checksum), for pickles and
+  /// files. Like the snapshot itself it is only meaningful for a World built from the same
+  /// config (callers store the config's hash beside it) and the same dicestack build.
+  /// Throws InputError for an empty snapshot.
+  std::string to_bytes() const;
+  /// Reads to_bytes()'s record, checking marker, version, checksum, sizes and every index.
+  /// Throws InputError naming what is wrong.
+  static WorldSnapshot from_bytes(std::string_view bytes);
 
   struct Data;  ///< Box2D-level contents, private to core/src
 

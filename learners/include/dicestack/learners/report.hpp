@@ -1,0 +1,41 @@
+#pragma once
+// What `dicestack evaluate --json` reports, built in one place for the command line and the
+// Python package (whose evaluate() returns the same keys).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/datasets/episode.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/regressors/model.hpp>
+
+namespace dicestack {
+
+/// A model's eq. 9 errors on a demonstration set under the default episode split.
+struct ModelErrors {
+  double train_error = 0.0;
+  std::optional<double> test_error;  ///< when the split has test episodes
+  std::string split;                 ///< the split's description
+};
+
+/// Throws InputError if the split leaves no training episode.
+ModelErrors model_errors(const Model& model, const std::vector<Episode>& episodes);
+
+/// How the rollouts were asked for.
+struct EvaluationRun {
+  std::string model;                ///< the model file as the user named it
+  std::uint64_t seed = 0;
+  std::string initial_push = "none";
+};
+
+/// The `evaluate --json` object as one line of JSON: model, regressor, features, episodes,
+/// seed, initial_push, dice_in_cup_mean, dice_in_cup_3_rate, stacked_rate, wall_contact_rate,
+/// realistic_success_rate (each rate also as [value, low, high] under *_ci95),
+/// mean_episode_length, us_per_step, seconds, and train_error, test_error, split when `errors`
+/// is given.
+std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& stats,
+                            const ModelErrors* errors = nullptr);
+
+}  // namespace dicestack

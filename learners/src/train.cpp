@@ -1,0 +1,67 @@
+#include <dicestack/learners/train.hpp>
+
+#include <chrono>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/record.hpp>
+
+namespace dicestack {
+
+std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const WorldConfig& world) {
+  if (spec.empty() || (spec == "builtin" && !std::filesystem::exists(spec))) return builtin_demo_set(world);
+  if (spec == "human" && !std::filesystem::exists(spec)) return human_demo_set(world);
+  return spec;
+}
+
+TrainReport train_model(const TrainRequest& request) {
+  const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
+  RegressorRegistry::global().info(request.regressor);  // unknown names fail before any work
+  const FeatureMap& features = feature_map(
+      request.features.empty() ? LearnerRegistry::global().info(request.learner).default_features : request.features);
+  if (request.split != "episodes" && request.split != "none")
+    throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
+  std::vector<Episode> train = request.demos, test;
+  if (request.split == "episodes") {
+    train.clear();
+    for (std::size_t i = 0; i < request.demos.size(); ++i)
+      (is_test_episode(i) ? test : train).push_back(request.demos[i]);
+  }
+  LearnContext c;
+  c.demos = train;
+  c.held_out = test;
+  c.world = request.world;
+  c.regressor = request.regressor;
+  c.regressor_sets = request.regressor_sets;
+  c.features = features.name();
+  c.seed = request.seed;
+  c.threads = request.threads;
+  c.checkpoint_dir = request.checkpoint_dir;
+  c.resume = request.resume;
+  c.progress = request.progress;
+
+  TrainReport report;
+  report.features = features.name();
+  const auto t0 = std::chrono::steady_clock::now();
+  report.result = learner->learn(c);
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Model& model = *report.result.model;
+  model.record["learner"] = request.learner;
+  model.record["learner_options"] = learner->params().summary();
+  model.record["demos"] = request.demos_name;
+  model.record["split"] = request.split;
+  model.record["seed"] = std::to_string(request.seed);
+
+  const Dataset train_d = make_dataset(train, features);
+  const auto sigma = column_sigma(train_d.y);
+  report.train_error = scaled_l1_error(train_d.y, model.predict(train_d.x), sigma);
+  if (!test.empty()) {
+    const Dataset test_d = make_dataset(test, features);
+    report.test_error = scaled_l1_error(test_d.y, model.predict(test_d.x), sigma);
+  }
+  return report;
+}
+
+}  // namespace dicestack

@@ -1,0 +1,52 @@
+"""dicestack: imitation learning for dynamic dice stacking, from Python.
+
+The world as a Gymnasium environment (DiceStackEnv, DiceStackVectorEnv), the automatic experts,
+demonstrations as numpy arrays, and training and evaluation with dicestack's C++ regressors and
+learners. See docs/python.md.
+"""
+from . import _dicestack
+from ._world import default_world
+from .demos import Episode, load_demos, save_demos
+from .env import DiceStackEnv
+from .models import Expert, Model, Policy, evaluate, expert, load_model, train
+from .vector_env import DiceStackVectorEnv
+
+__version__ = _dicestack.__version__
+Snapshot = _dicestack.Snapshot
+
+__all__ = [
+    "DiceStackEnv",
+    "DiceStackVectorEnv",
+    "Episode",
+    "Expert",
+    "Model",
+    "Policy",
+    "Snapshot",
+    "default_world",
+    "evaluate",
+    "expert",
+    "load_demos",
+    "load_model",
+    "save_demos",
+    "train",
+]
+
+ENV_ID = "dicestack/DiceStack-v0"
+
+
+def _register_with_gymnasium():
+    try:
+        from gymnasium.envs.registration import register, registry
+    except ImportError:
+        return
+    if ENV_ID not in registry:
+        # The environment ends its own episodes at the world's time limit: no TimeLimit wrapper.
+        register(
+            id=ENV_ID,
+            entry_point="dicestack.env:DiceStackEnv",
+            vector_entry_point="dicestack.vector_env:DiceStackVectorEnv",
+            max_episode_steps=None,
+        )
+
+
+_register_with_gymnasium()

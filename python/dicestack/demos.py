@@ -1,0 +1,106 @@
+"""Demonstrations: episodes with numpy arrays, read from and written to dicestack's folder format
+(one CSV per episode plus meta.json; docs/datasets.md) by the C++ library, which checks every
+value and never replaces a folder that is not a dicestack set."""
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _dicestack
+from ._world import resolve_world
+
+SOURCES = ("human", "expert", "policy", "correction")
+
+
+@dataclass
+class Episode:
+    """One demonstration: T states (before each action) and the T actions taken in them.
+
+    `sources` says who chose each action (human, expert, policy or correction; default: policy);
+    the outcome fields are what the judge saw over the whole episode.
+    """
+
+    states: np.ndarray
+    actions: np.ndarray
+    sources: list = None
+    name: str = ""
+    seed: int = 0
+    origin: str = ""
+    steps: int = 0
+    dice_in_cup: int = 0
+    dice_in_cup_now: int = 0
+    stacked: bool = False
+    stacked_steps: int = 0
+    wall_contact: bool = False
+
+    def __post_init__(self):
+        self.states = np.asarray(self.states, dtype=np.float64)
+        self.actions = np.asarray(self.actions, dtype=np.float64)
+        if self.sources is None:
+            self.sources = ["policy"] * len(self.states)
+
+    def __len__(self):
+        return len(self.states)
+
+    @property
+    def realistic_success(self):
+        """Stacked without touching a wall: the paper's realistic success."""
+        return bool(self.stacked and not self.wall_contact)
+
+    @property
+    def source(self):
+        """The steps' common source, or "mixed"."""
+        kinds = set(self.sources)
+        return kinds.pop() if len(kinds) == 1 else "mixed"
+
+    def _as_record(self):
+        return {
+            "name": self.name,
+            "seed": int(self.seed),
+            "states": self.states,
+            "actions": self.actions,
+            "sources": list(self.sources),
+            "origin": self.origin,
+            "steps": int(self.steps),
+            "dice_in_cup": int(self.dice_in_cup),
+            "dice_in_cup_now": int(self.dice_in_cup_now),
+            "stacked": bool(self.stacked),
+            "stacked_steps": int(self.stacked_steps),
+            "wall_contact": bool(self.wall_contact),
+        }
+
+    @classmethod
+    def _from_record(cls, record):
+        return cls(**record)
+
+
+def _records(episodes):
+    out = []
+    for e in episodes:
+        if not isinstance(e, Episode):
+            raise TypeError(f"expected dicestack.Episode objects, got {type(e).__name__}")
+        out.append(e._as_record())
+    return out
+
+
+def load_demos(source="builtin", world=None):
+    """Episodes of a demonstration set: "builtin" (80 expert successes, generated on first use),
+    "human" (the paper's 68 recordings, converted) or a folder. `world` picks the world the
+    built-in and human sets are made for (a folder carries its own)."""
+    if not isinstance(source, (str, os.PathLike)):
+        raise TypeError(f"source must be 'builtin', 'human' or a folder, got {type(source).__name__}")
+    folder = _dicestack.resolve_demo_set(os.fspath(source), resolve_world(world))
+    data = _dicestack.read_demo_set(folder)
+    return [Episode._from_record(r) for r in data["episodes"]]
+
+
+def save_demos(episodes, path, world=None, description="", provenance=""):
+    """Writes `episodes` as a demonstration set in folder `path` (created, or replaced whole when
+    it is a dicestack set; any other folder is refused with ValueError)."""
+    _dicestack.write_demo_set(
+        os.fspath(path),
+        _records(episodes),
+        resolve_world(world),
+        description or "episodes saved from Python",
+        provenance or "dicestack.save_demos",
+    )

@@ -1,0 +1,97 @@
+// Demonstration sets: read and written by the library (its checks and its ownership rule), seen
+// from Python as dicts of numpy arrays (dicestack.Episode wraps them).
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/train.hpp>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "demos.hpp"
+#include "errors.hpp"
+
+namespace dicestack::python {
+
+py::dict episode_dict(const Episode& e) {
+  py::list sources;
+  for (StepSource s : e.sources) sources.append(std::string(to_string(s)));
+  py::dict d;
+  d["name"] = e.name;
+  d["seed"] = e.seed;
+  d["states"] = rows_to_array(e.states);
+  d["actions"] = rows_to_array(e.actions);
+  d["sources"] = sources;
+  d["origin"] = e.origin;
+  d["steps"] = e.outcome.steps;
+  d["dice_in_cup"] = e.outcome.dice_in_cup;
+  d["dice_in_cup_now"] = e.outcome.dice_in_cup_now;
+  d["stacked"] = e.outcome.stacked;
+  d["stacked_steps"] = e.outcome.stacked_steps;
+  d["wall_contact"] = e.outcome.wall_contact;
+  return d;
+}
+
+Episode episode_from(const py::handle& obj) {
+  const auto d = obj.cast<py::dict>();
+  Episode e;
+  e.name = d["name"].cast<std::string>();
+  e.seed = seed_from(d["seed"], "episode seed").value_or(0);
+  e.states = rows_from<kStateDim>(d["states"], "episode states");
+  e.actions = rows_from<kActionDim>(d["actions"], "episode actions");
+  for (const auto& s : d["sources"]) e.sources.push_back(step_source_from(s.cast<std::string>()));
+  e.origin = d["origin"].cast<std::string>();
+  e.outcome.steps = d["steps"].cast<int>();
+  e.outcome.dice_in_cup = d["dice_in_cup"].cast<int>();
+  e.outcome.dice_in_cup_now = d["dice_in_cup_now"].cast<int>();
+  e.outcome.stacked = d["stacked"].cast<bool>();
+  e.outcome.stacked_steps = d["stacked_steps"].cast<int>();
+  e.outcome.wall_contact = d["wall_contact"].cast<bool>();
+  check_episode(e);
+  return e;
+}
+
+std::vector<Episode> episodes_from(const py::iterable& episodes) {
+  std::vector<Episode> out;
+  for (const auto& e : episodes) out.push_back(episode_from(e));
+  return out;
+}
+
+std::filesystem::path demo_folder(const std::filesystem::path& spec, const WorldConfig& world) {
+  py::gil_scoped_release nogil;  // the built-in set is generated on first use (seconds)
+  return resolve_demo_set(spec, world);
+}
+
+void bind_demos(py::module_& m) {
+  m.def("resolve_demo_set", &demo_folder, py::arg("spec"), py::arg("world"),
+        "The folder of \"builtin\", \"human\" or a path (the built-in set is generated on first use)");
+  m.def(
+      "read_demo_set",
+      [](const std::filesystem::path& path) {
+        const DemoSet set = reading(path, [&] { return read_demo_set(path); });
+        py::list episodes;
+        for (const auto& e : set.episodes) episodes.append(episode_dict(e));
+        py::dict d;
+        d["world"] = set.world;
+        d["description"] = set.description;
+        d["provenance"] = set.provenance;
+        d["episodes"] = episodes;
+        return d;
+      },
+      py::arg("path"));
+  m.def(
+      "write_demo_set",
+      [](const std::filesystem::path& path, const py::iterable& episodes, const WorldConfig& world, const std::string& description,
+         const std::string& provenance) {
+        DemoSet set;
+        set.world = world;
+        set.description = description;
+        set.provenance = provenance;
+        set.episodes = episodes_from(episodes);
+        py::gil_scoped_release nogil;
+        write_demo_set(set, path);
+      },
+      py::arg("path"), py::arg("episodes"), py::arg("world"), py::arg("description"), py::arg("provenance"));
+}
+
+}  // namespace dicestack::python

@@ -1,0 +1,302 @@
+// Env (one environment), Snapshot (its exact, picklable copy) and VectorEnv (N environments
+// stepped in C++ on all cores with the GIL released, autoreset on the next step).
+#include <algorithm>
+#include <atomic>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include <dicestack/core/parallel.hpp>
+#include <dicestack/core/render.hpp>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+
+namespace dicestack::python {
+namespace {
+
+/// An EnvSnapshot with the world it belongs to and the episode bookkeeping around it.
+struct Snapshot {
+  EnvSnapshot env;
+  std::uint64_t world_hash = 0;
+  std::uint64_t episode_seed = 0;
+  std::optional<std::uint64_t> seed_base;
+  std::uint64_t seed_count = 0;
+};
+
+constexpr int kSnapshotPickleVersion = 1;
+
+Snapshot take_snapshot(EnvCore& core) {
+  return {core.env().snapshot(), core.world_hash(), core.episode_seed(), core.seeds().base(), core.seeds().count()};
+}
+
+void restore_snapshot(EnvCore& core, const Snapshot& s) {
+  if (s.world_hash != core.world_hash())
+    throw py::value_error("snapshot was taken in another world (world config hash " + std::to_string(s.world_hash) +
+                          ", this environment's " + std::to_string(core.world_hash()) + ")");
+  core.env().restore(s.env);
+  core.seeds().set(s.seed_base, s.seed_count);
+  core.restored(s.episode_seed);
+}
+
+py::tuple snapshot_state(const Snapshot& s) {
+  return py::make_tuple(kSnapshotPickleVersion, s.world_hash, py::bytes(to_bytes(s.env)), s.episode_seed,
+                        s.seed_base ? py::object(py::int_(*s.seed_base)) : py::none(), s.seed_count);
+}
+
+Snapshot snapshot_from_state(const py::tuple& t) {
+  if (t.size() != 6 || t[0].cast<int>() != kSnapshotPickleVersion)
+    throw py::value_error("not a dicestack snapshot record (expected version " + std::to_string(kSnapshotPickleVersion) +
+                          " with 6 fields)");
+  Snapshot s;
+  s.world_hash = t[1].cast<std::uint64_t>();
+  s.env = env_snapshot_from_bytes(t[2].cast<std::string>());
+  s.episode_seed = t[3].cast<std::uint64_t>();
+  if (!t[4].is_none()) s.seed_base = t[4].cast<std::uint64_t>();
+  s.seed_count = t[5].cast<std::uint64_t>();
+  return s;
+}
+
+py::tuple step_tuple(const StepResult& r) {
+  return py::make_tuple(to_array(r.observation), r.reward, r.terminated, r.truncated, info_dict(r.info));
+}
+
+template <std::size_t N>
+py::tuple bounds(const Box<N>& box) {
+  return py::make_tuple(to_array(box.low), to_array(box.high));
+}
+
+py::array_t<std::uint8_t> render_rgb(const EnvCore& core, double pixels_per_metre, bool hud) {
+  const DiceEnv& env = core.env();
+  RenderOptions options;
+  options.pixels_per_metre = pixels_per_metre;
+  options.show_hud = hud;
+  const Image image = render_state(env.get_state(), env.config(), Hud{env.t(), env.outcome(), ""}, options);
+  py::array_t<std::uint8_t> out({image.height, image.width, 3});
+  std::uint8_t* p = out.mutable_data();
+  for (std::size_t i = 0; i + 2 < image.bgr.size(); i += 3) {  // BGR -> RGB
+    p[i] = image.bgr[i + 2];
+    p[i + 1] = image.bgr[i + 1];
+    p[i + 2] = image.bgr[i];
+  }
+  return out;
+}
+
+/// What one slot of the vector env produced in a step.
+struct SlotResult {
+  State observation{};
+  double reward = 0.0;
+  bool terminated = false;
+  bool truncated = false;
+  StepInfo info;
+};
+
+/// N environments, autoreset "next-step" (Gymnasium 1.x's default): the step after an episode
+/// ended resets that environment and returns its first observation with reward 0 and
+/// terminated = truncated = False.
+class VectorEnv {
+ public:
+  VectorEnv(const WorldConfig& world, int num_envs, int threads) : threads_(threads) {
+    if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
+    envs_.reserve(static_cast<std::size_t>(num_envs));
+    for (int i = 0; i < num_envs; ++i) envs_.emplace_back(world);
+    done_.assign(envs_.size(), 0);
+    results_.resize(envs_.size());
+  }
+
+  std::size_t size() const { return envs_.size(); }
+
+  py::tuple reset(const std::vector<std::optional<std::uint64_t>>& seeds) {
+    if (seeds.size() != envs_.size())
+      throw py::value_error("reset needs one seed (or None) per environment: " + std::to_string(envs_.size()) +
+                            ", got " + std::to_string(seeds.size()));
+    run([&](std::size_t i) {
+      SlotResult& r = results_[i];
+      r = SlotResult{};
+      r.observation = envs_[i].reset(seeds[i]);
+      r.info = envs_[i].info();
+      done_[i] = 0;
+    });
+    return py::make_tuple(observations(), infos());
+  }
+
+  py::tuple step(const py::handle& action_rows) {
+    const auto actions = rows_from<kActionDim>(action_rows, "actions");
+    if (actions.size() != envs_.size())
+      throw py::value_error("actions must have shape (" + std::to_string(envs_.size()) + ", 3), got " +
+                            std::to_string(actions.size()) + " rows");
+    for (std::size_t i = 0; i < actions.size(); ++i) require_finite(actions[i], "action of environment " + std::to_string(i));
+    run([&](std::size_t i) {
+      SlotResult& r = results_[i];
+      if (done_[i]) {
+        r = SlotResult{};
+        r.observation = envs_[i].reset(std::nullopt);
+        r.info = envs_[i].info();
+        done_[i] = 0;
+        return;
+      }
+      const StepResult s = envs_[i].step(actions[i]);
+      r = {s.observation, s.reward, s.terminated, s.truncated, s.info};
+      done_[i] = s.terminated || s.truncated;
+    });
+    const auto n = static_cast<py::ssize_t>(envs_.size());
+    py::array_t<double> rewards(n);
+    py::array_t<bool> terminated(n), truncated(n);
+    for (std::size_t i = 0; i < envs_.size(); ++i) {
+      rewards.mutable_data()[i] = results_[i].reward;
+      terminated.mutable_data()[i] = results_[i].terminated;
+      truncated.mutable_data()[i] = results_[i].truncated;
+    }
+    return py::make_tuple(observations(), rewards, terminated, truncated, infos());
+  }
+
+ private:
+  // Runs fn(i) for every environment on the worker threads, without the GIL; one call at a time.
+  template <class Fn>
+  void run(Fn&& fn) {
+    if (busy_.exchange(true)) throw std::logic_error("DiceStackVectorEnv: reset or step called from two threads at once");
+    struct Release {
+      std::atomic<bool>& flag;
+      ~Release() { flag = false; }
+    } release{busy_};
+    py::gil_scoped_release nogil;
+    parallel_for(envs_.size(), threads_, [&](std::size_t i, int) { fn(i); });
+  }
+
+  py::array_t<double> observations() const {
+    py::array_t<double> out({static_cast<py::ssize_t>(envs_.size()), static_cast<py::ssize_t>(kStateDim)});
+    double* p = out.mutable_data();
+    for (const auto& r : results_) p = std::copy(r.observation.begin(), r.observation.end(), p);
+    return out;
+  }
+
+  // Gymnasium's vector info: one array per key, and a "_key" mask of the environments that
+  // report it (all of them, always).
+  py::dict infos() const {
+    const auto n = static_cast<py::ssize_t>(envs_.size());
+    py::dict out;
+    auto column = [&](const char* key, auto value_of) {
+      using T = decltype(value_of(results_[0]));
+      py::array_t<T> values(n);
+      py::array_t<bool> mask(n);
+      for (std::size_t i = 0; i < results_.size(); ++i) {
+        values.mutable_data()[i] = value_of(results_[i]);
+        mask.mutable_data()[i] = true;
+      }
+      out[key] = values;
+      out[py::str(std::string("_") + key)] = mask;
+    };
+    column("t", [](const SlotResult& r) { return std::int64_t{r.info.t}; });
+    column("distance", [](const SlotResult& r) { return r.info.distance; });
+    column("wall_contact_step", [](const SlotResult& r) { return r.info.wall_contact_step; });
+    column("dice_in_cup", [](const SlotResult& r) { return std::int64_t{r.info.outcome.dice_in_cup}; });
+    column("dice_in_cup_now", [](const SlotResult& r) { return std::int64_t{r.info.outcome.dice_in_cup_now}; });
+    column("stacked", [](const SlotResult& r) { return r.info.outcome.stacked; });
+    column("stacked_steps", [](const SlotResult& r) { return std::int64_t{r.info.outcome.stacked_steps}; });
+    column("wall_contact", [](const SlotResult& r) { return r.info.outcome.wall_contact; });
+    column("realistic_success", [](const SlotResult& r) { return r.info.outcome.realistic_success(); });
+    return out;
+  }
+
+  std::vector<EnvCore> envs_;
+  std::vector<char> done_;
+  std::vector<SlotResult> results_;
+  int threads_;
+  std::atomic<bool> busy_{false};
+};
+
+}  // namespace
+
+std::optional<std::uint64_t> seed_from(const py::handle& seed, const char* what) {
+  if (seed.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(seed) || !PyIndex_Check(seed.ptr()))
+    throw py::type_error(std::string(what) + " must be an int or None, got " + std::string(py::repr(seed)));
+  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(seed.ptr()));
+  if (!index) throw py::error_already_set();
+  const unsigned long long value = PyLong_AsUnsignedLongLong(index.ptr());
+  if (value == static_cast<unsigned long long>(-1) && PyErr_Occurred()) {
+    PyErr_Clear();
+    throw py::value_error(std::string(what) + " must be a whole number in [0, 2^64 - 1], got " + std::string(py::repr(seed)));
+  }
+  return value;
+}
+
+int threads_from(const py::handle& threads) {
+  if (threads.is_none()) return 0;
+  const int t = threads.cast<int>();
+  if (t < 0) throw py::value_error("threads must be >= 0 (0 or None: all cores), got " + std::to_string(t));
+  return t;
+}
+
+py::dict info_dict(const StepInfo& i) {
+  py::dict d;
+  d["t"] = i.t;
+  d["distance"] = i.distance;
+  d["wall_contact_step"] = i.wall_contact_step;
+  d["dice_in_cup"] = i.outcome.dice_in_cup;
+  d["dice_in_cup_now"] = i.outcome.dice_in_cup_now;
+  d["stacked"] = i.outcome.stacked;
+  d["stacked_steps"] = i.outcome.stacked_steps;
+  d["wall_contact"] = i.outcome.wall_contact;
+  d["realistic_success"] = i.outcome.realistic_success();
+  return d;
+}
+
+EnvCore& env_core(const py::handle& env) {
+  if (py::isinstance<EnvCore>(env)) return env.cast<EnvCore&>();
+  if (py::hasattr(env, "_env")) {
+    const py::object inner = env.attr("_env");
+    if (py::isinstance<EnvCore>(inner)) return inner.cast<EnvCore&>();  // kept alive by `env`
+  }
+  throw py::type_error("expected a dicestack.DiceStackEnv, got " + std::string(py::repr(env)));
+}
+
+void bind_env(py::module_& m) {
+  py::class_<Snapshot>(m, "Snapshot", "An exact copy of an environment; picklable, restores only into the same world")
+      .def_property_readonly("state", [](const Snapshot& s) { return to_array(s.env.world.state()); })
+      .def_property_readonly("t", [](const Snapshot& s) { return s.env.outcome.steps; })
+      .def_property_readonly("world_hash", [](const Snapshot& s) { return s.world_hash; })
+      .def(py::pickle(&snapshot_state, &snapshot_from_state));
+
+  py::class_<EnvCore>(m, "Env", "One dice-stacking environment (the core of dicestack.DiceStackEnv)")
+      .def(py::init<const WorldConfig&>(), py::arg("world"))
+      .def(
+          "reset",
+          [](EnvCore& core, const py::object& seed, const py::object& state) {
+            const auto s = seed_from(seed);
+            const State obs = state.is_none() ? core.reset(s) : core.reset_to(state_from(state, "options[\"state\"]"), s);
+            return py::make_tuple(to_array(obs), info_dict(core.info()));
+          },
+          py::arg("seed") = py::none(), py::arg("state") = py::none())
+      .def("step", [](EnvCore& core, const py::handle& action) { return step_tuple(core.step(action_from(action))); },
+           py::arg("action"))
+      .def("snapshot", &take_snapshot)
+      .def("restore", &restore_snapshot, py::arg("snapshot"))
+      .def("render", &render_rgb, py::arg("pixels_per_metre") = 100.0, py::arg("hud") = true)
+      .def("observation_bounds", [](const EnvCore& c) { return bounds(c.env().observation_space()); })
+      .def("action_bounds", [](const EnvCore& c) { return bounds(c.env().action_space()); })
+      .def_property_readonly("state", [](const EnvCore& c) { return to_array(c.env().get_state()); })
+      .def_property_readonly("t", [](const EnvCore& c) { return c.env().t(); })
+      .def_property_readonly("info", [](const EnvCore& c) { return info_dict(c.info()); })
+      .def_property_readonly("world", [](const EnvCore& c) { return c.env().config(); })
+      .def_property_readonly("world_hash", &EnvCore::world_hash)
+      .def_property_readonly("episode_seed", &EnvCore::episode_seed);
+
+  py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
+      .def(py::init([](const WorldConfig& world, int num_envs, const py::object& threads) {
+             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads));
+           }),
+           py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none())
+      .def("__len__", &VectorEnv::size)
+      .def(
+          "reset",
+          [](VectorEnv& v, const py::list& seeds) {
+            std::vector<std::optional<std::uint64_t>> s;
+            for (const auto& seed : seeds) s.push_back(seed_from(seed));
+            return v.reset(s);
+          },
+          py::arg("seeds"))
+      .def("step", &VectorEnv::step, py::arg("actions"));
+}
+
+}  // namespace dicestack::python

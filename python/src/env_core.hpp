@@ -1,0 +1,65 @@
+#pragma once
+// One environment as the Python package steps it: a DiceEnv plus Gymnasium's seeding rule, shared
+// by DiceStackEnv and every slot of DiceStackVectorEnv so that both give the same episodes.
+// Plain C++ (no Python types), so the vector env can step it with the GIL released.
+#include <cstdint>
+#include <optional>
+
+#include <dicestack/core/env.hpp>
+
+namespace dicestack::python {
+
+/// Episode seeds under Gymnasium's rule: reset(seed=s) starts from s; a reset without a seed takes
+/// the next seed of a stream derived from the last explicit seed (derive_seed(s, 1), (s, 2), ...),
+/// or from the operating system's entropy when no seed was ever given.
+class EpisodeSeeds {
+ public:
+  std::uint64_t next(std::optional<std::uint64_t> seed);
+
+  /// The stream's state, for snapshots: the last explicit seed (if any) and resets since.
+  std::optional<std::uint64_t> base() const { return base_; }
+  std::uint64_t count() const { return count_; }
+  void set(std::optional<std::uint64_t> base, std::uint64_t count) { base_ = base, count_ = count; }
+
+ private:
+  std::optional<std::uint64_t> base_;
+  std::uint64_t count_ = 0;
+};
+
+/// A DiceEnv with its seed stream and what the Python info dict reports.
+class EnvCore {
+ public:
+  explicit EnvCore(const WorldConfig& world);
+
+  /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds.
+  State reset(std::optional<std::uint64_t> seed);
+  /// Starts an episode from a bare state; `seed` (per EpisodeSeeds) seeds the action noise.
+  State reset_to(const State& state, std::optional<std::uint64_t> seed);
+  /// One control step. Throws std::logic_error before the first reset (Gymnasium's order).
+  StepResult step(const Action& action);
+
+  /// The info of the episode's latest state (what reset reports; step's own is in StepResult).
+  StepInfo info() const;
+
+  DiceEnv& env() { return env_; }
+  const DiceEnv& env() const { return env_; }
+  std::uint64_t world_hash() const { return world_hash_; }
+  /// The seed of the current episode (0 before the first reset).
+  std::uint64_t episode_seed() const { return episode_seed_; }
+  /// Episodes started so far: an expert acting here restarts when this changes.
+  std::uint64_t episodes() const { return episodes_; }
+  EpisodeSeeds& seeds() { return seeds_; }
+
+  /// Puts back a snapshot's episode bookkeeping beside DiceEnv::restore.
+  void restored(std::uint64_t episode_seed);
+
+ private:
+  DiceEnv env_;
+  State goal_;
+  std::uint64_t world_hash_;
+  EpisodeSeeds seeds_;
+  std::uint64_t episode_seed_ = 0;
+  std::uint64_t episodes_ = 0;
+};
+
+}  // namespace dicestack::python

@@ -1,0 +1,207 @@
+// Models (load, predict, save), the policy a model gives (it keeps its episode's history for the
+// feature map), the automatic experts, and train() / evaluate() as the command line runs them.
+#include <memory>
+#include <optional>
+
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <dicestack/core/expert.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/policy.hpp>
+#include <dicestack/learners/report.hpp>
+#include <dicestack/learners/train.hpp>
+#include <dicestack/regressors/model.hpp>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "demos.hpp"
+#include "errors.hpp"
+
+namespace dicestack::python {
+namespace {
+
+/// A model as Python holds it: where it lives on disk (if anywhere) and how it was trained.
+struct PyModel {
+  std::shared_ptr<Model> model;
+  std::string path;          ///< the file it was loaded from or last saved to; empty: in memory
+  std::optional<py::dict> training;  ///< train()'s report, for models made by train()
+};
+
+/// A model acting step by step: keeps the states of its episode for the feature map.
+class PyPolicy {
+ public:
+  explicit PyPolicy(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
+  void reset() { states_.clear(); }
+  Action act(const py::handle& observation) {
+    states_.push_back(state_from(observation, "observation"));
+    // The world's applied actions are not known here; no built-in feature map reads them.
+    return model_->act(History{states_, {}});
+  }
+  std::size_t t() const { return states_.empty() ? 0 : states_.size() - 1; }
+
+ private:
+  std::shared_ptr<const Model> model_;
+  std::vector<State> states_;
+};
+
+/// An automatic expert acting on a Python environment; restarts (seeded with the episode's seed)
+/// whenever it meets a new episode.
+class PyExpert {
+ public:
+  explicit PyExpert(const std::string& name) : expert_(make_expert(name)) {}
+  Action act(EnvCore& core) {
+    if (world_hash_ && *world_hash_ != core.world_hash())
+      throw py::value_error("expert \"" + expert_->name() +
+                            "\" acts in the world of the first environment it was given; make one expert per world");
+    if (&core != env_ || core.episodes() != episodes_ || core.env().t() == 0) {
+      expert_->reset(core.episode_seed());
+      env_ = &core;
+      episodes_ = core.episodes();
+      world_hash_ = core.world_hash();
+    }
+    return expert_->act(core.env());
+  }
+  std::string name() const { return expert_->name(); }
+
+ private:
+  std::unique_ptr<Expert> expert_;
+  const EnvCore* env_ = nullptr;  // identity only, never dereferenced
+  std::uint64_t episodes_ = 0;
+  std::optional<std::uint64_t> world_hash_;
+};
+
+py::dict string_map(const std::map<std::string, std::string>& values) {
+  py::dict d;
+  for (const auto& [k, v] : values) d[py::str(k)] = v;
+  return d;
+}
+
+/// Demonstrations given as a name or folder ("builtin", "human", a path) or as episodes.
+std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& world, std::string* name) {
+  if (py::isinstance<py::str>(demos)) {
+    const std::string spec = demos.cast<std::string>();
+    std::filesystem::path dir;
+    {
+      py::gil_scoped_release nogil;
+      dir = resolve_demo_set(spec, world);
+    }
+    if (name) *name = dir.string();
+    return reading(dir, [&] { return read_demo_set(dir).episodes; });
+  }
+  if (name) *name = "<episodes from Python>";
+  return episodes_from(demos.cast<py::iterable>());
+}
+
+PyModel train(const WorldConfig& world, const py::handle& demos, const std::string& regressor,
+              const std::vector<std::string>& sets, const std::string& learner, const std::vector<std::string>& options,
+              const std::string& features, const std::string& split, const py::handle& seed, const py::handle& threads,
+              const std::string& out) {
+  if (!out.empty()) check_replaceable(out, model_ownership());  // refuse a user's file before any work
+  TrainRequest request;
+  request.world = world;
+  request.demos = demos_from(demos, world, &request.demos_name);
+  request.regressor = regressor;
+  request.regressor_sets = sets;
+  request.learner = learner;
+  request.learner_options = options;
+  request.features = features;
+  request.split = split;
+  request.seed = seed_from(seed).value_or(0);
+  request.threads = threads_from(threads);
+  std::optional<TrainReport> report;
+  {
+    py::gil_scoped_release nogil;
+    report = train_model(request);
+    if (!out.empty()) save_model(*report->result.model, out);
+  }
+  py::dict training;
+  training["learner"] = learner;
+  training["features"] = report->features;
+  training["seconds"] = report->seconds;
+  training["train_error"] = report->train_error;
+  if (report->test_error) training["test_error"] = *report->test_error;
+  return {report->result.model, out, training};
+}
+
+std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episodes, const py::handle& seed,
+                           const py::handle& threads, const std::string& push, const py::handle& demos) {
+  if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
+  const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push};
+  const InitialPush initial_push = initial_push_from(push);
+  const int t = threads_from(threads);
+  std::optional<std::vector<Episode>> demo_episodes;
+  if (!demos.is_none()) demo_episodes = demos_from(demos, world, nullptr);
+  std::shared_ptr<const Model> model = m.model;
+  py::gil_scoped_release nogil;
+  const EvalStats stats =
+      evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, run.seed, t, initial_push);
+  std::optional<ModelErrors> errors;
+  if (demo_episodes) errors = model_errors(*model, *demo_episodes);
+  return evaluation_json(run, *model, stats, errors ? &*errors : nullptr);
+}
+
+}  // namespace
+
+void bind_models(py::module_& m) {
+  py::class_<PyPolicy>(m, "Policy", "A model acting step by step; keeps its episode's states for the feature map")
+      .def(
+          "reset",
+          [](PyPolicy& p, const py::object& seed) {
+            (void)seed_from(seed);  // checked like every seed; a model's policy draws no random numbers
+            p.reset();
+          },
+          py::arg("seed") = py::none(), "Starts a new episode")
+      .def("act", [](PyPolicy& p, const py::handle& obs) { return to_array(p.act(obs)); }, py::arg("observation"),
+           "The action (dvx, dvy, dw) after this observation")
+      .def("__call__", [](PyPolicy& p, const py::handle& obs) { return to_array(p.act(obs)); }, py::arg("observation"))
+      .def_property_readonly("t", &PyPolicy::t);
+
+  py::class_<PyModel>(m, "Model", "A trained model: a feature map, a regressor and their standardisers")
+      .def("predict", [](const PyModel& pm, const py::handle& x) {
+             const Matrix rows = matrix_from(x, pm.model->features().width(), "X");
+             return to_array(pm.model->predict(rows));
+           }, py::arg("X"), "Actions (N x 3) for rows of the model's feature map (N x input_dim)")
+      .def("policy", [](const PyModel& pm) { return PyPolicy(pm.model); }, "A fresh policy acting with this model")
+      .def("save", [](PyModel& pm, const std::filesystem::path& path) {
+             save_model(*pm.model, path);
+             pm.path = path.string();
+           }, py::arg("path"), "Writes the model file (never over a file that is not a dicestack model)")
+      .def_property_readonly("features", [](const PyModel& pm) { return pm.model->features().name(); })
+      .def_property_readonly("features_version", [](const PyModel& pm) { return pm.model->features().version(); })
+      .def_property_readonly("input_dim", [](const PyModel& pm) { return pm.model->features().width(); })
+      .def_property_readonly("input_names", [](const PyModel& pm) { return pm.model->features().column_names(); })
+      .def_property_readonly("regressor", [](const PyModel& pm) { return pm.model->regressor().name(); })
+      .def_property_readonly("params", [](const PyModel& pm) {
+             py::dict d;
+             for (const auto& [k, v] : pm.model->regressor().params().as_text()) d[py::str(k)] = v;
+             return d;
+           })
+      .def_property_readonly("record", [](const PyModel& pm) { return string_map(pm.model->record); })
+      .def_property_readonly("path", [](const PyModel& pm) { return pm.path.empty() ? py::object(py::none()) : py::str(pm.path); })
+      .def_property_readonly("training", [](const PyModel& pm) { return pm.training ? py::object(*pm.training) : py::none(); });
+
+  m.def("load_model", [](const std::filesystem::path& path) {
+          return PyModel{std::make_shared<Model>(reading(path, [&] { return load_model(path); })), path.string(),
+                         std::nullopt};
+        }, py::arg("path"));
+
+  py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\" or \"mpc\") acting on an environment")
+      .def(py::init<const std::string&>(), py::arg("name"))
+      .def("act", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
+      .def("__call__", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
+      .def_property_readonly("name", &PyExpert::name);
+  m.def("expert_names", [] {
+    std::vector<std::string> names;
+    for (const auto& e : expert_list()) names.push_back(e.name);
+    return names;
+  });
+
+  m.def("train", &train, py::arg("world"), py::arg("demos"), py::arg("regressor"), py::arg("sets"), py::arg("learner"),
+        py::arg("options"), py::arg("features"), py::arg("split"), py::arg("seed"), py::arg("threads"), py::arg("out"));
+  m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
+        py::arg("threads"), py::arg("initial_push"), py::arg("demos"));
+}
+
+}  // namespace dicestack::python

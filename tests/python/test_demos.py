@@ -1,0 +1,72 @@
+"""Demonstrations as numpy arrays: the built-in set, and our folder format written and read back
+(the library's ownership rule included)."""
+import numpy as np
+import pytest
+
+import dicestack
+
+
+def test_builtin_set_shapes(builtin_episodes):
+    assert len(builtin_episodes) == 80
+    for e in builtin_episodes:
+        assert e.states.dtype == np.float64 and e.states.shape == (len(e), 24)
+        assert e.actions.dtype == np.float64 and e.actions.shape == (len(e), 3)
+        assert len(e.sources) == len(e) and e.source == "expert"
+        assert e.realistic_success and e.dice_in_cup == 3
+        assert isinstance(e.seed, int)
+    assert builtin_episodes[0].name == "episode_0000"
+
+
+def test_save_and_load_round_trip(tmp_path, builtin_episodes):
+    episodes = builtin_episodes[:3]
+    folder = tmp_path / "set"
+    dicestack.save_demos(episodes, folder, description="three of the built-in set")
+    back = dicestack.load_demos(folder)
+    assert [e.name for e in back] == ["episode_0000", "episode_0001", "episode_0002"]
+    for a, b in zip(episodes, back):
+        np.testing.assert_array_equal(a.states, b.states)
+        np.testing.assert_array_equal(a.actions, b.actions)
+        assert a.sources == b.sources and a.seed == b.seed
+        assert (a.stacked, a.wall_contact, a.dice_in_cup) == (b.stacked, b.wall_contact, b.dice_in_cup)
+    dicestack.save_demos(back[:1], folder)  # our own set may be replaced
+    assert len(dicestack.load_demos(folder)) == 1
+
+
+def test_episodes_made_in_python_save(tmp_path, rng):
+    env = dicestack.DiceStackEnv()
+    obs, _ = env.reset(seed=3)
+    states, actions = [], []
+    for _ in range(5):
+        action = rng.uniform(-1, 1, 3) * [1.0, 0.1, 0.5]
+        states.append(obs)
+        actions.append(action)
+        obs, *_ = env.step(action)
+    dicestack.save_demos([dicestack.Episode(states, actions, seed=3)], tmp_path / "mine")
+    (back,) = dicestack.load_demos(tmp_path / "mine")
+    assert back.source == "policy" and back.seed == 3
+    np.testing.assert_array_equal(back.states, np.array(states))
+
+
+def test_a_users_folder_is_never_replaced(tmp_path, builtin_episodes):
+    folder = tmp_path / "notes"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    with pytest.raises(ValueError, match="refusing to replace"):
+        dicestack.save_demos(builtin_episodes[:1], folder)
+    assert (folder / "notes.txt").read_text() == "mine"
+
+
+def test_bad_episodes_and_folders(tmp_path):
+    with pytest.raises(ValueError, match="shape"):
+        dicestack.save_demos([dicestack.Episode(np.zeros((3, 24)), np.zeros((3, 2)))], tmp_path / "a")
+    with pytest.raises(ValueError, match="states, 2 actions"):
+        dicestack.save_demos([dicestack.Episode(np.zeros((3, 24)), np.zeros((2, 3)))], tmp_path / "b")
+    with pytest.raises(ValueError, match="not one of human"):
+        dicestack.save_demos([dicestack.Episode(np.zeros((1, 24)), np.zeros((1, 3)), sources=["robot"])], tmp_path / "c")
+    with pytest.raises(FileNotFoundError):
+        dicestack.load_demos(tmp_path / "missing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError):
+        dicestack.load_demos(tmp_path / "empty")
+    with pytest.raises(TypeError):
+        dicestack.save_demos([{"states": []}], tmp_path / "d")

@@ -1,0 +1,151 @@
+"""DiceStackEnv under the Gymnasium contract: signatures, spaces, dtypes, seeding, rendering.
+Debian has no gymnasium package, so these are our own checks of what
+gymnasium.utils.env_checker.check_env checks (that test runs too where gymnasium is installed)."""
+import inspect
+
+import numpy as np
+import pytest
+
+import dicestack
+from conftest import random_actions, short_world
+
+INFO_KEYS = {"t", "distance", "wall_contact_step", "dice_in_cup", "dice_in_cup_now", "stacked", "stacked_steps",
+             "wall_contact", "realistic_success"}
+
+
+def test_reset_and_step_signatures_are_gymnasiums():
+    reset = inspect.signature(dicestack.DiceStackEnv.reset).parameters
+    assert reset["seed"].kind is inspect.Parameter.KEYWORD_ONLY and reset["seed"].default is None
+    assert reset["options"].kind is inspect.Parameter.KEYWORD_ONLY and reset["options"].default is None
+    assert list(inspect.signature(dicestack.DiceStackEnv.step).parameters) == ["self", "action"]
+    init = inspect.signature(dicestack.DiceStackEnv.__init__).parameters
+    assert init["world"].default is None and init["render_mode"].default is None
+
+
+def test_reset_and_step_return_gymnasium_tuples(env, rng):
+    obs, info = env.reset(seed=0)
+    assert isinstance(obs, np.ndarray) and obs.dtype == np.float64 and obs.shape == (24,)
+    assert isinstance(info, dict) and set(info) == INFO_KEYS
+    result = env.step(random_actions(rng, 1)[0])
+    assert len(result) == 5
+    obs, reward, terminated, truncated, info = result
+    assert obs.dtype == np.float64 and obs.shape == (24,)
+    assert type(reward) is float and type(terminated) is bool and type(truncated) is bool
+    assert set(info) == INFO_KEYS and info["t"] == 1
+
+
+def test_spaces_hold_every_observation_and_sample(env, rng):
+    assert env.observation_space.shape == (24,) and env.observation_space.dtype == np.float64
+    assert env.action_space.shape == (3,) and env.action_space.dtype == np.float64
+    assert np.array_equal(env.action_space.low, -env.action_space.high)
+    np.testing.assert_array_equal(env.action_space.high, [20.0, 20.0, 10.0])
+    env.action_space.seed(3)
+    for _ in range(20):
+        assert env.action_space.contains(env.action_space.sample())
+    obs, _ = env.reset(seed=5)
+    assert env.observation_space.contains(obs)
+    for action in random_actions(rng, 60):
+        obs, *_ = env.step(action)
+        assert env.observation_space.contains(obs)
+
+
+def test_metadata_and_rgb_render(env):
+    assert "rgb_array" in env.metadata["render_modes"]
+    assert env.metadata["render_fps"] == 30
+    env.reset(seed=1)
+    frame = env.render()
+    assert frame.shape == (700, 900, 3) and frame.dtype == np.uint8
+    assert frame.std() > 0  # a picture, not a blank
+    assert dicestack.DiceStackEnv().render() is None
+    with pytest.raises(ValueError, match="render_mode"):
+        dicestack.DiceStackEnv(render_mode="human")
+
+
+def test_same_seed_same_trajectory(rng):
+    actions = random_actions(rng, 80)
+
+    def run():
+        env = dicestack.DiceStackEnv()
+        steps = [env.reset(seed=42)]
+        steps += [env.step(a) for a in actions]
+        return steps
+
+    a, b = run(), run()
+    np.testing.assert_array_equal(a[0][0], b[0][0])
+    for x, y in zip(a[1:], b[1:]):
+        np.testing.assert_array_equal(x[0], y[0])
+        assert x[1:] == y[1:]
+
+
+def test_seeding_follows_gymnasium(env):
+    obs_1, _ = env.reset(seed=123)
+    obs_2, _ = env.reset()
+    obs_3, _ = env.reset(seed=123)
+    obs_4, _ = env.reset()
+    np.testing.assert_array_equal(obs_1, obs_3)
+    np.testing.assert_array_equal(obs_2, obs_4)
+    assert not np.array_equal(obs_1, obs_2)
+    obs_5, _ = env.reset(seed=456)
+    assert not np.array_equal(obs_1, obs_5)
+    assert env.np_random is not None
+
+
+def test_reset_from_a_given_state(env, rng):
+    start, _ = env.reset(seed=9)
+    for a in random_actions(rng, 10):
+        env.step(a)
+    obs, info = env.reset(options={"state": start})
+    np.testing.assert_array_equal(obs, start)
+    assert info["t"] == 0
+    with pytest.raises(ValueError, match="unknown reset option"):
+        env.reset(options={"start": "paper"})
+
+
+def test_time_limit_truncates():
+    env = dicestack.DiceStackEnv(world=short_world(5))
+    env.reset(seed=0)
+    flags = [env.step(np.zeros(3))[2:4] for _ in range(5)]
+    assert flags == [(False, False)] * 4 + [(False, True)]
+
+
+def test_expert_episode_terminates_with_realistic_success():
+    env = dicestack.DiceStackEnv()
+    expert = dicestack.expert("mpc")
+    env.reset(seed=0)
+    for _ in range(400):
+        _, _, terminated, truncated, info = env.step(expert(env))
+        if terminated or truncated:
+            break
+    assert terminated and info["realistic_success"] and info["stacked"] and not info["wall_contact"]
+
+
+def test_scripted_expert_acts_in_the_action_space(env):
+    expert = dicestack.expert("scripted")
+    assert expert.name == "scripted"
+    env.reset(seed=2)
+    action = expert.act(env)
+    assert action.shape == (3,) and action.dtype == np.float64 and env.action_space.contains(action)
+
+
+def test_world_from_dict_file_and_default(tmp_path):
+    world = short_world(7)
+    path = tmp_path / "w.json"
+    import json
+    path.write_text(json.dumps(world))
+    assert dicestack.DiceStackEnv(world=world).world == world
+    assert dicestack.DiceStackEnv(world=path).world == world
+    assert dicestack.DiceStackEnv().world == dicestack.default_world()
+
+
+def test_context_manager_and_unwrapped(env):
+    with dicestack.DiceStackEnv() as e:
+        e.reset(seed=0)
+    assert env.unwrapped is env
+
+
+def test_gymnasium_registration_and_checker():
+    gymnasium = pytest.importorskip("gymnasium")
+    from gymnasium.utils.env_checker import check_env
+
+    env = gymnasium.make("dicestack/DiceStack-v0")
+    check_env(env.unwrapped)

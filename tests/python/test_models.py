@@ -1,0 +1,102 @@
+"""Training, models, policies and evaluation from Python: the command line's code paths, with
+the same results as the command line."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import dicestack
+
+
+@pytest.fixture(scope="module")
+def few(builtin_episodes):
+    return builtin_episodes[:10]
+
+
+@pytest.fixture(scope="module")
+def knn(few):
+    return dicestack.train("knn", demos=few, params={"k": 2})
+
+
+def test_train_bc_returns_a_model(knn):
+    assert knn.regressor == "knn" and knn.params["k"] == "2"
+    assert knn.features == "state" and knn.input_dim == 24 and len(knn.input_names) == 24
+    assert knn.record["learner"] == "bc" and knn.record["split"] == "episodes"
+    assert knn.training["train_error"] >= 0 and knn.training["test_error"] > 0
+    assert knn.path is None
+
+
+def test_predict_and_policy_agree(knn, few):
+    states = few[0].states[:20]
+    predicted = knn.predict(states)
+    assert predicted.shape == (20, 3) and predicted.dtype == np.float64
+    policy = knn.policy()
+    policy.reset(seed=0)
+    np.testing.assert_array_equal(policy.act(states[0]), predicted[0])
+    assert policy.t == 0
+
+
+def test_policy_keeps_the_history_its_feature_map_reads(few):
+    model = dicestack.train("knn", demos=few, features="state+clock", split="none")
+    assert model.features == "state+clock" and model.input_dim == 25
+    states = few[1].states[:15]
+    rows = np.column_stack([states, np.arange(len(states))])
+    expected = model.predict(rows)
+    policy = model.policy()
+    acted = np.array([policy(s) for s in states])
+    np.testing.assert_array_equal(acted, expected)
+    policy.reset()
+    np.testing.assert_array_equal(policy(states[0]), expected[0])
+
+
+def test_save_load_round_trip(knn, few, tmp_path):
+    path = tmp_path / "knn.dsm"
+    knn.save(path)
+    loaded = dicestack.load_model(path)
+    assert loaded.path == str(path) and loaded.training is None
+    np.testing.assert_array_equal(loaded.predict(few[2].states), knn.predict(few[2].states))
+
+
+def test_train_writes_out_and_refuses_a_users_file(few, tmp_path):
+    out = tmp_path / "m.dsm"
+    model = dicestack.train("linear_svr", demos=few, out=out, seed=1)
+    assert out.exists() and model.path == str(out)
+    mine = tmp_path / "mine.txt"
+    mine.write_text("not a model")
+    with pytest.raises(ValueError, match="refusing to replace"):
+        dicestack.train("knn", demos=few, out=mine)
+    assert mine.read_text() == "not a model"
+
+
+def test_evaluate_reports_the_clis_keys_and_values(knn, few, tmp_path, cli):
+    path = tmp_path / "knn.dsm"
+    knn.save(path)
+    ours = dicestack.evaluate(dicestack.load_model(path), episodes=3, seed=4)
+    theirs = json.loads(subprocess.run([cli, "evaluate", "--model", str(path), "--episodes", "3", "--seed", "4",
+                                        "--json"], check=True, capture_output=True, text=True).stdout)
+    assert set(ours) == set(theirs)
+    for key in ("episodes", "stacked_rate", "wall_contact_rate", "realistic_success_rate", "dice_in_cup_mean",
+                "mean_episode_length", "model", "regressor", "features"):
+        assert ours[key] == theirs[key], key
+
+
+def test_evaluate_with_demos_and_threads(knn, few):
+    one = dicestack.evaluate(knn, episodes=3, seed=2, threads=1, demos=few)
+    two = dicestack.evaluate(knn, episodes=3, seed=2, threads=2, demos=few)
+    for key in ("stacked_rate", "realistic_success_rate", "dice_in_cup_mean", "train_error", "test_error"):
+        assert one[key] == two[key], key
+    assert one["episodes"] == 3 and "split" in one
+
+
+def test_expert_refuses_an_env_of_another_world():
+    expert = dicestack.expert("mpc")
+    env = dicestack.DiceStackEnv()
+    env.reset(seed=0)
+    expert(env)
+    world = dicestack.default_world()
+    world["episode"]["max_steps"] = 20
+    other = dicestack.DiceStackEnv(world=world)
+    other.reset(seed=0)
+    with pytest.raises(ValueError, match="one expert per world"):
+        expert(other)
