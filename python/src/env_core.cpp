@@ -24,7 +24,7 @@ std::uint64_t EpisodeSeeds::next(std::optional<std::uint64_t> seed) {
 }
 
 EnvCore::EnvCore(const WorldConfig& world)
-    : env_(world), goal_(goal_state(world)), world_hash_(world_hash(world)) {}
+    : env_(world), goal_(goal_state(world)), world_hash_(dicestack::world_hash(world)) {}
 
 State EnvCore::reset(std::optional<std::uint64_t> seed) {
   episode_seed_ = seeds_.next(seed);
