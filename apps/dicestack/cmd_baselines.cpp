@@ -87,6 +87,7 @@ int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, c
                     const nlohmann::json& curve, bool json, const std::string& text) {
   nlohmann::json saved = summary;
   saved["format"] = kBaselineFormat;
+  saved["version"] = 1;
   if (!curve.is_null()) saved[curve_key] = curve;
   AtomicFile f(file, Ownership::json_object("dicestack baseline summary", kBaselineFormat));
   f.stream() << saved.dump(1);

@@ -189,6 +189,7 @@ std::string render(const std::vector<Row>& rows, const std::string& format, cons
   if (format == "json") {
     json j = meta;
     j["format"] = kLeaderboardFormat;
+    j["version"] = 1;
     j["rows"] = json::array();
     for (const auto& r : rows) j["rows"].push_back(row_json(r));
     os << j.dump(2) << '\n';
@@ -343,7 +344,8 @@ int run_leaderboard(LeaderboardOptions opt) {
   if (!partial.empty() && std::filesystem::exists(partial)) {
     try {
       json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
-      if (p.value("meta", json()) == meta) done = p.value("rows", json::object());
+      // Rows of another version or other settings are not reused.
+      if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) done = p.value("rows", json::object());
     } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
     }
   }
@@ -407,7 +409,7 @@ int run_leaderboard(LeaderboardOptions opt) {
       if (!partial.empty()) {
         done[key] = row_json(row);
         AtomicFile f(partial, partial_ownership());
-        f.stream() << json{{"format", kPartialFormat}, {"meta", meta}, {"rows", done}}.dump();
+        f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
         f.commit();
       }
     }
