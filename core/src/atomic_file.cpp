@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cerrno>
 #include <charconv>
+#include <cstdio>
 #include <random>
 #include <system_error>
 
@@ -13,6 +14,7 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/types.hpp>
 
 namespace dicestack {
 namespace {
@@ -92,12 +94,23 @@ bool process_is_running(long pid) {
   return !(kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH);
 }
 
+std::string host_tag() {
+  static const std::string tag = [] {
+    char name[256] = {};
+    if (gethostname(name, sizeof name - 1) != 0) name[0] = '\0';
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "h%08llx", static_cast<unsigned long long>(fnv1a(name) >> 32));
+    return std::string(hex);
+  }();
+  return tag;
+}
+
 fs::path temporary_sibling(const fs::path& target, std::string_view tag) {
   static std::atomic<unsigned long> counter{0};
   thread_local std::mt19937_64 rng{std::random_device{}()};  // only names scratch files
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  return parent / (leftover_prefix(target, tag) + std::to_string(getpid()) + "-" + std::to_string(counter++) + "x" +
-                   std::to_string(rng() % 1000000000));
+  return parent / (leftover_prefix(target, tag) + std::to_string(getpid()) + "-" + host_tag() + "-" +
+                   std::to_string(counter++) + "x" + std::to_string(rng() % 1000000000));
 }
 
 std::vector<fs::path> dead_leftovers(const fs::path& target, std::string_view tag) {
@@ -113,6 +126,10 @@ std::vector<fs::path> dead_leftovers(const fs::path& target, std::string_view ta
     long pid = 0;
     const auto r = std::from_chars(digits, stop, pid);
     if (r.ec != std::errc() || r.ptr == digits || r.ptr == stop || *r.ptr != '-') continue;
+    // A pid means something only on the host that wrote it (a shared folder sees several):
+    // another host's leftovers are never judged. Names without a host tag predate it.
+    const std::string_view rest(r.ptr + 1, static_cast<std::size_t>(stop - r.ptr - 1));
+    if (rest.size() > 10 && rest[0] == 'h' && rest[9] == '-' && rest.substr(0, 9) != host_tag()) continue;
     if (!process_is_running(pid)) out.push_back(it->path());
   }
   return out;

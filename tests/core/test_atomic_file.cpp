@@ -107,12 +107,19 @@ TEST(AtomicFile, DeadRunsLeftoversAreRemovedLiveOnesKept) {
   const fs::path live = dir / (".out.txt.tmp-" + std::to_string(getpid()) + "-x");
   const fs::path parent = dir / (".out.txt.tmp-" + std::to_string(getppid()) + "-x");
   const fs::path other = dir / (".other.txt.tmp-" + std::to_string(test::dead_pid()) + "-x");
-  for (const auto& p : {dead, live, parent, other}) std::ofstream(p) << "half";
+  // Our own naming: a dead pid on this host is cleaned up; on another host a pid means nothing.
+  const std::string ours = temporary_sibling(path, "tmp").filename().string();  // .out.txt.tmp-<pid>-h<8 hex>-...
+  const std::string host = ours.substr(ours.find("-h") + 1, 9);
+  const fs::path dead_here = dir / (".out.txt.tmp-" + std::to_string(test::dead_pid()) + "-" + host + "-1x2");
+  const fs::path other_host = dir / (".out.txt.tmp-" + std::to_string(test::dead_pid()) + "-h00000000-1x2");
+  for (const auto& p : {dead, live, parent, other, dead_here, other_host}) std::ofstream(p) << "half";
   {
     AtomicFile f(path, kText);
     f.stream() << "new";
     f.commit();
   }
+  EXPECT_FALSE(fs::exists(dead_here));
+  EXPECT_TRUE(fs::exists(other_host)) << "another host's scratch file: its pid says nothing here";
   EXPECT_FALSE(fs::exists(dead)) << "a killed run's temporary file of this target is cleaned up";
   EXPECT_TRUE(fs::exists(live)) << "a running writer's temporary file is never touched";
   EXPECT_TRUE(fs::exists(parent));

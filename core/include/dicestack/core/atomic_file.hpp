@@ -32,12 +32,13 @@ struct Ownership {
 /// "PATH: exists and is not a WHAT; refusing to replace it: choose another --out or remove it yourself".
 void check_replaceable(const std::filesystem::path& path, const Ownership& owner);
 
-/// A fresh name next to `target` for a scratch file or folder: ".<name>.<tag>-<pid>-<unique>",
-/// unique within this process and, by a random part, across processes.
+/// A fresh name next to `target` for a scratch file or folder:
+/// ".<name>.<tag>-<pid>-h<host hash>-<unique>", unique within this process and, by a random
+/// part, across processes and hosts.
 std::filesystem::path temporary_sibling(const std::filesystem::path& target, std::string_view tag);
 
 /// Leftovers of `target` named by temporary_sibling with `tag` whose writer's pid no longer
-/// runs (killed runs). A live run's scratch files are never listed.
+/// runs on this host (killed runs). A live run's scratch files, and another host's, are never listed.
 std::vector<std::filesystem::path> dead_leftovers(const std::filesystem::path& target, std::string_view tag);
 
 /// True when the pid names a process that exists (kill(pid, 0) does not fail with ESRCH).
