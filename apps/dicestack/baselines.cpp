@@ -1,0 +1,83 @@
+#include "baselines.hpp"
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+namespace dicestack::cli {
+
+WorldConfig open_loop_world(const OptimiseCommandOptions& opt) {
+  WorldConfig w = opt.world.load();
+  w.physics.gravity.x *= opt.gravity_scale;
+  w.physics.gravity.y *= opt.gravity_scale;
+  w.physics.action_noise = opt.noise;
+  if (opt.discount >= 0.0) w.cost.gamma = opt.discount;
+  return w;
+}
+
+void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt) {
+  opt.world.add_to(cmd);
+  cmd.add_option("--steps", opt.settings.steps, "Control steps of the sequence (the original used 50, the paper's text 30)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd.add_option("--gravity-scale", opt.gravity_scale, "Multiplies gravity (the paper's text: 3)")->capture_default_str();
+  cmd.add_option("--noise", opt.noise, "Std of action noise, as a fraction of the action scale (0: deterministic)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd.add_option("--repeats", opt.settings.repeats, "Noisy runs averaged per evaluation")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd.add_option("--discount", opt.discount, "Discount gamma of eq. 6 (default: the world's, 0.1)")->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--threads", opt.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+}
+
+Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin) {
+  DiceEnv env(world);
+  Episode e;
+  e.name = "episode_0000";
+  e.origin = origin;
+  e.seed = seed;
+  State s = env.reset_to(paper_start_state(world), e.seed);
+  for (const Action& a : actions) {
+    e.states.push_back(s);
+    e.actions.push_back(a);
+    e.sources.push_back(StepSource::policy);
+    s = env.step(a).observation;
+  }
+  e.outcome = env.outcome();
+  return e;
+}
+
+void write_episode_set(const WorldConfig& world, const Episode& e, const std::string& description,
+                       const std::string& provenance, const std::filesystem::path& out) {
+  DemoSet set;
+  set.world = world;
+  set.description = description;
+  set.provenance = provenance;
+  set.episodes.push_back(e);
+  write_demo_set(set, out);
+}
+
+nlohmann::json outcome_json(const Outcome& o) {
+  return {{"dice_in_cup", o.dice_in_cup}, {"stacked", o.stacked}, {"wall_contact", o.wall_contact},
+          {"realistic_success", o.realistic_success()}};
+}
+
+std::string outcome_text(const Outcome& o) {
+  auto yes = [](bool b) { return b ? "yes" : "no"; };
+  return "dice in cup " + std::to_string(o.dice_in_cup) + ", stacked " + yes(o.stacked) + ", wall contact " +
+         yes(o.wall_contact) + ", realistic success " + yes(o.realistic_success());
+}
+
+int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, const std::string& curve_key,
+                    const nlohmann::json& curve, bool json, const std::string& text) {
+  nlohmann::json saved = summary;
+  saved["format"] = kBaselineFormat;
+  saved["version"] = 1;
+  if (!curve.is_null()) saved[curve_key] = curve;
+  AtomicFile f(file, Ownership::json_object("dicestack baseline summary", kBaselineFormat));
+  f.stream() << saved.dump(1);
+  f.commit();
+  print_line(json ? summary.dump() : text);
+  return 0;
+}
+
+}  // namespace dicestack::cli

@@ -1,0 +1,72 @@
+// `dicestack rrt`: RRT from the paper's start (paper V-D).
+#include <algorithm>
+#include <cstdio>
+
+#include <dicestack/core/rrt.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+#include "baselines.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct RrtCommandOptions {
+  WorldOption world;
+  RrtOptions rrt;
+  std::filesystem::path out;
+  bool json = false;
+};
+
+int run_rrt(const RrtCommandOptions& opt) {
+  check_demo_set_replaceable(opt.out);
+  const WorldConfig world = opt.world.load();
+  ProgressBar bar;
+  const RrtResult r = rrt(world, opt.rrt, [&](int nodes, double best) {
+    char text[160];
+    std::snprintf(text, sizeof text, "rrt: %d/%d nodes, nearest to the goal %.4g", nodes, opt.rrt.nodes, best);
+    bar.update(static_cast<double>(nodes) / std::max(1, opt.rrt.nodes), text);
+  });
+  bar.finish();
+  WorldConfig played = world;
+  played.episode.max_steps = std::max(played.episode.max_steps, static_cast<int>(r.actions.size()));
+  // When no node got nearer the goal than the start, there is no path: only rrt.json is written.
+  const Episode path = r.actions.empty() ? Episode{} : replay(played, r.actions, 0, "dicestack rrt");
+  if (r.actions.empty()) std::filesystem::create_directories(opt.out);
+  else
+    write_episode_set(played, path, "the path to the node nearest the goal in the tree of dicestack rrt",
+                      "dicestack rrt --nodes " + std::to_string(opt.rrt.nodes) + " --extend-steps " +
+                          std::to_string(opt.rrt.extend_steps) + " --seed " + std::to_string(opt.rrt.seed),
+                      opt.out);
+  const double rate = static_cast<double>(r.simulated_steps) / std::max(r.seconds, 1e-9);
+  nlohmann::json j{{"nodes", r.nodes},          {"simulated_steps", r.simulated_steps}, {"seconds", r.seconds},
+                   {"steps_per_second", rate},  {"best_distance", r.best_distance},   {"path_steps", r.actions.size()},
+                   {"seed", opt.rrt.seed},      {"out", opt.out.string()}};
+  j.update(outcome_json(path.outcome));
+  char line[256];
+  std::snprintf(line, sizeof line, "rrt: %d nodes, %lld simulated steps in %.1f s (%.0f steps/s); nearest to the goal %.4g after %zu steps\n",
+                r.nodes, r.simulated_steps, r.seconds, rate, r.best_distance, r.actions.size());
+  return finish_baseline(opt.out / "rrt.json", j, "", nullptr, opt.json,
+                         line + ("path (none if no node got nearer than the start): " + outcome_text(path.outcome) + " -> " +
+                                 opt.out.string()));
+}
+
+}  // namespace
+
+void add_rrt_command(CLI::App& app) {
+  auto opt = std::make_shared<RrtCommandOptions>();
+  auto& r = opt->rrt;
+  CLI::App* cmd = app.add_subcommand("rrt", "RRT from the paper's start (paper V-D): extensions optimise a few steps of actions");
+  opt->world.add_to(*cmd);
+  cmd->add_option("--nodes", r.nodes, "Extensions")->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--extend-steps", r.extend_steps, "Control steps per extension")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--extend-iterations", r.extend_iterations, "CMA-ES generations per extension")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--goal-bias", r.goal_bias, "Probability of growing towards the goal")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  cmd->add_option("--max-depth", r.max_depth_steps, "Nodes this many steps deep are not extended")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", r.seed, "Seed")->check(seed_check())->capture_default_str();
+  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--out", opt->out, "Folder for the best path (a demonstration set) and rrt.json")->required();
+  cmd->add_flag("--json", opt->json, "Print one JSON object");
+  cmd->callback([opt] { run_rrt(*opt); });
+}
+
+}  // namespace dicestack::cli
