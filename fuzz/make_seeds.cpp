@@ -1,7 +1,8 @@
 // Writes the generated part of the seed corpus (scripts/fuzz.sh --make-seeds): for every
 // built-in regressor, the payloads of two tiny fitted models (20 rows, 24 -> 3 and 4 -> 2, fixed
-// seeds) behind their dimension bytes; the default world config; a 3-step demonstration set's
-// meta.json and episode CSV, as write_demo_set writes them. Usage: dicestack_fuzz_seeds CORPUS_DIR
+// seeds) behind their dimension bytes; a model file of each (and one in format 1); the default
+// world config; a 3-step demonstration set's meta.json and episode CSV, as write_demo_set
+// writes them. Usage: dicestack_fuzz_seeds CORPUS_DIR
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,10 +11,12 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/regressors/registry.hpp>
+#include <dicestack/regressors/model.hpp>
 
 #include "payload_input.hpp"
 
@@ -69,6 +72,23 @@ int main(int argc, char** argv) {
               fuzz::dim_bytes(d, k) + r->save_payload());
       }
     }
+    // Whole model files: each regressor on 20 states, and a format 1 file (no feature map).
+    const fs::path tmp = fs::temp_directory_path() / ("dicestack_fuzz_seeds_" + std::to_string(getpid()));
+    fs::create_directories(tmp);
+    for (const auto& name : {"knn", "linear_svr", "rbf_svr", "mlp", "random_forest", "gbt"}) {
+      Matrix x, y;
+      tiny_data(kStateDim, kActionDim, 19, x, y);
+      save_model(Model::train(registry.create(name, fuzz::seed_fit_settings(name)), x, y, 19), tmp / "m.dsm");
+      write(out / "model_file" / (std::string(name) + ".dsm"), slurp(tmp / "m.dsm"));
+    }
+    {
+      const std::string file = slurp(out / "model_file" / "linear_svr.dsm");
+      const auto newline = file.find('\n');
+      auto header = nlohmann::json::parse(file.substr(0, newline));
+      for (const char* key : {"features", "features_version", "input_dim", "input_names", "checksum"}) header.erase(key);
+      header["version"] = 1;
+      write(out / "model_file" / "version1.dsm", header.dump() + file.substr(newline));
+    }
     write(out / "world_config" / "default.json", to_json(WorldConfig{}));
 
     DemoSet set;
@@ -84,10 +104,9 @@ int main(int argc, char** argv) {
     }
     e.outcome.steps = 3;
     set.episodes.push_back(e);
-    const fs::path tmp = fs::temp_directory_path() / ("dicestack_fuzz_seeds_" + std::to_string(getpid()));
-    write_demo_set(set, tmp);
-    write(out / "demo_meta" / "written.json", slurp(tmp / "meta.json"));
-    write(out / "episode_csv" / "written.csv", slurp(tmp / "episode_0000.csv"));
+    write_demo_set(set, tmp / "set");
+    write(out / "demo_meta" / "written.json", slurp(tmp / "set" / "meta.json"));
+    write(out / "episode_csv" / "written.csv", slurp(tmp / "set" / "episode_0000.csv"));
     fs::remove_all(tmp);
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "dicestack_fuzz_seeds: %s\n", ex.what());

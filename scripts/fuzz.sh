@@ -5,13 +5,13 @@
 #
 #   scripts/fuzz.sh [TARGET...] [--runs N] [--time S] [--jobs J] [--make-seeds] [--build-only]
 #
-#   TARGET        episode_csv demo_meta world_config payload_knn payload_linear_svr
+#   TARGET        episode_csv demo_meta world_config model_file payload_knn payload_linear_svr
 #                 payload_rbf_svr payload_mlp payload_random_forest payload_gbt (default: all)
 #   --runs N      executions per target (default 1000000; 0 = no limit, use with --time)
 #   --time S      also stop a target after S seconds
 #   --jobs J      build jobs (default 2)
-#   --make-seeds  regenerate the generated seeds (fitted payloads, default world config, a
-#                 written meta.json and episode CSV) into fuzz/corpus/, then run as usual
+#   --make-seeds  regenerate the generated seeds (fitted payloads and model files, the default
+#                 world config, a written meta.json and episode CSV) into fuzz/corpus/
 #   --build-only  configure and build, run nothing
 #
 # New inputs the fuzzer finds go to build-fuzz/corpus/<target>/ (never into the repository);
@@ -23,7 +23,7 @@ set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${DICESTACK_FUZZ_BUILD:-$root/build-fuzz}
-all=(episode_csv demo_meta world_config payload_knn payload_linear_svr payload_rbf_svr payload_mlp
+all=(episode_csv demo_meta world_config model_file payload_knn payload_linear_svr payload_rbf_svr payload_mlp
      payload_random_forest payload_gbt)
 runs=1000000 seconds=0 jobs=2 make_seeds=0 build_only=0 targets=()
 

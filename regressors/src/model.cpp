@@ -117,14 +117,21 @@ void save_model(const Model& model, const std::filesystem::path& path) {
 }
 
 Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry) {
-  const std::string where = path.string() + ": ";
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(where + "cannot open model file");
-  std::string first;
-  if (!std::getline(in, first) || first.empty()) throw InputError(where + "empty file; not a dicestack model");
+  if (!in) throw InputError(path.string() + ": cannot open model file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return parse_model_file(bytes.str(), path.string(), registry);
+}
+
+Model parse_model_file(std::string_view bytes, const std::string& path, const RegressorRegistry& registry) {
+  const std::string where = path + ": ";
+  const auto newline = bytes.find('\n');
+  const std::string_view first = bytes.substr(0, newline);
+  if (first.empty()) throw InputError(where + "empty file; not a dicestack model");
   json h;
   try {
-    h = parse_json_limited<json>(first, path.string());
+    h = parse_json_limited<json>(first, path);
   } catch (const json::exception&) {
     throw InputError(where + "the first line is not a JSON header; not a dicestack model");
   }
@@ -134,19 +141,14 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
     if (version > kModelFormatVersion)
       throw InputError(where + "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
                        std::to_string(kModelFormatVersion) + "); upgrade dicestack");
-    // The payload's size against the bytes present, before anything is allocated.
-    const auto bytes = header_count(h, "payload_bytes", std::uint64_t{1} << 40, where);
-    const auto body_start = in.tellg();
-    in.seekg(0, std::ios::end);
-    const auto present = static_cast<std::uint64_t>(in.tellg() - body_start);
-    in.seekg(body_start);
-    if (present < bytes)
-      throw InputError(where + "truncated: the payload has " + std::to_string(present) + " of " + std::to_string(bytes) +
-                       " bytes");
-    if (present > bytes) throw InputError(where + "has bytes after the payload; corrupted");
-    std::string payload(static_cast<std::size_t>(bytes), '\0');
-    in.read(payload.data(), static_cast<std::streamsize>(bytes));
-    if (static_cast<std::uint64_t>(in.gcount()) != bytes) throw InputError(where + "cannot read the payload");
+    // The payload's size against the bytes present; nothing is allocated for it.
+    const auto bytes_claimed = header_count(h, "payload_bytes", std::uint64_t{1} << 40, where);
+    const std::string_view payload = newline == std::string_view::npos ? std::string_view() : bytes.substr(newline + 1);
+    const std::uint64_t present = payload.size();
+    if (present < bytes_claimed)
+      throw InputError(where + "truncated: the payload has " + std::to_string(present) + " of " +
+                       std::to_string(bytes_claimed) + " bytes");
+    if (present > bytes_claimed) throw InputError(where + "has bytes after the payload; corrupted");
     if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
       throw InputError(where + "corrupted: the payload's checksum does not match the header");
     if (version >= 2 && h.at("checksum").get<std::string>() != whole_checksum(h, payload))
@@ -183,7 +185,12 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
       throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
     std::vector<std::string> sets;
     for (const auto& [k, v] : h.at("params").items()) sets.push_back(k + "=" + v.get<std::string>());
-    auto regressor = registry.create(name, sets);
+    std::unique_ptr<Regressor> regressor;
+    try {
+      regressor = registry.create(name, sets);
+    } catch (const ConfigError& e) {
+      throw InputError(where + "\"params\": " + e.what());
+    }
     auto scaler = [&](const char* key, std::size_t dim) {
       Standardizer s;
       s.mean = h.at(key).at("mean").get<std::vector<double>>();

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <tuple>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -180,6 +181,28 @@ TEST(ModelFile, RbfSvrPayloadCountsAreChecked) {
   }();
   EXPECT_THAT(edited(sv_total, "sv_total: 100000"), HasSubstr("rbf_svr"));
   EXPECT_THAT(edited(sv_total, "sv_total: 1"), HasSubstr("rbf_svr"));
+}
+
+TEST(ModelFile, BadParametersAreRefusedNamingTheFile) {
+  // Found by fuzz/model_file: a resealed header with "c": "0" gave the registry's ConfigError
+  // ("rbf_svr: parameter ...") without the file's name.
+  const Matrix x = random_rows(30, 24, 7);
+  const fs::path path = temp_model("params");
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  const auto [original, payload] = read_parts(path);
+  for (const auto& [key, value, expected] : {std::tuple<const char*, const char*, const char*>{
+                                                 "epsilon", "-1", "parameter \"epsilon\" must be >= 0, got -1"},
+                                             {"max_iter", "many", "parameter \"max_iter\" expects an integer"},
+                                             {"gama", "1", "unknown parameter \"gama\""}}) {
+    nlohmann::json header = original;
+    header["params"][key] = value;
+    reseal(header, payload);
+    write_parts(path, header, payload);
+    const std::string error = test::error_of([&] { load_model(path); });
+    EXPECT_THAT(error, HasSubstr(path.string() + ": \"params\": linear_svr: " + expected)) << key;
+    EXPECT_THROW(load_model(path), InputError) << key;
+  }
+  fs::remove(path);
 }
 
 TEST(ModelFile, VersionOneReadsAsTheStateMap) {

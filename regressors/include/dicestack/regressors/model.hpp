@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/types.hpp>
@@ -70,5 +71,10 @@ void save_model(const Model& model, const std::filesystem::path& path);
 /// regressor's input), dimensions, standardisers, payload size and checksum.
 /// Throws InputError naming the file and what is wrong (or ConfigError for an unknown regressor).
 Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry = RegressorRegistry::global());
+
+/// What load_model does with a model file's bytes, for callers that hold them (the fuzzer,
+/// tests): `where` (a path) starts every message. Same checks, same errors.
+Model parse_model_file(std::string_view bytes, const std::string& where,
+                       const RegressorRegistry& registry = RegressorRegistry::global());
 
 }  // namespace dicestack
