@@ -65,7 +65,8 @@ void export_set(const DemoSet& set, const std::string& format, const fs::path& o
 int run_export(const ExportOptions& opt) {
   std::vector<std::string> left_out;
   const DemoSet set = exportable(opt.dir, opt.world.load(), opt.skip_incomplete, left_out);
-  const std::string id = opt.dataset_id.empty() ? default_minari_dataset_id(resolve_demo_set(opt.dir, opt.world.load())) : opt.dataset_id;
+  // The name the user gave ("builtin", "human" or a folder), not the cache folder it stands for.
+  const std::string id = opt.dataset_id.empty() ? default_minari_dataset_id(opt.dir) : opt.dataset_id;
   export_set(set, opt.format, opt.out, id);
   if (!left_out.empty()) {
     std::string names;

@@ -147,6 +147,16 @@ def test_bad_file_is_refused_naming_the_path(robomimic_file, tmp_path):
     assert "HDF5-DIAG" not in p.stderr and not (tmp_path / "x").exists()
 
 
+def test_the_human_recordings_export_for_minari_under_their_name(tmp_path):
+    run("dataset", "export", "human", "--format", "minari", "--out", tmp_path / "human")
+    m = json.loads((tmp_path / "human" / "data" / "metadata.json").read_text())
+    assert m["dataset_id"] == "dicestack/human-v0"
+    assert m["total_episodes"] == 68
+    with h5py.File(tmp_path / "human" / "data" / "main_data.hdf5", "r") as f:
+        assert len(f.keys()) == 68
+        assert f["episode_0"]["observations"].shape[0] == f["episode_0"]["actions"].shape[0] + 1
+
+
 def test_a_version_one_set_names_the_episodes_that_do_not_replay(tmp_path):
     good = os.path.join(SOURCE, "tests", "datasets", "data", "good")
     p = run("dataset", "export", good, "--format", "robomimic", "--out", tmp_path / "g.hdf5", check=False)
