@@ -1,7 +1,8 @@
 #pragma once
 // Demonstrations that travel: robomimic's and Minari's HDF5 layouts, written from and read into
 // dicestack's DemoSet (docs/datasets.md, "robomimic and Minari"). This library alone links HDF5,
-// so the other libraries (and every regressor plugin) never load it.
+// so the other libraries (and every regressor plugin) never load it. Debian's HDF5 is the serial
+// build, which is not thread-safe: call these functions from one thread at a time.
 #include <array>
 #include <cstddef>
 #include <filesystem>
