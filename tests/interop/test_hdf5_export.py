@@ -164,3 +164,40 @@ def test_a_version_one_set_names_the_episodes_that_do_not_replay(tmp_path):
     assert "2 of 2 episodes have no final state" in p.stderr and "episode_0000, episode_0001" in p.stderr
     assert "--skip-incomplete" in p.stderr
     assert not (tmp_path / "g.hdf5").exists()
+
+
+def as_version_one(src, dst, tamper=None):
+    """Copies a set as format version 1 (no reward column, no final state or end flags);
+    `tamper` names a file whose third row's cup_x is moved by 1 mm."""
+    dst.mkdir()
+    meta = json.loads((src / "meta.json").read_text())
+    meta["version"] = 1
+    for e in meta["episodes"]:
+        for key in ("final_state", "terminated", "truncated"):
+            del e[key]
+        lines = (src / e["file"]).read_text().splitlines()
+        rows = [line.rsplit(",", 1)[0] for line in lines]
+        if e["file"] == tamper:
+            cells = rows[3].split(",")
+            cells[1] = repr(float(cells[1]) + 1e-3)
+            rows[3] = ",".join(cells)
+        (dst / e["file"]).write_text("\n".join(rows) + "\n")
+    (dst / "meta.json").write_text(json.dumps(meta, indent=1))
+
+
+def test_a_version_one_set_is_completed_by_replay(recorded, robomimic_file, tmp_path):
+    as_version_one(recorded / "demos", tmp_path / "v1")
+    run("dataset", "validate", tmp_path / "v1")
+    run("dataset", "export", tmp_path / "v1", "--format", "robomimic", "--out", tmp_path / "v1.hdf5")
+    with h5py.File(tmp_path / "v1.hdf5", "r") as a, h5py.File(robomimic_file, "r") as b:
+        for i in range(7):
+            for key in ("rewards", "next_obs/cup_pose", "next_obs/die2_vel", "actions", "states"):
+                np.testing.assert_array_equal(a[f"data/demo_{i}/{key}"][()], b[f"data/demo_{i}/{key}"][()])
+            assert a[f"data/demo_{i}"].attrs["dicestack_truncated"] == b[f"data/demo_{i}"].attrs["dicestack_truncated"]
+    # An edited state does not replay: named, and left out only when asked.
+    as_version_one(recorded / "demos", tmp_path / "edited", tamper="episode_0002.csv")
+    p = run("dataset", "export", tmp_path / "edited", "--format", "minari", "--out", tmp_path / "m", check=False)
+    assert p.returncode == 1 and "1 of 7 episodes have no final state" in p.stderr and "episode_0002" in p.stderr
+    p = run("dataset", "export", tmp_path / "edited", "--format", "minari", "--out", tmp_path / "m", "--skip-incomplete")
+    assert "left out 1 episodes without a final state (they do not replay): episode_0002" in p.stdout
+    assert json.loads((tmp_path / "m" / "data" / "metadata.json").read_text())["total_episodes"] == 6
