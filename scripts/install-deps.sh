@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages dicestack builds and tests with. Idempotent: when every
 # package is already installed it changes nothing and does not touch the network.
 # The Python package (python/) and its tests need pybind11, numpy, pytest, scikit-learn and
-# matplotlib; `--python` adds XGBoost's Python package, for bench/compare_python.py.
+# matplotlib; HDF5 export/import needs libhdf5-dev, its tests python3-h5py; `--python` adds XGBoost's Python package, for bench/compare_python.py.
 set -euo pipefail
 
 packages=(
@@ -26,6 +26,8 @@ packages=(
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ and libFuzzer
   pybind11-dev python3-dev python3-numpy   # `import dicestack` (python/)
   python3-pytest python3-sklearn python3-matplotlib  # its tests and examples
+  libhdf5-dev             # robomimic and Minari HDF5 export/import (dicestack_interop)
+  python3-h5py            # the tests that read the exported HDF5 files
 )
 
 if [ "${1:-}" = "--python" ]; then

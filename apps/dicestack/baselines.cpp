@@ -40,7 +40,14 @@ Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std
     e.states.push_back(s);
     e.actions.push_back(a);
     e.sources.push_back(StepSource::policy);
-    s = env.step(a).observation;
+    const StepResult r = env.step(a);
+    s = r.observation;
+    e.rewards.push_back(r.reward);
+    e.terminated = r.terminated;
+  }
+  if (!e.states.empty()) {
+    e.final_state = s;
+    e.truncated = !e.terminated;
   }
   e.outcome = env.outcome();
   return e;

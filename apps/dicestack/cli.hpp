@@ -23,6 +23,8 @@ void add_render_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`
 void add_bench_load_command(CLI::App& bench);        // under `bench`
+void add_bench_dataset_command(CLI::App& bench);     // under `bench`
+void add_interop_commands(CLI::App& import, CLI::App& dataset);  // import robomimic|minari, dataset export
 void add_bench_optimise_command(CLI::App& bench);    // under `bench`
 void add_optimise_command(CLI::App& app);
 void add_reinforce_command(CLI::App& app);

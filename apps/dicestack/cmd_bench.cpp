@@ -249,6 +249,7 @@ void add_bench_command(CLI::App& app) {
 
   add_bench_regressors_command(*bench);
   add_bench_load_command(*bench);
+  add_bench_dataset_command(*bench);
   add_bench_optimise_command(*bench);
 }
 

@@ -1,5 +1,5 @@
 // `dicestack import cupdice` and `dicestack dataset info|validate`: getting demonstrations in,
-// and looking at them.
+// and looking at them (robomimic and Minari: cmd_interop.cpp).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -171,7 +171,7 @@ void add_dataset_commands(CLI::App& app) {
   imp->world.add_to(*cupdice);
   cupdice->callback([imp] { run_import(*imp); });
 
-  CLI::App* dataset = app.add_subcommand("dataset", "Inspect and check demonstration sets");
+  CLI::App* dataset = app.add_subcommand("dataset", "Inspect, check and export demonstration sets");
   dataset->require_subcommand(1);
   auto info = std::make_shared<DatasetOptions>();
   CLI::App* cmd = dataset->add_subcommand("info", "Summary: episodes, frames, outcomes, per-column ranges");
@@ -182,6 +182,7 @@ void add_dataset_commands(CLI::App& app) {
   cmd = dataset->add_subcommand("validate", "Check every file of a set; exit 1 with the first problem");
   cmd->add_option("dir", check->dir, "Demonstration folder")->required();
   cmd->callback([check] { run_validate(*check); });
+  add_interop_commands(*import, *dataset);
 }
 
 }  // namespace dicestack::cli

@@ -9,13 +9,15 @@
 
 #include "cli.hpp"
 #include "options.hpp"
+#include "video.hpp"
 
 namespace dicestack::cli {
 namespace {
 
 struct EvaluateOptions {
   WorldOption world;
-  std::filesystem::path model, demos, save_rollouts;
+  std::filesystem::path model, demos, save_rollouts, video_dir;
+  std::string video_format = "mp4";
   int episodes = 20;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -27,9 +29,24 @@ int run_evaluate(const EvaluateOptions& opt) {
   const WorldConfig world = opt.world.load();
   auto model = std::make_shared<const Model>(load_model(opt.model));
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
+  const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
   std::vector<Episode> rollouts;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,
-                               opt.threads, initial_push_from(opt.push), opt.save_rollouts.empty() ? nullptr : &rollouts);
+                               opt.threads, initial_push_from(opt.push), keep ? &rollouts : nullptr);
+  if (!opt.video_dir.empty()) {
+    // One video per rollout, named as --save-rollouts names its episodes (as robomimic's
+    // run_trained_agent writes one per rollout).
+    std::filesystem::create_directories(opt.video_dir);
+    for (std::size_t i = 0; i < rollouts.size(); ++i) {
+      std::vector<State> states = rollouts[i].states;
+      if (rollouts[i].final_state) states.push_back(*rollouts[i].final_state);
+      char name[48];
+      std::snprintf(name, sizeof name, "episode_%04zu.%s", i, opt.video_format.c_str());
+      write_frames(states, world,
+                   model->regressor().name() + " rollout " + std::to_string(i) + ", seed " + std::to_string(opt.seed),
+                   opt.video_dir / name);
+    }
+  }
   if (!opt.save_rollouts.empty()) {
     DemoSet set;
     set.world = world;
@@ -80,6 +97,11 @@ void add_evaluate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--save-rollouts", opt->save_rollouts,
                   "Also write the rollouts as a demonstration set (source policy; outcomes in meta.json)");
+  cmd->add_option("--video-dir", opt->video_dir,
+                  "Also draw one video per rollout into this folder (episode_<i>.mp4, i as in --save-rollouts)");
+  cmd->add_option("--video-format", opt->video_format, "mp4, avi or gif")
+      ->check(CLI::IsMember({"mp4", "avi", "gif"}))
+      ->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt] { run_evaluate(*opt); });
 }

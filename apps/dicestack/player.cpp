@@ -95,6 +95,10 @@ PlayReport play(const PlayOptions& opt) {
   auto finish_episode = [&] {
     if (!opt.record.empty() && episode.size() > 0) {
       episode.outcome = env.outcome();
+      if (!episode.final_state) {  // saved or closed before the episode ended: a truncation
+        episode.final_state = env.get_state();
+        episode.truncated = true;
+      }
       append_to_demo_set(opt.record, {episode}, opt.world, "recorded with dicestack play");
       ++report.episodes_recorded;
     }
@@ -140,7 +144,11 @@ PlayReport play(const PlayOptions& opt) {
       episode.states.push_back(s);
       episode.actions.push_back(a);
       episode.sources.push_back(StepSource::human);
+      episode.rewards.push_back(r.reward);
       if (r.terminated || r.truncated) {
+        episode.final_state = r.observation;
+        episode.terminated = r.terminated;
+        episode.truncated = r.truncated;
         finish_episode();
         celebrate = r.terminated ? static_cast<int>(1.5 / frame_s) : 1;
       }

@@ -38,6 +38,11 @@ StepResult DiceEnv::step(const Action& action) {
   return r;
 }
 
+double step_reward(const State& observation, int steps, const WorldConfig& config, const State& goal) {
+  const int remaining = std::max(0, config.episode.max_steps - steps);
+  return -std::pow(config.cost.gamma, remaining) * state_distance(observation, goal, config.cost);
+}
+
 StepResult DiceEnv::finish_step(bool wall) {
   const auto& c = config();
   StepResult r;
@@ -47,8 +52,7 @@ StepResult DiceEnv::finish_step(bool wall) {
   r.info.distance = state_distance(r.observation, goal_, c.cost);
   r.info.wall_contact_step = wall;
   r.info.outcome = outcome_;
-  const int remaining = std::max(0, c.episode.max_steps - outcome_.steps);
-  r.reward = -std::pow(c.cost.gamma, remaining) * r.info.distance;
+  r.reward = step_reward(r.observation, outcome_.steps, c, goal_);
   r.terminated = outcome_.realistic_success() && outcome_.stacked_steps >= c.judge.success_hold_steps;
   r.truncated = !r.terminated && outcome_.steps >= c.episode.max_steps;
   return r;

@@ -42,7 +42,7 @@ fs::path cache_dir() {
 }
 
 fs::path human_demo_set(const WorldConfig& world) {
-  const fs::path dir = cache_dir() / ("human-" + short_hash(world_hash(world)));
+  const fs::path dir = cache_dir() / ("human-v2-" + short_hash(world_hash(world)));
   if (!fs::exists(dir / "meta.json")) write_demo_set(import_cupdice(data_dir() / "cupdice", world), dir);
   return dir;
 }

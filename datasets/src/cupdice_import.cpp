@@ -7,7 +7,9 @@
 #include <numbers>
 #include <sstream>
 
+#include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/judge.hpp>
 #include <dicestack/core/world.hpp>
 
@@ -189,6 +191,14 @@ Episode import_cupdice_file(const fs::path& file, const WorldConfig& world) {
   }
   e.sources.assign(e.states.size(), StepSource::human);
   e.outcome = judge_recording(e.states, last, world);
+  // Format v2: the last row is the final state; rewards as DiceEnv::step would give them for the
+  // recorded states; a recording ends in success when the judge says so, otherwise it was stopped.
+  e.final_state = last;
+  const State goal = goal_state(world);
+  for (std::size_t t = 0; t < e.states.size(); ++t)
+    e.rewards.push_back(step_reward(t + 1 < e.states.size() ? e.states[t + 1] : last, static_cast<int>(t + 1), world, goal));
+  e.terminated = e.outcome.realistic_success();
+  e.truncated = !e.terminated;
   return e;
 }
 

@@ -26,7 +26,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-constexpr std::size_t kColumns = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
+constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
+constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
+constexpr std::size_t kNumbers = 1 + kStateDim + kActionDim;         // t, state, action
 
 std::string read_file(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -86,7 +88,9 @@ void write_episode_csv(const Episode& e, const fs::path& path, AtomicFile::Lefto
     out << t;
     for (double v : e.states[t]) out << ',' << number_text(v);
     for (double v : e.actions[t]) out << ',' << number_text(v);
-    out << ',' << to_string(e.sources[t]) << '\n';
+    out << ',' << to_string(e.sources[t]) << ',';
+    if (e.has_transitions()) out << number_text(e.rewards[t]);  // empty cell: unknown
+    out << '\n';
   }
   file.commit();
 }
@@ -102,7 +106,10 @@ json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
                         {"steps", e.size()},
                         {"origin", e.origin},
                         {"sources", std::vector<std::string>(sources.begin(), sources.end())},
-                        {"outcome", outcome_json(e.outcome)}});
+                        {"outcome", outcome_json(e.outcome)},
+                        {"final_state", e.final_state ? json(*e.final_state) : json(nullptr)},
+                        {"terminated", e.terminated},
+                        {"truncated", e.truncated}});
   }
   return {{"format", kDemoFormat},
           {"version", kDemoFormatVersion},
@@ -115,7 +122,9 @@ json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
             {"time", "s"},
             {"control_dt", set.world.physics.control_dt},
             {"state", "before the step's action; cup x, y at its centre of mass"},
-            {"action", "velocity change of the cup applied at the start of the step: dvx, dvy (m/s), dw (rad/s)"}}},
+            {"action", "velocity change of the cup applied at the start of the step: dvx, dvy (m/s), dw (rad/s)"},
+            {"reward", "DiceEnv::step's reward for arriving at the next state (empty: unknown)"},
+            {"final_state", "the state after the last action (null: unknown)"}}},
           {"world", json::parse(to_json(set.world))},
           {"episodes", episodes}};
 }
@@ -169,10 +178,37 @@ Outcome outcome_from(const json& j, const fs::path& meta, const std::string& fil
   return o;
 }
 
-Ownership episode_csv_ownership() {
+std::string csv_header(int version) {
   std::string header;
-  for (const auto& c : episode_csv_columns()) header += (header.empty() ? "" : ",") + c;
-  return Ownership::first_line("dicestack episode CSV", {header});
+  for (const auto& c : episode_csv_columns(version)) header += (header.empty() ? "" : ",") + c;
+  return header;
+}
+
+Ownership episode_csv_ownership() {
+  return Ownership::first_line("dicestack episode CSV", {csv_header(1), csv_header(2)});
+}
+
+// Version 2's per-episode additions: "final_state" (null or 24 finite numbers), "terminated",
+// "truncated".
+void transitions_from(const json& entry, const fs::path& meta, DemoMetaEntry& e) {
+  if (!entry.contains("final_state")) meta_error(meta, "missing the final_state of " + e.file + " (null when unknown)");
+  const json& f = entry["final_state"];
+  if (!f.is_null()) {
+    if (!f.is_array() || f.size() != kStateDim)
+      meta_error(meta, "\"final_state\" of " + e.file + " must be null or a list of " + std::to_string(kStateDim) + " numbers");
+    State s{};
+    for (std::size_t k = 0; k < kStateDim; ++k) {
+      if (!f[k].is_number()) meta_error(meta, "\"final_state\" of " + e.file + ": item " + std::to_string(k) + " is not a number");
+      s[k] = f[k].get<double>();
+      if (!std::isfinite(s[k])) meta_error(meta, "\"final_state\" of " + e.file + ": item " + std::to_string(k) + " is not finite");
+    }
+    e.final_state = s;
+  }
+  e.terminated = meta_field<bool>(entry, "terminated", meta, "true or false");
+  e.truncated = meta_field<bool>(entry, "truncated", meta, "true or false");
+  if (e.terminated && e.truncated) meta_error(meta, e.file + " is both terminated and truncated");
+  if (!e.final_state && (e.terminated || e.truncated))
+    meta_error(meta, e.file + " has no final state, so terminated and truncated must be false (unknown)");
 }
 
 Ownership meta_ownership() { return Ownership::json_object("dicestack demonstration meta.json", kDemoFormat); }
@@ -219,20 +255,22 @@ void replace_folder(const fs::path& dir, const std::function<void(const fs::path
 
 }  // namespace
 
-std::vector<std::string> episode_csv_columns() {
+std::vector<std::string> episode_csv_columns(int version) {
   std::vector<std::string> cols{"t"};
   for (auto n : state_names()) cols.emplace_back(n);
   for (auto n : action_names()) cols.emplace_back(n);
   cols.emplace_back("source");
+  if (version >= 2) cols.emplace_back("reward");
   return cols;
 }
 
-Episode read_episode_csv(const fs::path& file) {
-  return parse_episode_csv(read_file(file), file.string(), file.stem().string());
-}
+namespace {
 
-Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name) {
-  const auto columns = episode_csv_columns();
+// parse_episode_csv, also telling the file's layout version (by its header).
+Episode parse_csv(std::string_view text, const std::string& where, std::string name, int& version) {
+  std::vector<std::string> columns;
+  std::size_t width = 0;
+  bool reward_empty = false;
   Episode e;
   e.name = std::move(name);
   std::vector<std::string_view> fields;
@@ -249,20 +287,24 @@ Episode parse_episode_csv(std::string_view text, const std::string& where, std::
     }
     split_fields(line, fields);
     if (line_no == 1) {
-      if (fields.size() != kColumns)
+      if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2)
         throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
-                         std::to_string(kColumns) + " (t, 24 state names, dvx, dvy, dw, source)");
-      for (std::size_t c = 0; c < kColumns; ++c)
+                         std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1) or " +
+                         std::to_string(kColumnsV2) + " (the same and reward: version 2)");
+      width = fields.size();
+      version = width == kColumnsV1 ? 1 : 2;
+      columns = episode_csv_columns(version);
+      for (std::size_t c = 0; c < width; ++c)
         if (trim(fields[c]) != columns[c])
           throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
                            "\", expected \"" + columns[c] + "\"");
       continue;
     }
-    if (fields.size() != kColumns)
+    if (fields.size() != width)
       throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
-                       std::to_string(kColumns) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
-    std::array<double, kColumns - 1> values{};
-    for (std::size_t c = 0; c + 1 < kColumns; ++c) {
+                       std::to_string(width) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
+    std::array<double, kNumbers> values{};
+    for (std::size_t c = 0; c < kNumbers; ++c) {
       const std::string_view f = trim(fields[c]);
       double v = 0.0;
       const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
@@ -285,14 +327,43 @@ Episode parse_episode_csv(std::string_view text, const std::string& where, std::
     e.states.push_back(s);
     e.actions.push_back(a);
     try {
-      e.sources.push_back(step_source_from(trim(fields[kColumns - 1])));
+      e.sources.push_back(step_source_from(trim(fields[kNumbers])));
     } catch (const InputError& err) {
       throw InputError(prefix + "column \"source\": " + err.what());
+    }
+    if (version >= 2) {
+      const std::string_view f = trim(fields[kNumbers + 1]);
+      if (e.states.size() == 1) reward_empty = f.empty();
+      if (f.empty() != reward_empty)
+        throw InputError(prefix + "column \"reward\" is " + (f.empty() ? "empty" : "a number") + " but line 2's is " +
+                         (reward_empty ? "empty" : "a number") + "; an episode's rewards are all known or all empty");
+      if (!f.empty()) {
+        double v = 0.0;
+        const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+        if (r.ec != std::errc() || r.ptr != f.data() + f.size())
+          throw InputError(prefix + "column \"reward\": \"" + std::string(f.substr(0, 40)) + (f.size() > 40 ? "...\"" : "\"") +
+                           " is not a number");
+        if (!std::isfinite(v))
+          throw InputError(prefix + "column \"reward\" is " + (std::isnan(v) ? "NaN" : "infinite") +
+                           "; demonstrations must be finite");
+        e.rewards.push_back(v);
+      }
     }
   }
   if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
   if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");
   return e;
+}
+
+}  // namespace
+
+Episode read_episode_csv(const fs::path& file) {
+  return parse_episode_csv(read_file(file), file.string(), file.stem().string());
+}
+
+Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name) {
+  int version = 0;
+  return parse_csv(text, where, std::move(name), version);
 }
 
 DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
@@ -313,6 +384,7 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
   if (!meta.contains("world")) meta_error(meta_path, "missing \"world\"");
 
   DemoMeta out;
+  out.version = version;
   out.world = world_config_from_json(meta["world"].dump(), meta_path.string() + " \"world\"");
   out.description = optional_text(meta, "description", meta_path);
   out.provenance = optional_text(meta, "provenance", meta_path);
@@ -330,6 +402,7 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
     e.steps = meta_field<std::size_t>(entry, "steps", meta_path, "an unsigned integer");
     if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + e.file);
     e.outcome = outcome_from(entry["outcome"], meta_path, e.file);
+    if (version >= 2) transitions_from(entry, meta_path, e);
     out.episodes.push_back(std::move(e));
   }
   return out;
@@ -350,7 +423,19 @@ DemoSet read_demo_set(const fs::path& dir) {
     listed.insert(entry.file);
     const fs::path path = dir / entry.file;
     if (!fs::exists(path)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
-    Episode e = read_episode_csv(path);
+    int csv_version = 0;
+    Episode e = parse_csv(read_file(path), path.string(), path.stem().string(), csv_version);
+    // A version-2 set may hold version-1 files (appended to an old set): episodes without transitions.
+    if (csv_version > meta.version)
+      throw InputError(path.string() + ":1: the header is format version " + std::to_string(csv_version) +
+                       "'s (with reward), but meta.json says version " + std::to_string(meta.version));
+    if (entry.final_state && e.rewards.empty())
+      throw InputError(path.string() + ": meta.json gives a final state, so every row needs a reward");
+    if (!entry.final_state && !e.rewards.empty())
+      throw InputError(path.string() + ": has rewards, but meta.json gives no final state (they are known together)");
+    e.final_state = entry.final_state;
+    e.terminated = entry.terminated;
+    e.truncated = entry.truncated;
     e.seed = entry.seed;
     e.origin = std::move(entry.origin);
     if (entry.steps != e.size())

@@ -1,5 +1,7 @@
 #include <dicestack/datasets/episode.hpp>
 
+#include <cmath>
+
 #include <dicestack/core/error.hpp>
 
 namespace dicestack {
@@ -20,6 +22,12 @@ StepSource step_source_from(std::string_view text) {
   throw InputError("\"" + std::string(text.substr(0, 40)) + (text.size() > 40 ? "..." : "") + "\" is not one of human, expert, policy, correction");
 }
 
+void Episode::clear_transitions() {
+  final_state.reset();
+  rewards.clear();
+  terminated = truncated = false;
+}
+
 void check_episode(const Episode& e) {
   const std::string who = "episode " + (e.name.empty() ? std::string("(unnamed)") : e.name);
   if (e.states.empty()) throw InputError(who + ": has no steps");
@@ -30,6 +38,17 @@ void check_episode(const Episode& e) {
     require_finite(e.states[t], who + " state " + std::to_string(t));
     require_finite(e.actions[t], who + " action " + std::to_string(t));
   }
+  if (!e.final_state) {
+    if (!e.rewards.empty()) throw InputError(who + ": has rewards but no final state; they are known together");
+    return;
+  }
+  require_finite(*e.final_state, who + " final state");
+  if (e.rewards.size() != e.states.size())
+    throw InputError(who + ": " + std::to_string(e.states.size()) + " states and " + std::to_string(e.rewards.size()) +
+                     " rewards; they must be equal");
+  for (std::size_t t = 0; t < e.rewards.size(); ++t)
+    if (!std::isfinite(e.rewards[t])) throw InputError(who + " reward " + std::to_string(t) + " is not finite");
+  if (e.terminated && e.truncated) throw InputError(who + ": both terminated and truncated");
 }
 
 }  // namespace dicestack

@@ -44,7 +44,13 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
     e.sources.push_back(label ? label->source : source);
     const StepResult r = env.step(executed);
     applied.push_back(r.applied);
-    if (r.terminated || r.truncated || applied.size() == options.max_steps) break;
+    e.rewards.push_back(r.reward);
+    if (r.terminated || r.truncated || applied.size() == options.max_steps) {
+      e.final_state = r.observation;
+      e.terminated = r.terminated;
+      e.truncated = !r.terminated;  // the time limit or options.max_steps
+      break;
+    }
     e.states.push_back(r.observation);
   }
   e.outcome = env.outcome();

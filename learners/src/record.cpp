@@ -44,7 +44,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
   const std::uint64_t h = world_hash(world);
   char name[40];
-  std::snprintf(name, sizeof name, "expert-v2-%08llx", static_cast<unsigned long long>(h >> 32));
+  std::snprintf(name, sizeof name, "expert-v3-%08llx", static_cast<unsigned long long>(h >> 32));
   const auto dir = cache_dir() / name;
   if (std::filesystem::exists(dir / "meta.json")) return dir;
 

@@ -44,6 +44,12 @@ awk -F, 'NR == 2 { x0 = $2; y0 = $3 } NR > 1 { if ($2 > xmax) xmax = $2; dy = $3
                if (xmax - x0 < 0.5) { print "FAIL: cup did not move right"; exit 1 }
                if (dymax > 0.2) { print "FAIL: cup drifted vertically"; exit 1 } }' "$csv"
 
+# Format v2: quit mid-episode, the recording keeps its final state and is a truncation; every
+# row has a reward.
+grep -q '"truncated": true' "$work/rec/meta.json" || { echo "FAIL: the recording is not marked truncated"; exit 1; }
+if grep -q '"final_state": null' "$work/rec/meta.json"; then echo "FAIL: the recording has no final state"; exit 1; fi
+awk -F, 'NR > 1 && $30 == "" { print "FAIL: row " NR " has no reward"; exit 1 }' "$csv"
+
 png="$work/dicestack_0.png"
 test -s "$png" || { echo "FAIL: no screenshot"; exit 1; }
 # PNG header: width and height are big-endian 32-bit integers at bytes 16-23.

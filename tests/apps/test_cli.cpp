@@ -302,9 +302,15 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+clock+start_state");
   // --save-rollouts writes the rollouts as a set, and refuses a user's folder.
   const auto rollouts = std::filesystem::temp_directory_path() / ("dicestack_cli_rollouts_" + std::to_string(getpid()));
-  p = run("evaluate --model " + model.string() + " --episodes 2 --save-rollouts " + rollouts.string());
+  const auto videos = rollouts.string() + "_videos";
+  p = run("evaluate --model " + model.string() + " --episodes 2 --save-rollouts " + rollouts.string() + " --video-dir " +
+          videos + " --video-format gif");
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(run("dataset info " + rollouts.string()).output, HasSubstr("episodes 2"));
+  // One video per rollout, named as the saved episodes are.
+  EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0000.gif"), 1000u);
+  EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0001.gif"), 1000u);
+  std::filesystem::remove_all(videos);
   std::filesystem::remove_all(rollouts);
   std::filesystem::create_directories(rollouts);
   { std::ofstream(rollouts / "notes.txt") << "mine"; }

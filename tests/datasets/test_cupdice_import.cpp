@@ -6,7 +6,9 @@
 #include <fstream>
 #include <numbers>
 
+#include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/world.hpp>
 #include <dicestack/datasets/cupdice_import.hpp>
 
@@ -36,6 +38,27 @@ TEST(CupdiceImport, ImportsAll68Recordings) {
   // All three final-layout recordings end in a stack, as their README says.
   for (std::size_t i = 0; i < 3; ++i) EXPECT_TRUE(set.episodes[i].outcome.stacked) << set.episodes[i].origin;
   EXPECT_GE(stacked, 40u);
+}
+
+// Format v2: the recording's last row is the final state; rewards are DiceEnv's for the
+// recorded states; a recording ends in success (terminated) or was stopped (truncated).
+TEST(CupdiceImport, RecordingsCarryTheirFinalStateRewardsAndEnd) {
+  const WorldConfig w;
+  const State goal = goal_state(w);
+  for (const char* file : {"final/imitate_0.csv", "legacy/imitate_3.csv"}) {
+    const Episode e = import_cupdice_file(kCupdice / file, w);
+    ASSERT_TRUE(e.has_transitions()) << file;
+    ASSERT_EQ(e.rewards.size(), e.size());
+    EXPECT_EQ(e.rewards[0], step_reward(e.states[1], 1, w, goal));
+    EXPECT_EQ(e.rewards.back(), step_reward(*e.final_state, static_cast<int>(e.size()), w, goal));
+    EXPECT_EQ(e.terminated, e.outcome.realistic_success());
+    EXPECT_NE(e.terminated, e.truncated);
+    EXPECT_NO_THROW(check_episode(e));
+  }
+  // Final layout: the last row, its cup velocity including the last action.
+  const Episode f = import_cupdice_file(kCupdice / "final" / "imitate_0.csv", w);
+  EXPECT_EQ((*f.final_state)[si::kCupX], f.states.back()[si::kCupX]);
+  EXPECT_EQ((*f.final_state)[si::kCupVx], f.states.back()[si::kCupVx] + f.actions.back()[0]);
 }
 
 TEST(CupdiceImport, FinalLayoutConversion) {

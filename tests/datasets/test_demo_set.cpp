@@ -97,6 +97,63 @@ TEST(DemoSet, WriteThenReadIsExact) {
   fs::remove_all(dir);
 }
 
+// Format v2: the final state, the rewards and the end flags travel with an episode; a v1 set
+// (tests/datasets/data/good) reads as episodes without them.
+TEST(DemoSet, VersionTwoKeepsTransitionsAndVersionOneReadsWithoutThem) {
+  DemoSet set = read_demo_set(kData / "good");
+  EXPECT_EQ(parse_demo_meta(slurp(kData / "good" / "meta.json"), "m.json").version, 1);
+  for (const auto& e : set.episodes) EXPECT_FALSE(e.has_transitions());
+  Episode& e = set.episodes[0];
+  State last = e.states.back();
+  last[0] += 0.1 + 0.2;
+  e.final_state = last;
+  for (std::size_t t = 0; t < e.size(); ++t) e.rewards.push_back(-0.1 * static_cast<double>(t) - 1e-17);
+  e.terminated = true;
+  const fs::path dir = fs::temp_directory_path() / ("dicestack_demo_v2_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  write_demo_set(set, dir);
+  EXPECT_EQ(parse_demo_meta(slurp(dir / "meta.json"), "m.json").version, 2);
+  const DemoSet back = read_demo_set(dir);
+  ASSERT_TRUE(back.episodes[0].has_transitions());
+  EXPECT_EQ(*back.episodes[0].final_state, last);
+  EXPECT_EQ(back.episodes[0].rewards, e.rewards);
+  EXPECT_TRUE(back.episodes[0].terminated);
+  EXPECT_FALSE(back.episodes[0].truncated);
+  EXPECT_FALSE(back.episodes[1].has_transitions()) << "unknown stays unknown";
+  EXPECT_TRUE(back.episodes[1].rewards.empty());
+
+  // Appending to a v1 set upgrades its meta.json; its v1 files read as before.
+  const fs::path old = dir.string() + "_v1";
+  fs::remove_all(old);
+  fs::copy(kData / "good", old);
+  append_to_demo_set(old, {back.episodes[0]}, back.world, "appended");
+  const DemoSet appended = read_demo_set(old);
+  ASSERT_EQ(appended.episodes.size(), 3u);
+  EXPECT_FALSE(appended.episodes[0].has_transitions());
+  EXPECT_EQ(appended.episodes[2].rewards, e.rewards);
+
+  // A file and meta.json that disagree are refused, naming the file.
+  std::string csv = slurp(dir / "episode_0000.csv");
+  const auto cut = csv.find('\n', csv.find('\n') + 1);
+  const auto comma = csv.rfind(',', cut);
+  std::ofstream(dir / "episode_0000.csv", std::ios::binary) << csv.substr(0, comma + 1) + csv.substr(cut);
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }),
+              HasSubstr("episode_0000.csv:3: column \"reward\" is a number but line 2's is empty"));
+  std::ofstream(dir / "episode_0000.csv", std::ios::binary) << csv;
+  std::string meta = slurp(dir / "meta.json");
+  const auto at = meta.find("\"terminated\": true");
+  ASSERT_NE(at, std::string::npos);
+  std::ofstream(dir / "meta.json", std::ios::binary) << meta.substr(0, at) + "\"terminated\": 1" + meta.substr(at + 18);
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }), HasSubstr("meta.json: \"terminated\" must be true or false"));
+  std::ofstream(dir / "meta.json", std::ios::binary) << meta;
+  const auto v1 = slurp(kData / "good" / "meta.json");
+  std::ofstream(dir / "meta.json", std::ios::binary) << v1;
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }),
+              HasSubstr("episode_0000.csv:1: the header is format version 2's (with reward), but meta.json says version 1"));
+  fs::remove_all(dir);
+  fs::remove_all(old);
+}
+
 TEST(DemoSet, AppendAddsEpisodesAndKeepsTheOldOnes) {
   const fs::path dir = fs::temp_directory_path() / "dicestack_demo_append";
   fs::remove_all(dir);
@@ -146,7 +203,7 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("missing_file"), HasSubstr("meta.json: lists episode_0009.csv, which does not exist"));
   EXPECT_THAT(read_error("extra_file"), HasSubstr("episode_0002.csv: not listed in meta.json"));
   EXPECT_THAT(read_error("newer_version"),
-              HasSubstr("meta.json: format version 3 is newer than this dicestack reads (1); upgrade dicestack"));
+              HasSubstr("meta.json: format version 3 is newer than this dicestack reads (2); upgrade dicestack"));
   EXPECT_THAT(read_error("wrong_format"), HasSubstr("format \"robomimic\" is not dicestack-demos"));
   EXPECT_THAT(read_error("steps_mismatch"), HasSubstr("says episode_0000.csv has 7 steps; the file has 4"));
   EXPECT_THAT(read_error("no_meta"), HasSubstr("meta.json: missing; not a dicestack demonstration folder"));

@@ -30,6 +30,12 @@ struct StepResult {
   StepInfo info;
 };
 
+/// The reward DiceEnv::step gives for arriving at `observation` after `steps` control steps of
+/// an episode: -gamma^max(0, episode.max_steps - steps) * state_distance(observation, goal)
+/// (cost.hpp); summed over an episode of episode.max_steps steps it is minus eq. 6. `goal` is
+/// goal_state(config). Also used to fill the rewards of recordings made outside DiceEnv.
+double step_reward(const State& observation, int steps, const WorldConfig& config, const State& goal);
+
 /// Lower and upper bounds of an observation or an action.
 template <std::size_t N>
 struct Box {

@@ -17,7 +17,8 @@ std::filesystem::path data_dir();
 std::filesystem::path cache_dir();
 
 /// The paper's 68 recordings converted for `world`; imported into the cache on first use
-/// (keyed by the world config), then read from there.
+/// (folder human-v2-<world hash>: v2 since the sets carry format v2's transitions), then read
+/// from there.
 std::filesystem::path human_demo_set(const WorldConfig& world);
 
 }  // namespace dicestack

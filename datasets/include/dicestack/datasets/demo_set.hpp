@@ -4,6 +4,7 @@
 // units, world config, provenance, per-episode outcomes). Opens in any spreadsheet or pandas.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,7 +15,9 @@
 namespace dicestack {
 
 inline constexpr const char* kDemoFormat = "dicestack-demos";
-inline constexpr int kDemoFormatVersion = 1;
+/// Version 2 adds each episode's final state, terminated and truncated (meta.json) and the
+/// reward of each step (a `reward` column); version 1 folders stay readable (docs/formats.md).
+inline constexpr int kDemoFormatVersion = 2;
 /// Format marker of the JSON summaries the baselines (optimise, reinforce, rrt) write into a set.
 inline constexpr const char* kBaselineFormat = "dicestack-baseline";
 
@@ -26,8 +29,9 @@ struct DemoSet {
   std::vector<Episode> episodes;  ///< in file-name order
 };
 
-/// The header row of an episode CSV.
-std::vector<std::string> episode_csv_columns();
+/// The header row of an episode CSV of format `version` (1: t, 24 state names, dvx, dvy, dw,
+/// source; 2: those and reward).
+std::vector<std::string> episode_csv_columns(int version = kDemoFormatVersion);
 
 /// Reads a whole set, checking everything: meta.json's format and version, that its episode
 /// list matches the CSV files exactly, every header, row and value (finite numbers, known
@@ -40,8 +44,9 @@ Episode read_episode_csv(const std::filesystem::path& file);
 
 /// What read_episode_csv does with a file's text, for callers that hold the text (the fuzzer,
 /// tests): `where` starts every message ("where:line: ..."), `name` becomes Episode::name. Checks
-/// the header, every row and value; seed, outcome and origin stay empty (meta.json has them).
-/// Throws InputError.
+/// the header (either version's), every row and value; a version-2 file's reward cells are all
+/// numbers (into Episode::rewards) or all empty (unknown). Seed, outcome, origin, final state and
+/// the end flags stay empty (meta.json has them). Throws InputError.
 Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name);
 
 /// One entry of meta.json's "episodes" list.
@@ -51,10 +56,14 @@ struct DemoMetaEntry {
   std::size_t steps = 0;  ///< rows the file must have
   std::string origin;
   Outcome outcome;
+  std::optional<State> final_state;  ///< version 2's "final_state" (null or absent: unknown)
+  bool terminated = false;           ///< version 2's "terminated"
+  bool truncated = false;            ///< version 2's "truncated"
 };
 
 /// What a set's meta.json says, checked on its own (no episode file is opened).
 struct DemoMeta {
+  int version = kDemoFormatVersion;  ///< the file's format version (1 or 2)
   WorldConfig world;
   std::string description;
   std::string provenance;

@@ -1,6 +1,7 @@
 #pragma once
 // One demonstration: where it started, what was seen and done at every step, and how it ended.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,7 +20,9 @@ std::string_view to_string(StepSource source);
 /// Parses a StepSource; throws InputError naming the text and the accepted values.
 StepSource step_source_from(std::string_view text);
 
-/// A demonstration: T pre-action states and the T actions taken in them (DESIGN "Demonstrations").
+/// A demonstration: T pre-action states and the T actions taken in them (DESIGN "Demonstrations"),
+/// and (demonstration format v2) the transitions' ends: the final state, each step's reward and
+/// how the episode ended. Those are known together or not at all (has_transitions()).
 struct Episode {
   std::string name;            ///< file stem, e.g. "episode_0007"
   std::uint64_t seed = 0;      ///< seed of the initial state (0 when unknown, e.g. human recordings)
@@ -28,12 +31,24 @@ struct Episode {
   std::vector<StepSource> sources;  ///< who chose each action
   Outcome outcome;             ///< the judge's outcome of the whole episode
   std::string origin;          ///< where it came from (a source file, an expert's name); may be empty
+  /// The state after the last action: with `states`, the T + 1 observations Minari and
+  /// robomimic's next_obs need. Empty when unknown (a v1 set, or data made without a world).
+  std::optional<State> final_state;
+  std::vector<double> rewards;  ///< the environment's reward of each step (DiceEnv::step); T, or empty when unknown
+  bool terminated = false;      ///< the last step ended the episode in success (DiceEnv's terminated)
+  bool truncated = false;       ///< it ended otherwise: time limit, a cut rollout, a stopped recording
 
   std::size_t size() const { return states.size(); }
+  /// True when final_state, rewards and the end flags are known (format v2's additions).
+  bool has_transitions() const { return final_state.has_value(); }
+  /// Forgets the v2 additions (final state, rewards, flags), e.g. after editing the states.
+  void clear_transitions();
 };
 
 /// Throws InputError naming the episode unless states, actions and sources have one equal,
-/// non-zero length and every value is finite.
+/// non-zero length and every value is finite; with a final state, rewards has that length too,
+/// the final state and rewards are finite and at most one of terminated and truncated is set;
+/// without one, rewards is empty.
 void check_episode(const Episode& episode);
 
 }  // namespace dicestack

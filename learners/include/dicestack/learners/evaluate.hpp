@@ -34,8 +34,9 @@ struct RolloutOptions {
 /// The one rollout loop. Runs `policy` from `start` until termination, the time limit or
 /// options.max_steps, and records the episode: the state before each action, the outcome, and
 /// per step the policy's label() if it has one, else its action clipped to the world's limits
-/// (its clean label; without noise, exactly what the world applied), tagged `source`. The
-/// policy's History holds the actions the world applied.
+/// (its clean label; without noise, exactly what the world applied), tagged `source`, and (format
+/// v2) the final state, each step's reward and whether it ended in success (terminated) or
+/// otherwise (truncated). The policy's History holds the actions the world applied.
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
                 const RolloutOptions& options = {});
 

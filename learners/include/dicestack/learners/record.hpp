@@ -25,7 +25,8 @@ inline constexpr int kBuiltinSuccesses = 80;
 /// The built-in demonstration set: the first kBuiltinSuccesses realistic successes of the
 /// "mpc" expert from random starts seeded with kBuiltinSeed (the paper's "almost 70"), with
 /// provenance in meta.json. Generated into the cache on first use (a few seconds), keyed by
-/// the world config; afterwards read from there.
+/// the world config (folder expert-v3-<world hash>; v3 since the sets carry format v2's
+/// transitions, so older caches are not reused); afterwards read from there.
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads = 0);
 
 }  // namespace dicestack

@@ -1,0 +1,193 @@
+#include "common.hpp"
+
+#include <charconv>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/world.hpp>
+#include <dicestack/interop/interop.hpp>
+#include <dicestack/version.hpp>
+
+namespace dicestack {
+
+namespace {
+
+constexpr std::array<ObservationKey, 2 + 2 * kDiceCount> kKeys{{
+    {"cup_pose", {state_index::kCupX, state_index::kCupY, state_index::kCupAngle}},
+    {"cup_vel", {state_index::kCupVx, state_index::kCupVy, state_index::kCupW}},
+    {"die0_pose", {state_index::die(0), state_index::die(0) + 1, state_index::die(0) + 2}},
+    {"die0_vel", {state_index::die(0) + 3, state_index::die(0) + 4, state_index::die(0) + 5}},
+    {"die1_pose", {state_index::die(1), state_index::die(1) + 1, state_index::die(1) + 2}},
+    {"die1_vel", {state_index::die(1) + 3, state_index::die(1) + 4, state_index::die(1) + 5}},
+    {"die2_pose", {state_index::die(2), state_index::die(2) + 1, state_index::die(2) + 2}},
+    {"die2_vel", {state_index::die(2) + 3, state_index::die(2) + 4, state_index::die(2) + 5}},
+}};
+
+}  // namespace
+
+std::span<const ObservationKey> observation_keys() { return kKeys; }
+
+void require_transitions(const std::vector<Episode>& episodes, const std::string& where) {
+  std::vector<std::string> missing;
+  for (const auto& e : episodes)
+    if (!e.has_transitions()) missing.push_back(e.name.empty() ? "(unnamed)" : e.name);
+  if (missing.empty()) return;
+  std::string list;
+  for (std::size_t i = 0; i < missing.size() && i < 10; ++i) list += (i ? ", " : "") + missing[i];
+  if (missing.size() > 10) list += " and " + std::to_string(missing.size() - 10) + " more";
+  throw InputError(where + ": " + std::to_string(missing.size()) + " of " + std::to_string(episodes.size()) +
+                   " episodes have no final state, rewards or end flags (format v1, and replaying them does not "
+                   "reproduce their recorded states): " + list);
+}
+
+namespace interop {
+namespace {
+
+std::string shape_text(const std::vector<hsize_t>& d) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < d.size(); ++i) s += (i ? ", " : "") + std::to_string(d[i]);
+  return s + (d.size() == 1 ? ",)" : ")");
+}
+
+}  // namespace
+
+h5::Array read_shaped(hid_t loc, const std::string& name, const std::string& where, std::size_t rows, std::size_t cols,
+                      bool integral) {
+  h5::Array a = h5::read_numbers(loc, name, where, integral);
+  const std::vector<hsize_t> want = cols ? std::vector<hsize_t>{rows, cols} : std::vector<hsize_t>{rows};
+  if (a.dims != want) throw InputError(where + ": shape " + shape_text(a.dims) + ", expected " + shape_text(want));
+  return a;
+}
+
+h5::Array read_rows(hid_t loc, const std::string& name, const std::string& where, std::size_t cols) {
+  h5::Array a = h5::read_numbers(loc, name, where);
+  if (a.dims.size() != 2 || a.dims[1] != cols || a.dims[0] == 0)
+    throw InputError(where + ": shape " + shape_text(a.dims) + ", expected (T, " + std::to_string(cols) + ") with T >= 1");
+  return a;
+}
+
+
+std::string sources_text(const std::vector<StepSource>& sources) {
+  std::string out;
+  for (std::size_t i = 0; i < sources.size();) {
+    std::size_t j = i;
+    while (j < sources.size() && sources[j] == sources[i]) ++j;
+    out += (out.empty() ? "" : ",") + std::string(to_string(sources[i])) + ":" + std::to_string(j - i);
+    i = j;
+  }
+  return out;
+}
+
+std::vector<StepSource> sources_from_text(const std::string& text, std::size_t steps, const std::string& where) {
+  std::vector<StepSource> out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const auto comma = text.find(',', start);
+    const std::string run = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const auto colon = run.find(':');
+    if (colon == std::string::npos) throw InputError(where + ": \"" + run.substr(0, 40) + "\" is not source:count");
+    StepSource s;
+    try {
+      s = step_source_from(run.substr(0, colon));
+    } catch (const InputError& e) {
+      throw InputError(where + ": " + e.what());
+    }
+    std::size_t n = 0;
+    const char* b = run.data() + colon + 1;
+    const char* e = run.data() + run.size();
+    const auto r = std::from_chars(b, e, n);
+    if (r.ec != std::errc() || r.ptr != e || n == 0 || n > steps - out.size())
+      throw InputError(where + ": run \"" + run.substr(0, 40) + "\" does not fit " + std::to_string(steps) + " steps");
+    out.insert(out.end(), n, s);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (out.size() != steps)
+    throw InputError(where + ": gives " + std::to_string(out.size()) + " sources for " + std::to_string(steps) + " steps");
+  return out;
+}
+
+nlohmann::json outcome_json(const Outcome& o) {
+  return {{"steps", o.steps}, {"dice_in_cup", o.dice_in_cup}, {"stacked", o.stacked}, {"wall_contact", o.wall_contact}};
+}
+
+Outcome outcome_from_json(const nlohmann::json& j, const std::string& where) {
+  Outcome o;
+  auto integer = [&](const char* key, int lo, int hi) {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number_integer() || j[key].get<std::int64_t>() < lo ||
+        j[key].get<std::int64_t>() > hi)
+      throw InputError(where + ": \"" + key + "\" must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(j[key].get<std::int64_t>());
+  };
+  auto flag = [&](const char* key) {
+    if (!j.contains(key) || !j[key].is_boolean()) throw InputError(where + ": \"" + key + "\" must be true or false");
+    return j[key].get<bool>();
+  };
+  o.steps = integer("steps", 0, 1 << 30);
+  o.dice_in_cup = integer("dice_in_cup", 0, static_cast<int>(kDiceCount));
+  o.stacked = flag("stacked");
+  o.wall_contact = flag("wall_contact");
+  o.stacked_steps = o.stacked ? 1 : 0;  // as read_demo_set reads meta.json
+  o.dice_in_cup_now = o.dice_in_cup;
+  return o;
+}
+
+Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world) {
+  Outcome o;
+  World probe(world);
+  for (const State& s : states) {
+    probe.set_state(s);
+    observe(o, s, probe.touching_walls(), world);
+  }
+  probe.set_state(final_state);
+  observe(o, final_state, probe.touching_walls(), world);
+  o.steps = static_cast<int>(states.size());
+  o.stacked_steps = o.stacked ? 1 : 0;
+  o.dice_in_cup_now = o.dice_in_cup;
+  return o;
+}
+
+nlohmann::json parse_json_text(const std::string& text, const std::string& where) {
+  try {
+    return parse_json_limited<nlohmann::json>(text, where);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(where + ": not valid JSON: " + e.what());
+  }
+}
+
+nlohmann::json set_record(const DemoSet& set, const char* format) {
+  return {{"format", format},
+          {"version", kInteropFormatVersion},
+          {"dicestack_version", DICESTACK_VERSION},
+          {"demo_format_version", kDemoFormatVersion},
+          {"description", set.description},
+          {"provenance", set.provenance}};
+}
+
+void replace_folder(const std::filesystem::path& dir, const std::function<void(const std::filesystem::path&)>& fill) {
+  namespace fs = std::filesystem;
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  std::error_code ec;
+  for (const auto& tmp : dead_leftovers(dir, "tmp")) fs::remove_all(tmp, ec);
+  for (const auto& old : dead_leftovers(dir, "old"))
+    if (!fs::exists(fs::symlink_status(dir, ec))) fs::rename(old, dir, ec);  // a dead run's only copy
+    else fs::remove_all(old, ec);
+  const fs::path tmp = temporary_sibling(dir, "tmp");
+  const fs::path old = temporary_sibling(dir, "old");
+  fs::create_directory(tmp);
+  try {
+    fill(tmp);
+    if (fs::exists(fs::symlink_status(dir, ec))) fs::rename(dir, old);
+    fs::rename(tmp, dir);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
+    throw;
+  }
+  fs::remove_all(old, ec);
+}
+
+}  // namespace interop
+}  // namespace dicestack

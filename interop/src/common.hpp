@@ -1,0 +1,48 @@
+#pragma once
+// What the robomimic and Minari readers and writers share (private to interop/).
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/judge.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+#include "h5.hpp"
+
+namespace dicestack::interop {
+
+/// A dataset of exactly rows x cols numbers (cols 0: one dimension of rows); `integral` as
+/// h5::read_numbers takes it. Throws InputError "WHERE: shape (3, 2), expected (4, 3)".
+h5::Array read_shaped(hid_t loc, const std::string& name, const std::string& where, std::size_t rows, std::size_t cols,
+                      bool integral = false);
+/// A dataset of T >= 1 rows of `cols` floating-point numbers.
+h5::Array read_rows(hid_t loc, const std::string& name, const std::string& where, std::size_t cols);
+
+/// Per-step sources as runs: "expert:120,correction:3".
+std::string sources_text(const std::vector<StepSource>& sources);
+/// Reads sources_text's form back; throws InputError naming `where` unless it gives `steps` sources.
+std::vector<StepSource> sources_from_text(const std::string& text, std::size_t steps, const std::string& where);
+
+/// The outcome fields meta.json keeps (steps, dice_in_cup, stacked, wall_contact).
+nlohmann::json outcome_json(const Outcome& outcome);
+Outcome outcome_from_json(const nlohmann::json& j, const std::string& where);
+
+/// The judge run over an episode's states and its final state (no settling), for files that do
+/// not carry our outcome.
+Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world);
+
+/// Parses JSON text from a file attribute, naming `where` if it is not JSON.
+nlohmann::json parse_json_text(const std::string& text, const std::string& where);
+
+/// The "dicestack" object both exports carry: marker, version, the writer's version, description, provenance.
+nlohmann::json set_record(const DemoSet& set, const char* format);
+
+/// Writes a whole folder beside `dir` and renames it into place (a previous `dir`, which the
+/// caller has checked is ours, is moved aside first and removed after). Dead runs' leftovers of
+/// `dir` are removed first.
+void replace_folder(const std::filesystem::path& dir, const std::function<void(const std::filesystem::path&)>& fill);
+
+}  // namespace dicestack::interop
