@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 namespace dicestack {
 
@@ -24,7 +25,12 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       const int worker = tbb::this_task_arena::current_thread_index();
-      for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i, worker);
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        // After an item threw, the other threads stop at their next item, not at the end of
+        // their chunk (which can hold most of the loop): an interrupted evaluation ends at once.
+        if (tbb::is_current_task_group_canceling()) return;
+        fn(i, worker);
+      }
     });
   });
 }

@@ -1,6 +1,7 @@
 #include <dicestack/learners/evaluate.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -115,7 +116,7 @@ EvalStats summarise(const std::vector<Episode>& eps, double policy_seconds, doub
 }  // namespace
 
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
-                   int threads, InitialPush push, std::vector<Episode>* rollouts) {
+                   int threads, InitialPush push, std::vector<Episode>* rollouts, const RolloutProgress& progress) {
   RolloutOptions options;
   options.push = push;
   const int workers = resolve_threads(threads);
@@ -123,6 +124,7 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
   std::vector<double> policy_seconds(static_cast<std::size_t>(workers), 0.0);
   std::vector<Episode> eps(static_cast<std::size_t>(episodes));
+  std::atomic<int> finished{0};
   const auto t0 = std::chrono::steady_clock::now();
   parallel_for(eps.size(), threads, [&](std::size_t i, int w) {
     const auto slot = static_cast<std::size_t>(w);
@@ -131,6 +133,7 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
     const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
     const State start = random_start_state(world, episode_seed);
     eps[i] = rollout(envs.at(w), timed, start, episode_seed, StepSource::policy, options);
+    if (progress) progress(++finished, episodes);
   });
   double total_policy = 0.0;
   for (double s : policy_seconds) total_policy += s;

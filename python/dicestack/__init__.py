@@ -1,14 +1,15 @@
 """dicestack: imitation learning for dynamic dice stacking, from Python.
 
 The world as a Gymnasium environment (DiceStackEnv, DiceStackVectorEnv), the automatic experts,
-demonstrations as numpy arrays, and training and evaluation with dicestack's C++ regressors and
-learners. See docs/python.md.
+demonstrations as numpy arrays, training, evaluation and the leaderboard with dicestack's C++
+learners and its regressors or Python ones (register_regressor). See docs/python.md.
 """
 from . import _dicestack
 from ._world import default_world
 from .demos import Episode, load_demos, save_demos
 from .env import DiceStackEnv
-from .models import Expert, Model, Policy, evaluate, expert, load_model, train
+from .models import Expert, Model, Policy, evaluate, expert, leaderboard, load_model, train
+from .regressors import register_regressor, regressor_names
 from .vector_env import DiceStackVectorEnv
 
 __version__ = _dicestack.__version__
@@ -25,8 +26,11 @@ __all__ = [
     "default_world",
     "evaluate",
     "expert",
+    "leaderboard",
     "load_demos",
     "load_model",
+    "register_regressor",
+    "regressor_names",
     "save_demos",
     "train",
 ]

@@ -1,9 +1,12 @@
-"""Models, experts, training and evaluation: the same code paths as `dicestack train`,
-`dicestack evaluate --json` and `dicestack record` (the C++ learners run with the GIL released)."""
+"""Models, experts, training, evaluation and the leaderboard: the same code paths as `dicestack
+train`, `dicestack evaluate --json`, `dicestack leaderboard` and `dicestack record` (the C++
+learners run with the GIL released). Long calls draw a progress bar on stderr and stop on Ctrl-C
+(KeyboardInterrupt), leaving no half-written output."""
 import json
 import os
 
 from . import _dicestack
+from ._progress import progress_bar
 from ._world import resolve_world
 from .demos import Episode, _records
 
@@ -12,9 +15,18 @@ Policy = _dicestack.Policy
 Expert = _dicestack.Expert
 
 
-def load_model(path):
-    """A model file written by `dicestack train` or Model.save (FileNotFoundError if missing)."""
-    return _dicestack.load_model(os.fspath(path))
+def load_model(path, allow_pickle=False):
+    """A model file written by `dicestack train` or Model.save (FileNotFoundError if missing).
+
+    A model of a Python regressor (register_regressor) keeps its estimator pickled in
+    PATH.pkl. Unpickling runs code, so such a model is read only with allow_pickle=True, and
+    should be only from a source you trust; without it, ValueError says so. The pickle must be
+    the one saved with the model file (its size and FNV-1a are recorded there). Loading it needs
+    no register_regressor call in this process, only the estimator's classes importable.
+    """
+    if not isinstance(allow_pickle, bool):
+        raise TypeError(f"allow_pickle must be True or False, got {type(allow_pickle).__name__}")
+    return _dicestack.load_model(os.fspath(path), allow_pickle)
 
 
 def expert(name):
@@ -45,14 +57,16 @@ def _demos_argument(demos):
 
 
 def train(regressor, learner="bc", demos="builtin", features=None, options=None, params=None, seed=0, out=None,
-          *, world=None, split="episodes", threads=None):
+          *, world=None, split="episodes", threads=None, progress=None):
     """Trains a model as `dicestack train` does and returns it (also written to `out` if given).
 
-    regressor: a registry name (knn, linear_svr, rbf_svr, mlp, random_forest, gbt); params its
-    settings ({"k": 5}). learner: bc, dagger, dad or dart; options its settings. features: the
-    feature map (default: the learner's). demos: "builtin", "human", a folder or a list of
-    Episodes. split "episodes" holds every fifth episode out (test error), "none" trains on all.
-    The model's `training` dict holds train_error, test_error (if any) and seconds.
+    regressor: a registry name (knn, linear_svr, rbf_svr, mlp, random_forest, gbt, or one added
+    with register_regressor); params its settings ({"k": 5}). learner: bc, dagger, dad or dart;
+    options its settings. features: the feature map (default: the learner's). demos: "builtin",
+    "human", a folder or a list of Episodes. split "episodes" holds every fifth episode out (test
+    error), "none" trains on all. The model's `training` dict holds train_error, test_error (if
+    any) and seconds. progress: draw a progress bar on stderr (None: when stderr is a terminal).
+    Ctrl-C stops the training with KeyboardInterrupt; `out` is then left as it was.
     """
     return _dicestack.train(
         resolve_world(world),
@@ -66,14 +80,17 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
         seed,
         threads,
         os.fspath(out) if out is not None else "",
+        progress_bar(progress),
     )
 
 
-def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None, initial_push="none"):
+def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None, initial_push="none",
+             progress=None):
     """Rolls `model` out from `episodes` random starts, as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
-    given). The result does not depend on `threads`."""
+    given). The result does not depend on `threads`. progress: a progress bar on stderr (None:
+    when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt."""
     if not isinstance(model, Model):
         raise TypeError(f"model must be a dicestack.Model, got {type(model).__name__}")
     return json.loads(
@@ -85,5 +102,71 @@ def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None
             threads,
             initial_push,
             None if demos is None else _demos_argument(demos),
+            progress_bar(progress),
         )
     )
+
+
+_FORMATS = {".md": "md", ".csv": "csv", ".tex": "latex", ".json": "json"}
+
+
+def _names(values, what):
+    if values is None:
+        return []
+    if isinstance(values, str):
+        return [v for v in values.split(",") if v]
+    values = list(values)
+    if not all(isinstance(v, str) for v in values):
+        raise TypeError(f"{what} must be a str or a list of str")
+    return values
+
+
+def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
+                profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, threads=None,
+                out=None, format=None, progress=None):
+    """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
+    learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
+    with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
+    train_error, test_error, dice_in_cup_mean, episodes, stacked, wall_contact,
+    realistic_success, the rates and their *_ci95 intervals, fit_s, us_per_step; -1 where a
+    value does not apply, as in the command line's table).
+
+    regressors: names (None: every registered one, Python regressors included); learners: None
+    (bc, dagger, dart) or names; features: feature maps (None: each learner's own); options: a
+    dict of learner options applied to every learner that has the key; baselines: names
+    (cmaes, de, basinhop, bayes, reinforce, rrt) or "all"; profile "quick" or "paper"; split
+    "episodes" or "rows"; episodes: rollouts per row and seed (None: 20 quick, 100 paper);
+    seeds: training seeds per row. demos: "builtin", "human" or a folder.
+
+    out: also write the table there, in `format` (md, csv, latex or json; None: from the file's
+    suffix, .md .csv .tex .json, else md), atomically and never over a file that is not a
+    dicestack leaderboard; finished rows are kept in OUT.partial.json, so an interrupted run
+    (Ctrl-C: KeyboardInterrupt) resumes where it stopped when called again with the same settings.
+    progress: a progress bar on stderr (None: when stderr is a terminal).
+    """
+    if format is None:
+        format = _FORMATS.get(os.path.splitext(os.fspath(out))[1].lower(), "md") if out is not None else "md"
+    if not isinstance(demos, (str, os.PathLike)):
+        raise TypeError("demos must be 'builtin', 'human' or a folder")
+    for name, value in (("episodes", episodes), ("seeds", seeds)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+            raise ValueError(f"{name} must be a positive int, got {value!r}")
+    table = _dicestack.leaderboard(
+        resolve_world(world),
+        os.fspath(demos),
+        _names(regressors, "regressors"),
+        _names(learners, "learners"),
+        _assignments(options or {}, "options"),
+        _names(baselines, "baselines"),
+        _names(features, "features"),
+        profile,
+        split,
+        episodes or 0,
+        seeds,
+        seed,
+        threads,
+        os.fspath(out) if out is not None else "",
+        format,
+        progress_bar(progress),
+    )
+    return json.loads(table)["rows"]

@@ -8,6 +8,7 @@
 
 #include <dicestack/core/judge.hpp>
 #include <dicestack/core/world_config.hpp>
+#include <dicestack/regressors/model.hpp>
 
 #include "env_core.hpp"
 
@@ -18,7 +19,11 @@ namespace py = pybind11;
 void bind_world(py::module_& m);   // WorldConfig
 void bind_env(py::module_& m);     // Env, Snapshot, VectorEnv
 void bind_demos(py::module_& m);   // demonstration sets
-void bind_models(py::module_& m);  // Model, Policy, Expert, train, evaluate
+void bind_models(py::module_& m);  // Model, Policy, Expert, train, evaluate, leaderboard
+void bind_regressors(py::module_& m);  // register_regressor, regressor_names
+
+/// What load_model(path, allow_pickle=True) unpickles a Python regressor's model with (GIL held).
+PickleLoader python_pickle_loader();
 
 /// None, or a whole number in [0, 2^64 - 1]; ValueError (TypeError for a non-integer) otherwise.
 std::optional<std::uint64_t> seed_from(const py::handle& seed, const char* what = "seed");

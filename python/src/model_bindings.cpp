@@ -1,5 +1,6 @@
 // Models (load, predict, save), the policy a model gives (it keeps its episode's history for the
-// feature map), the automatic experts, and train() / evaluate() as the command line runs them.
+// feature map), the automatic experts, and train() / evaluate() / leaderboard() as the command
+// line runs them, with a progress bar and Ctrl-C (LongCall).
 #include <memory>
 #include <optional>
 
@@ -9,6 +10,7 @@
 #include <dicestack/core/expert.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/leaderboard.hpp>
 #include <dicestack/learners/policy.hpp>
 #include <dicestack/learners/report.hpp>
 #include <dicestack/learners/train.hpp>
@@ -18,6 +20,7 @@
 #include "convert.hpp"
 #include "demos.hpp"
 #include "errors.hpp"
+#include "long_call.hpp"
 
 namespace dicestack::python {
 namespace {
@@ -94,11 +97,19 @@ std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& worl
   return episodes_from(demos.cast<py::iterable>());
 }
 
+/// Refuses a user's file at a model's path, and at its pickle's when the regressor pickles, before any work.
+void check_model_replaceable(const std::filesystem::path& out, const std::string& regressor,
+                             const std::vector<std::string>& sets) {
+  check_replaceable(out, model_ownership());
+  if (dynamic_cast<const PickledRegressor*>(RegressorRegistry::global().create(regressor, sets).get()))
+    check_replaceable(pickle_path(out), pickle_ownership(out));
+}
+
 PyModel train(const WorldConfig& world, const py::handle& demos, const std::string& regressor,
               const std::vector<std::string>& sets, const std::string& learner, const std::vector<std::string>& options,
               const std::string& features, const std::string& split, const py::handle& seed, const py::handle& threads,
-              const std::string& out) {
-  if (!out.empty()) check_replaceable(out, model_ownership());  // refuse a user's file before any work
+              const std::string& out, py::object bar) {
+  if (!out.empty()) check_model_replaceable(out, regressor, sets);
   TrainRequest request;
   request.world = world;
   request.demos = demos_from(demos, world, &request.demos_name);
@@ -110,6 +121,15 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
   request.split = split;
   request.seed = seed_from(seed).value_or(0);
   request.threads = threads_from(threads);
+  LongCall call(std::move(bar));
+  request.progress = [&](const Progress& p) {
+    std::string text = learner + " " + regressor + ": iteration " + std::to_string(p.iteration) + "/" +
+                       std::to_string(p.iterations);
+    if (p.windows > 0) text += ", window " + std::to_string(p.window) + "/" + std::to_string(p.windows);
+    text += ", " + p.phase;
+    if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
+    call.poll(p.fraction, text);
+  };
   std::optional<TrainReport> report;
   {
     py::gil_scoped_release nogil;
@@ -126,7 +146,7 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
 }
 
 std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episodes, const py::handle& seed,
-                           const py::handle& threads, const std::string& push, const py::handle& demos) {
+                           const py::handle& threads, const std::string& push, const py::handle& demos, py::object bar) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
   const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push};
   const InitialPush initial_push = initial_push_from(push);
@@ -134,12 +154,48 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   std::optional<std::vector<Episode>> demo_episodes;
   if (!demos.is_none()) demo_episodes = demos_from(demos, world, nullptr);
   std::shared_ptr<const Model> model = m.model;
+  LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
-  const EvalStats stats =
-      evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, run.seed, t, initial_push);
+  const EvalStats stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, run.seed, t,
+                                   initial_push, nullptr, [&](int finished, int of) {
+                                     call.poll(static_cast<double>(finished) / of,
+                                               "evaluate: " + std::to_string(finished) + "/" + std::to_string(of) + " rollouts");
+                                   });
   std::optional<ModelErrors> errors;
   if (demo_episodes) errors = model_errors(*model, *demo_episodes);
   return evaluation_json(run, *model, stats, errors ? &*errors : nullptr);
+}
+
+/// The leaderboard's json table (its rows are what Python returns); written to `out` if given.
+std::string leaderboard(const WorldConfig& world, const std::string& demos, const std::vector<std::string>& regressors,
+                        const std::vector<std::string>& learners, const std::vector<std::string>& options,
+                        const std::vector<std::string>& baselines, const std::vector<std::string>& features,
+                        const std::string& profile, const std::string& split, int episodes, int seeds,
+                        const py::handle& seed, const py::handle& threads, const std::string& out,
+                        const std::string& format, py::object bar) {
+  LeaderboardRequest request;
+  request.world = world;
+  request.regressors = regressors;
+  request.learners = learners;
+  request.options = options;
+  request.baselines = baselines;
+  request.features = features;
+  request.profile = profile;
+  request.split = split;
+  request.episodes = episodes;
+  request.seeds = seeds;
+  request.seed = seed_from(seed).value_or(0);
+  request.threads = threads_from(threads);
+  request.out = out;
+  request.format = format;
+  LongCall call(std::move(bar));
+  py::gil_scoped_release nogil;
+  request.demos = resolve_demo_set(demos, world);
+  const Leaderboard board = reading(request.demos, [&] {
+    return run_leaderboard(request, [&](const LeaderboardProgress& p) { call.poll(p.fraction, p.text); });
+  });
+  if (!out.empty()) write_leaderboard(board, format, out);
+  return render_leaderboard(board, "json");
 }
 
 }  // namespace
@@ -182,10 +238,11 @@ void bind_models(py::module_& m) {
       .def_property_readonly("path", [](const PyModel& pm) { return pm.path.empty() ? py::object(py::none()) : py::str(pm.path); })
       .def_property_readonly("training", [](const PyModel& pm) { return pm.training ? py::object(*pm.training) : py::none(); });
 
-  m.def("load_model", [](const std::filesystem::path& path) {
-          return PyModel{std::make_shared<Model>(reading(path, [&] { return load_model(path); })), path.string(),
-                         std::nullopt};
-        }, py::arg("path"));
+  m.def("load_model", [](const std::filesystem::path& path, bool allow_pickle) {
+          const PickleLoader pickles = allow_pickle ? python_pickle_loader() : PickleLoader();
+          auto model = reading(path, [&] { return load_model(path, RegressorRegistry::global(), pickles); });
+          return PyModel{std::make_shared<Model>(std::move(model)), path.string(), std::nullopt};
+        }, py::arg("path"), py::arg("allow_pickle"));
 
   py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\" or \"mpc\") acting on an environment")
       .def(py::init<const std::string&>(), py::arg("name"))
@@ -199,9 +256,14 @@ void bind_models(py::module_& m) {
   });
 
   m.def("train", &train, py::arg("world"), py::arg("demos"), py::arg("regressor"), py::arg("sets"), py::arg("learner"),
-        py::arg("options"), py::arg("features"), py::arg("split"), py::arg("seed"), py::arg("threads"), py::arg("out"));
+        py::arg("options"), py::arg("features"), py::arg("split"), py::arg("seed"), py::arg("threads"), py::arg("out"),
+        py::arg("bar"));
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
-        py::arg("threads"), py::arg("initial_push"), py::arg("demos"));
+        py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"));
+  m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
+        py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
+        py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),
+        py::arg("bar"));
 }
 
 }  // namespace dicestack::python

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_dicestack, m) {
   dicestack::python::bind_env(m);
   dicestack::python::bind_demos(m);
   dicestack::python::bind_models(m);
+  dicestack::python::bind_regressors(m);
 }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -41,7 +43,73 @@ std::uint64_t header_count(const json& h, const char* key, std::uint64_t max, co
   return v.get<std::uint64_t>();
 }
 
+constexpr const char* kPickledFormat = "dicestack-pickled-regressor";
+
+json pickled_record(std::string_view pickle, const std::string& type) {
+  return {{"format", kPickledFormat}, {"version", 1}, {"object_type", type}, {"pickle_bytes", pickle.size()},
+          {"pickle_fnv1a", fnv1a_hex(pickle)}};
+}
+
+// The record of a pickled payload, or nothing if the payload is not one.
+std::optional<json> pickled_record_of(std::string_view payload) {
+  if (payload.empty() || payload.front() != '{' || payload.size() > 4096) return std::nullopt;
+  try {
+    json j = parse_json_limited<json>(payload, "payload");
+    if (j.is_object() && j.value("format", "") == kPickledFormat && j.contains("pickle_bytes") &&
+        j["pickle_bytes"].is_number_unsigned() && j.contains("pickle_fnv1a") && j["pickle_fnv1a"].is_string())
+      return j;
+  } catch (const std::exception&) {  // not JSON, or too deep: not a pickled payload
+  }
+  return std::nullopt;
+}
+
+// The pickled record of the dicestack model file at `model`, or nothing (no such file, not a
+// model, not pickled). Never throws: it decides whether a file may be replaced.
+std::optional<json> pickled_record_of_file(const std::filesystem::path& model) {
+  std::ifstream in(model, std::ios::binary);
+  std::string first;
+  if (!in || !std::getline(in, first)) return std::nullopt;
+  try {
+    const json h = parse_json_limited<json>(first, model.string());
+    if (!h.is_object() || h.value("format", "") != kModelFormat) return std::nullopt;
+    std::string payload(4097, '\0');
+    in.read(payload.data(), static_cast<std::streamsize>(payload.size()));
+    payload.resize(static_cast<std::size_t>(in.gcount()));
+    return pickled_record_of(payload);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::optional<std::string> read_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+bool matches(const std::string& bytes, const json& record) {
+  return bytes.size() == record.at("pickle_bytes").get<std::uint64_t>() &&
+         fnv1a_hex(bytes) == record.at("pickle_fnv1a").get<std::string>();
+}
+
+// Messages never echo long values from a file.
+std::string cut(std::string text) { return text.size() > 80 ? text.substr(0, 80) + "..." : text; }
+
 }  // namespace
+
+std::string PickledRegressor::do_save() const { return pickled_record(pickle(), object_type()).dump(); }
+
+std::filesystem::path pickle_path(const std::filesystem::path& model) { return model.string() + ".pkl"; }
+
+bool is_pickled_payload(std::string_view payload) { return pickled_record_of(payload).has_value(); }
+
+Ownership pickle_ownership(const std::filesystem::path& model) {
+  return {"pickle saved with the dicestack model " + model.string(), [model](const std::filesystem::path& p) {
+            const auto record = pickled_record_of_file(model);
+            const auto bytes = record ? read_bytes(p) : std::nullopt;
+            return bytes && matches(*bytes, *record);
+          }};
+}
 
 Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer y, const FeatureMap& features)
     : regressor_(std::move(regressor)), features_(&features), x_(std::move(x)), y_(std::move(y)) {
@@ -89,7 +157,15 @@ Ownership model_ownership() { return Ownership::json_first_line("dicestack model
 
 void save_model(const Model& model, const std::filesystem::path& path) {
   const Regressor& r = model.regressor();
-  const std::string payload = r.save_payload();
+  const auto* pickled = dynamic_cast<const PickledRegressor*>(&r);
+  std::string payload, pickle;
+  if (pickled) {
+    if (!r.fitted()) throw InputError(r.name() + ": cannot save a model that was never fitted");
+    pickle = pickled->pickle();  // once: the payload describes exactly these bytes
+    payload = pickled_record(pickle, pickled->object_type()).dump();
+  } else {
+    payload = r.save_payload();
+  }
   json params = json::object();
   for (const auto& [k, v] : r.params().as_text()) params[k] = v;
   json header{{"format", kModelFormat},
@@ -111,20 +187,33 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                     {"payload_bytes", payload.size()},
                     {"payload_fnv1a", fnv1a_hex(payload)}};
   header["checksum"] = whole_checksum(header, payload);
+  // Both outputs are checked before either is written. The pickle is committed first, so that
+  // a model file never names a pickle that is not there.
+  const std::filesystem::path pkl = pickle_path(path);
+  std::optional<AtomicFile> pickle_file;
+  if (pickled) pickle_file.emplace(pkl, pickle_ownership(path));
   AtomicFile file(path, model_ownership());
+  std::error_code ec;
+  const bool stale_pickle = !pickled && std::filesystem::is_regular_file(pkl, ec) && pickle_ownership(path).recognises(pkl);
   file.stream() << header.dump() << '\n' << payload;
+  if (pickle_file) {
+    pickle_file->stream() << pickle;
+    pickle_file->commit();
+  }
   file.commit();
+  if (stale_pickle) std::filesystem::remove(pkl, ec);  // the replaced model's; nothing names it now
 }
 
-Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry) {
+Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry, const PickleLoader& pickles) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open model file");
   std::ostringstream bytes;
   bytes << in.rdbuf();
-  return parse_model_file(bytes.str(), path.string(), registry);
+  return parse_model_file(bytes.str(), path.string(), registry, pickles);
 }
 
-Model parse_model_file(std::string_view bytes, const std::string& path, const RegressorRegistry& registry) {
+Model parse_model_file(std::string_view bytes, const std::string& path, const RegressorRegistry& registry,
+                       const PickleLoader& pickles) {
   const std::string where = path + ": ";
   const auto newline = bytes.find('\n');
   const std::string_view first = bytes.substr(0, newline);
@@ -181,15 +270,32 @@ Model parse_model_file(std::string_view bytes, const std::string& path, const Re
       throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, this world takes " +
                        std::to_string(kActionDim) + "-d");
     const std::string name = h.at("regressor").get<std::string>();
-    if (!registry.contains(name))
-      throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
     std::vector<std::string> sets;
     for (const auto& [k, v] : h.at("params").items()) sets.push_back(k + "=" + v.get<std::string>());
     std::unique_ptr<Regressor> regressor;
-    try {
-      regressor = registry.create(name, sets);
-    } catch (const ConfigError& e) {
-      throw InputError(where + "\"params\": " + e.what());
+    if (const auto record = pickled_record_of(payload)) {
+      const std::filesystem::path pkl = pickle_path(std::filesystem::path(path));
+      const std::string type = record->value("object_type", std::string("?"));
+      if (!pickles)
+        throw InputError(where + "regressor \"" + cut(name) + "\" is a Python object (" + cut(type) + ") pickled in " +
+                         pkl.string() +
+                         "; unpickling runs code, so dicestack reads it only from Python, with "
+                         "dicestack.load_model(path, allow_pickle=True) (never from the command line), and only from "
+                         "a source you trust");
+      const auto pickle = read_bytes(pkl);
+      if (!pickle) throw InputError(pkl.string() + ": cannot open the pickle of the model " + path);
+      if (!matches(*pickle, *record))
+        throw InputError(pkl.string() + ": does not match the model file " + path +
+                         " (its size or FNV-1a differs from the one recorded there): they were not saved together");
+      regressor = pickles(name, sets, *pickle);
+    } else {
+      if (!registry.contains(name))
+        throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
+      try {
+        regressor = registry.create(name, sets);
+      } catch (const ConfigError& e) {
+        throw InputError(where + "\"params\": " + e.what());
+      }
     }
     auto scaler = [&](const char* key, std::size_t dim) {
       Standardizer s;

@@ -19,8 +19,10 @@ RegressorRegistry& RegressorRegistry::global() {
   return *registry;
 }
 
-void RegressorRegistry::add(RegressorInfo info) {
-  info.source = registering_source_;
+void RegressorRegistry::add(RegressorInfo info) { add(std::move(info), registering_source_); }
+
+void RegressorRegistry::add(RegressorInfo info, std::string source) {
+  info.source = std::move(source);
   if (const auto it = entries_.find(info.name); it != entries_.end())
     throw ConfigError("regressor \"" + info.name + "\" registered twice (" + it->second.source + ", and " +
                       info.source + ")");

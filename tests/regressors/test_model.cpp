@@ -2,8 +2,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <cstdio>
 #include <cstring>
 #include <sstream>
@@ -217,6 +219,96 @@ TEST(ModelFile, VersionOneReadsAsTheStateMap) {
   const Model back = load_model(path);
   EXPECT_EQ(back.features().name(), "state");
   EXPECT_EQ(back.predict(x.topRows(5)), m.predict(x.topRows(5)));
+  fs::remove(path);
+}
+
+// A stand-in for a Python regressor: its "pickle" is the mean of the labels, as text.
+class MeanPickled final : public PickledRegressor {
+ public:
+  using PickledRegressor::PickledRegressor;
+  std::string pickle() const override {
+    std::ostringstream out;
+    out << std::setprecision(17) << "mean " << mean_[0] << ' ' << mean_[1] << ' ' << mean_[2];
+    return out.str();
+  }
+  std::string object_type() const override { return "tests.MeanPickled"; }
+  void set(const std::array<double, 3>& mean) { mean_ = mean; }
+
+ private:
+  void do_fit(const Matrix&, const Matrix& y, std::uint64_t) override {
+    for (Eigen::Index k = 0; k < 3; ++k) mean_[static_cast<std::size_t>(k)] = y.col(k).mean();
+  }
+  void do_predict_row(std::span<const double>, std::span<double> y) const override { std::copy(mean_.begin(), mean_.end(), y.begin()); }
+  void do_load(std::string_view payload, std::size_t, std::size_t) override {
+    if (!is_pickled_payload(payload)) throw InputError("not a pickled payload");
+  }
+  std::array<double, 3> mean_{};
+};
+
+PickleLoader mean_loader(int* calls) {
+  return [calls](const std::string& name, const std::vector<std::string>& params, const std::string& bytes) {
+    ++*calls;
+    EXPECT_TRUE(params.empty());
+    std::array<double, 3> mean{};
+    std::istringstream in(bytes.substr(5));
+    in >> mean[0] >> mean[1] >> mean[2];
+    auto r = std::make_unique<MeanPickled>(name, Params());
+    r->set(mean);
+    return std::unique_ptr<Regressor>(std::move(r));
+  };
+}
+
+TEST(ModelFile, PickledRegressorsKeepTheirPickleBesideTheModel) {
+  const Matrix x = random_rows(50, 24, 5);
+  const Model m = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, labels(x), 3);
+  const fs::path path = temp_model("pickled"), pkl = pickle_path(path);
+  EXPECT_EQ(pkl.string(), path.string() + ".pkl");
+  save_model(m, path);
+  ASSERT_TRUE(fs::exists(pkl));
+  EXPECT_TRUE(is_pickled_payload(read_parts(path).second));
+  // Without a loader (the command line) it is refused, and the message says why.
+  const std::string error = test::error_of([&] { load_model(path); });
+  EXPECT_THAT(error, HasSubstr(path.string() + ": regressor \"py_mean\" is a Python object (tests.MeanPickled) pickled in " + pkl.string()));
+  EXPECT_THAT(error, HasSubstr("unpickling runs code"));
+  EXPECT_THAT(error, HasSubstr("allow_pickle=True"));
+  EXPECT_THROW(load_model(path), InputError);
+  int calls = 0;
+  const Model back = load_model(path, RegressorRegistry::global(), mean_loader(&calls));
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(back.regressor().name(), "py_mean");
+  EXPECT_EQ(back.predict(x.topRows(3)), m.predict(x.topRows(3)));
+  // Saved again over its own files; a pickle that is not the model's is not read.
+  save_model(back, path);
+  std::ofstream(pkl, std::ios::app) << " ";
+  EXPECT_THAT(test::error_of([&] { load_model(path, RegressorRegistry::global(), mean_loader(&calls)); }),
+              HasSubstr("does not match the model file"));
+  EXPECT_EQ(calls, 1);
+  // ... nor replaced: it is no longer the one the model file names.
+  EXPECT_THAT(test::error_of([&] { save_model(m, path); }), HasSubstr("refusing to replace it"));
+  fs::remove(pkl);
+  EXPECT_THAT(test::error_of([&] { load_model(path, RegressorRegistry::global(), mean_loader(&calls)); }),
+              HasSubstr("cannot open the pickle"));
+  fs::remove(path);
+}
+
+TEST(ModelFile, APickleThatIsNotOursIsNeverReplaced) {
+  const Matrix x = random_rows(50, 24, 6);
+  const Model pickled = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, labels(x), 3);
+  const fs::path path = temp_model("users_pickle"), pkl = pickle_path(path);
+  std::ofstream(pkl) << "the user's own pickle";
+  EXPECT_THAT(test::error_of([&] { save_model(pickled, path); }), HasSubstr(pkl.string() + ": exists and is not a pickle saved with the dicestack model"));
+  EXPECT_FALSE(fs::exists(path));
+  // A built-in model beside it leaves the user's file alone...
+  const Model knn = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
+  save_model(knn, path);
+  EXPECT_TRUE(fs::exists(pkl));
+  fs::remove(pkl);
+  // ... and a built-in model saved over a pickled one removes that model's pickle.
+  save_model(pickled, path);
+  ASSERT_TRUE(fs::exists(pkl));
+  save_model(knn, path);
+  EXPECT_FALSE(fs::exists(pkl));
+  EXPECT_EQ(load_model(path).regressor().name(), "knn");
   fs::remove(path);
 }
 

@@ -12,7 +12,7 @@ int resolve_threads(int threads);
 /// Calls fn(i, worker) for every i in [0, n), on up to `threads` threads (0 = all cores).
 /// `worker` is in [0, resolve_threads(threads)) and no two calls with the same worker run at
 /// once, so it can index per-thread scratch state (one World per thread). The first exception
-/// thrown by fn is rethrown here after the loop stops.
+/// thrown by fn is rethrown here after the loop stops: the other threads start no further item.
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t i, int worker)>& fn);
 
 }  // namespace dicestack

@@ -64,10 +64,15 @@ struct EvalStats {
 /// Makes one policy per worker thread (policies may keep per-episode state).
 using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
 
+/// Called as each rollout ends with (rollouts finished, rollouts in all), from the worker threads,
+/// several at once. An exception it throws stops the evaluation and is rethrown.
+using RolloutProgress = std::function<void(int finished, int total)>;
+
 /// Rolls a policy out from `episodes` random starts (evaluation_start_seed(seed, i)), in parallel
 /// on `threads` threads with one world each; the result does not depend on the thread count.
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
-                   int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr);
+                   int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr,
+                   const RolloutProgress& progress = {});
 
 /// Replays every demonstration's actions from its own first state (paper VI-A).
 EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads);

@@ -78,6 +78,9 @@ class RegressorRegistry {
   /// Adds a regressor. Throws ConfigError if the name is taken, naming both sources:
   /// `regressor "knn" registered twice (built-in, and plugin ./libknn2.so)`.
   void add(RegressorInfo info);
+  /// Adds a regressor registered by `source` (named in messages, e.g. "Python
+  /// (dicestack.register_regressor)"); throws as add(info) does.
+  void add(RegressorInfo info, std::string source);
 
   /// A new, unfitted regressor with the schema's defaults overridden by "key=value"
   /// assignments. Throws ConfigError for an unknown name (listing the registered ones) or a

@@ -1,0 +1,87 @@
+#pragma once
+// The leaderboard: the paper's Table I regenerated. Every regressor under every learner (and
+// feature map), with train and test error (eq. 9), rollout outcomes with 95% Wilson intervals,
+// fit time and time per step; baselines without demonstrations as rows of their own, and the
+// demonstrations' playback for reference. Shared by `dicestack leaderboard` and the Python
+// package's dicestack.leaderboard(), which print and write the same tables.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// What `dicestack leaderboard` asks for; the defaults are the command line's.
+struct LeaderboardRequest {
+  WorldConfig world;
+  std::filesystem::path demos;          ///< the demonstration folder (see resolve_demo_set)
+  std::vector<std::string> regressors;  ///< registry names; empty: every registered regressor
+  std::vector<std::string> learners;    ///< empty: bc, dagger, dart
+  std::vector<std::string> options;     ///< "key=value", applied to every learner that has the key
+  /// cmaes, de, basinhop, bayes, reinforce, rrt, or the one name "all": rows without demonstrations.
+  std::vector<std::string> baselines;
+  /// Feature maps: a row per learner and map it can read; empty: each learner's own (the paper
+  /// profile adds "state" and dart's map for every learner that reads them).
+  std::vector<std::string> features;
+  std::string profile = "quick";  ///< "quick" or "paper": learner options, budgets, rollouts
+  std::string split = "episodes";  ///< "episodes" (i % 5 == 4 is test) or "rows" (the paper's 25 % of rows)
+  int episodes = 0;               ///< rollouts per row and training seed; 0: 20 (quick) or 100 (paper)
+  int seeds = 1;                  ///< training seeds per row, >= 1
+  std::uint64_t seed = 0;         ///< the first training seed, and the seed of the rollouts' starts
+  int threads = 0;                ///< 0 = all cores; results do not depend on it
+  /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
+  /// before any work (a user's file is refused), and finished rows go to <out>.partial.json as
+  /// they come, so that a rerun with the same settings resumes.
+  std::filesystem::path out;
+  std::string format = "md";  ///< the table's format at `out`: md, csv, latex or json
+};
+
+/// One row of the table. Negative errors and times mean "none" (printed "-").
+struct LeaderboardRow {
+  std::string regressor, learner, features = "-";
+  double train_error = 0, test_error = 0, fit_s = 0, us_per_step = 0, dice_in_cup = 0;
+  int episodes = 0, stacked = 0, walls = 0, success = 0;
+};
+
+/// A finished run: its rows, and the text and settings every format carries.
+struct Leaderboard {
+  std::vector<LeaderboardRow> rows;
+  std::string header;     ///< one line: demonstrations, split, profile, rollouts, options
+  std::string meta_json;  ///< the settings as a JSON object (a json table's top-level keys)
+};
+
+/// Where a run stands.
+struct LeaderboardProgress {
+  std::string text;       ///< "[2/6] bc knn: training (seed 0), iteration 1/1, fit"
+  double fraction = 0.0;  ///< of the whole run, in [0, 1]
+  /// A new step: the command line prints a line for each; the calls in between (each rollout,
+  /// each learner report) only tick. Ticks may come from worker threads, several at once.
+  bool milestone = false;
+};
+using LeaderboardProgressFn = std::function<void(const LeaderboardProgress&)>;
+
+/// Trains and rolls out every row. Names (regressors, learners, maps, baselines), the profile,
+/// split, format and counts are checked before any work (ConfigError), and so are `out` and its
+/// partial file (InputError). Rows already in <out>.partial.json with the same settings are
+/// reused. An exception from `progress` ends the run and is rethrown.
+Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress = {});
+
+/// The table as text: "md" (the header line, then a Markdown table), "csv", "latex" or "json"
+/// (the settings and a "rows" array); what `dicestack leaderboard --format F` prints.
+/// Throws ConfigError for another format.
+std::string render_leaderboard(const Leaderboard& board, const std::string& format);
+
+/// One row as a JSON object: the json table's row (regressor, learner, features, train_error,
+/// test_error, dice_in_cup_mean, episodes, stacked, wall_contact, realistic_success, the three
+/// rates with their *_ci95 intervals, fit_s, us_per_step).
+std::string leaderboard_row_json(const LeaderboardRow& row);
+
+/// Writes the rendered table to `out` atomically (md and latex after a marker line, so that a
+/// later run recognises the file as its own), never over a file that is not a dicestack
+/// leaderboard of that format, then removes <out>.partial.json. Throws InputError.
+void write_leaderboard(const Leaderboard& board, const std::string& format, const std::filesystem::path& out);
+
+}  // namespace dicestack

@@ -1,0 +1,479 @@
+#include <dicestack/learners/leaderboard.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/open_loop.hpp>
+#include <dicestack/core/reinforce.hpp>
+#include <dicestack/core/rrt.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/version.hpp>
+
+namespace dicestack {
+namespace {
+
+using nlohmann::json;
+
+json row_json(const LeaderboardRow& r) {
+  const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
+  return {{"regressor", r.regressor},     {"learner", r.learner},          {"features", r.features},
+          {"train_error", r.train_error},
+          {"test_error", r.test_error},   {"dice_in_cup_mean", r.dice_in_cup}, {"episodes", r.episodes},
+          {"stacked", r.stacked},         {"wall_contact", r.walls},       {"realistic_success", r.success},
+          {"stacked_rate", st.value},     {"stacked_ci95", {st.low, st.high}},
+          {"wall_contact_rate", wc.value}, {"wall_contact_ci95", {wc.low, wc.high}},
+          {"realistic_success_rate", rs.value}, {"realistic_success_ci95", {rs.low, rs.high}},
+          {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
+}
+
+void add_outcomes(LeaderboardRow& row, const EvalStats& st, int seeds) {
+  row.episodes += st.episodes;
+  row.stacked += static_cast<int>(std::lround(st.stacked.value * st.episodes));
+  row.walls += static_cast<int>(std::lround(st.wall_contact.value * st.episodes));
+  row.success += static_cast<int>(std::lround(st.realistic_success.value * st.episodes));
+  row.dice_in_cup += st.dice_in_cup_mean / seeds;
+  row.us_per_step += st.policy_us_per_step / seeds;
+}
+
+// The network REINFORCE learned, acting on states.
+class NetworkPolicy final : public Policy {
+ public:
+  NetworkPolicy(std::shared_ptr<const PolicyNetwork> net, const WorldConfig& world) : net_(std::move(net)), world_(world) {}
+  Action act(const History& h) override { return net_->act(h.current(), world_); }
+  std::string name() const override { return "reinforce"; }
+
+ private:
+  std::shared_ptr<const PolicyNetwork> net_;
+  WorldConfig world_;
+};
+
+// Runs a baseline with the profile's budget: an open-loop sequence (optimisers, RRT) played
+// from every start, or REINFORCE's network acting on the states.
+PolicyFactory baseline_policy(const std::string& name, const WorldConfig& world, bool paper, std::uint64_t seed, int threads) {
+  std::vector<Action> actions;
+  if (name == "reinforce") {
+    ReinforceOptions o;
+    o.iterations = paper ? 1000 : 100;
+    o.seed = seed;
+    o.threads = threads;
+    auto net = std::make_shared<const PolicyNetwork>(reinforce(world, o).policy);
+    return [net, world] { return std::make_unique<NetworkPolicy>(net, world); };
+  }
+  if (name == "rrt") {
+    RrtOptions o;
+    o.nodes = paper ? 1000 : 100;
+    o.seed = seed;
+    o.threads = threads;
+    actions = rrt(world, o).actions;
+  } else {
+    OptimiseOptions o;
+    o.method = name;
+    o.evaluations = name == "bayes" ? (paper ? 500 : 200) : (paper ? 5000 : 1000);
+    o.seed = seed;
+    OpenLoopProblem problem(world, {}, threads);
+    actions = problem.actions(optimise(problem, o).best.data());
+  }
+  Episode sequence;
+  sequence.actions = actions;
+  return [sequence] { return std::make_unique<PlaybackPolicy>(sequence); };
+}
+
+LeaderboardRow row_from(const json& j) {
+  LeaderboardRow r;
+  r.regressor = j.at("regressor");
+  r.learner = j.at("learner");
+  r.features = j.value("features", "-");
+  r.train_error = j.at("train_error");
+  r.test_error = j.at("test_error");
+  r.dice_in_cup = j.at("dice_in_cup_mean");
+  r.episodes = j.at("episodes");
+  r.stacked = j.at("stacked");
+  r.walls = j.at("wall_contact");
+  r.success = j.at("realistic_success");
+  r.fit_s = j.at("fit_s");
+  r.us_per_step = j.at("us_per_step");
+  return r;
+}
+
+std::string pct(int k, int n) {
+  const Rate r = wilson(k, n);
+  char s[64];
+  std::snprintf(s, sizeof s, "%.0f%% [%.0f-%.0f]", 100 * r.value, 100 * r.low, 100 * r.high);
+  return s;
+}
+
+std::string fixed(double v, int digits) {
+  if (v < 0) return "-";
+  char s[32];
+  std::snprintf(s, sizeof s, "%.*f", digits, v);
+  return s;
+}
+
+constexpr const char* kLeaderboardFormat = "dicestack-leaderboard";
+constexpr const char* kPartialFormat = "dicestack-leaderboard-partial";
+constexpr const char* kCsvHeader =
+    "regressor,learner,features,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
+    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
+// The header before feature maps had a column (still ours to replace).
+constexpr const char* kCsvHeaderV1 =
+    "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
+    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
+
+// The first line a written table starts with (md and latex get a marker comment), and which
+// existing files --out may replace: tables of the same format that dicestack wrote.
+std::string file_marker(const std::string& format) {
+  if (format == "md") return "<!-- dicestack leaderboard -->\n";
+  if (format == "latex") return "% dicestack leaderboard\n";
+  return "";
+}
+
+Ownership table_ownership(const std::string& format) {
+  if (format == "json") return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"});
+  if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1});
+  // md and latex: our marker line, or the header line tables had before the marker.
+  const std::string marker = file_marker(format), what = "dicestack leaderboard (" + format + ")";
+  return {what, [marker = marker.substr(0, marker.size() - 1), format](const std::filesystem::path& p) {
+            std::ifstream in(p, std::ios::binary);
+            std::string first;
+            std::getline(in, first);
+            const std::string old = format == "latex" ? "% dicestack " : "dicestack ";
+            return first == marker || (first.rfind(old, 0) == 0 && first.find(" leaderboard: ") != std::string::npos);
+          }};
+}
+
+Ownership partial_ownership() {
+  return Ownership::json_object("dicestack leaderboard progress file", kPartialFormat, {"meta", "rows"});
+}
+
+std::string render(const std::vector<LeaderboardRow>& rows, const std::string& format, const std::string& header, const json& meta) {
+  std::ostringstream os;
+  const std::vector<std::string> cols{"regressor", "learner", "features", "train error", "test error", "dice in cup",
+                                      "stacked", "wall contact", "realistic success", "fit s", "us/step"};
+  auto cells = [](const LeaderboardRow& r) {
+    return std::vector<std::string>{r.regressor, r.learner, r.features, fixed(r.train_error, 3), fixed(r.test_error, 3),
+                                    fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
+                                    pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
+  };
+  if (format == "json") {
+    json j = meta;
+    j["format"] = kLeaderboardFormat;
+    j["version"] = 1;
+    j["rows"] = json::array();
+    for (const auto& r : rows) j["rows"].push_back(row_json(r));
+    os << j.dump(2) << '\n';
+  } else if (format == "csv") {
+    os << kCsvHeader << '\n';
+    for (const auto& r : rows) {
+      const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
+      os << r.regressor << ',' << r.learner << ',' << r.features << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
+         << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
+         << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
+    }
+  } else if (format == "latex") {
+    os << "% " << header << "\n\\begin{tabular}{lllrrrrrrrr}\n\\hline\n";
+    for (std::size_t c = 0; c < cols.size(); ++c) os << cols[c] << (c + 1 < cols.size() ? " & " : " \\\\\n\\hline\n");
+    for (const auto& r : rows) {
+      const auto v = cells(r);
+      for (std::size_t c = 0; c < v.size(); ++c) {
+        std::string cell = v[c];
+        for (std::size_t p = 0; (p = cell.find_first_of("%_", p)) != std::string::npos; p += 2) cell.insert(p, "\\");
+        os << cell << (c + 1 < v.size() ? " & " : " \\\\\n");
+      }
+    }
+    os << "\\hline\n\\end{tabular}\n";
+  } else {
+    os << header << "\n\n|";
+    for (const auto& c : cols) os << ' ' << c << " |";
+    os << "\n|";
+    for (std::size_t c = 0; c < cols.size(); ++c) os << (c < 3 ? "---|" : "---:|");
+    os << '\n';
+    for (const auto& r : rows) {
+      os << '|';
+      for (const auto& v : cells(r)) os << ' ' << v << " |";
+      os << '\n';
+    }
+  }
+  return os.str();
+}
+
+void check_one_of(const std::string& what, const std::string& value, const std::vector<std::string>& allowed) {
+  if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return;
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  throw ConfigError("leaderboard: " + what + " \"" + value + "\" is not one of " + list);
+}
+
+}  // namespace
+
+Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
+  LeaderboardRequest opt = request;
+  check_one_of("profile", opt.profile, {"quick", "paper"});
+  check_one_of("split", opt.split, {"episodes", "rows"});
+  check_one_of("format", opt.format, {"md", "csv", "latex", "json"});
+  if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
+  if (opt.seeds < 1) throw ConfigError("leaderboard: seeds must be at least 1, got " + std::to_string(opt.seeds));
+  auto report = [&](const std::string& text, double fraction, bool milestone) {
+    if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
+  };
+  auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
+  auto tick = [&](const std::string& text, double fraction) { report(text, fraction, false); };
+  const WorldConfig& world = opt.world;
+  const bool paper = opt.profile == "paper";
+  const int episodes = opt.episodes > 0 ? opt.episodes : (paper ? 100 : 20);
+  const auto& dir = opt.demos;
+  const DemoSet set = read_demo_set(dir);
+  const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
+  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger", "dart"} : opt.learners;
+  // Learner options: the profile's defaults, then --option (for every learner that has the key).
+  auto options_for = [&](const std::string& learner) {
+    std::vector<std::string> out;
+    if (learner == "dagger") out = paper ? std::vector<std::string>{"iterations=5", "rollouts=20"}
+                                         : std::vector<std::string>{"iterations=2", "rollouts=10"};
+    if (learner == "dad" && !paper) out = {"windows=2", "iterations=1", "corrector_iterations=10"};  // paper: its defaults
+    for (const auto& kv : opt.options) {
+      const auto key = kv.substr(0, kv.find('='));
+      for (const auto& p : LearnerRegistry::global().info(learner).params)
+        if (p.name == key) {
+          std::erase_if(out, [&](const std::string& o) { return o.substr(0, o.find('=')) == key; });
+          out.push_back(kv);
+        }
+    }
+    return out;
+  };
+  for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
+  std::vector<std::string> known_baselines = optimiser_names();
+  known_baselines.insert(known_baselines.end(), {"reinforce", "rrt"});
+  if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = known_baselines;
+  for (const auto& b : opt.baselines)
+    if (std::find(known_baselines.begin(), known_baselines.end(), b) == known_baselines.end())
+      throw ConfigError("unknown baseline \"" + b + "\"; expected cmaes, de, basinhop, bayes, reinforce, rrt or all");
+  for (const auto& l : learners)
+    if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
+      throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
+
+  // (learner, feature map) rows: each learner with every map of --features it can read, or with
+  // its own default map.
+  std::vector<std::pair<std::string, std::string>> combos;
+  for (const auto& l : learners) {
+    const LearnerInfo& info = LearnerRegistry::global().info(l);
+    // The paper profile's full picture: every learner with the bare state and with dart's map too.
+    std::vector<std::string> maps{info.default_features};
+    if (paper && info.default_features != "state") maps.insert(maps.begin(), "state");
+    if (paper && info.default_features == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
+    for (const auto& f : opt.features.empty() ? maps : opt.features) {
+      feature_map(f);  // unknown names fail before any work
+      if (info.state_features_only && f != "state") {
+        if (!opt.features.empty()) say("note: " + l + " reads only the state; skipping features " + f, 0.0);
+        continue;
+      }
+      if (opt.split == "rows" && f != "state" && opt.features.empty()) continue;  // a default map that needs episodes
+      if (opt.split == "rows" && f != "state")
+        throw ConfigError("features \"" + f + "\" read an episode's history; --split rows shuffles the rows: use --split episodes");
+      combos.emplace_back(l, f);
+    }
+  }
+
+  // Episode split: learners get the training episodes. Row split (the paper's protocol): they
+  // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
+  const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
+  std::map<std::string, Split> feature_splits;  // the same split seen through each feature map
+  auto split_for = [&](const std::string& f) -> const Split& {
+    if (f == "state") return split;
+    if (!feature_splits.contains(f)) feature_splits.emplace(f, split_by_episode(set.episodes, feature_map(f)));
+    return feature_splits.at(f);
+  };
+  std::vector<Episode> train, held_out;
+  if (opt.split == "rows") {
+    Episode rows;
+    rows.name = "training-rows";
+    for (Eigen::Index i = 0; i < split.train.x.rows(); ++i) {
+      State st;
+      Action a;
+      for (std::size_t j = 0; j < kStateDim; ++j) st[j] = split.train.x(i, static_cast<Eigen::Index>(j));
+      for (std::size_t j = 0; j < kActionDim; ++j) a[j] = split.train.y(i, static_cast<Eigen::Index>(j));
+      rows.states.push_back(st);
+      rows.actions.push_back(a);
+      rows.sources.push_back(StepSource::human);
+    }
+    train.push_back(std::move(rows));
+  } else {
+    for (std::size_t i = 0; i < set.episodes.size(); ++i) (is_test_episode(i) ? held_out : train).push_back(set.episodes[i]);
+  }
+  const auto sigma = column_sigma(split.train.y);
+
+  std::size_t frames = 0;
+  for (const auto& e : set.episodes) frames += e.size();
+  std::ostringstream header;
+  header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << dir.string() << " (" << set.episodes.size()
+         << " episodes, " << frames << " frames); split " << split.description << "; profile " << opt.profile << "; "
+         << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
+         << " training seed(s); rates with 95% Wilson intervals";
+  json learner_options = json::object(), row_features = json::array();
+  for (const auto& l : learners) learner_options[l] = options_for(l);
+  for (const auto& [l, f] : combos) row_features.push_back(l + " " + f);
+  header << "; learner options " << learner_options.dump() << "; features " << row_features.dump();
+  if (!paper && opt.regressors.empty() && std::find(learners.begin(), learners.end(), "dart") != learners.end())
+    header << "; rbf_svr under dart left out of the quick profile (200 s to fit 60,000 rows; name it with "
+              "--regressors or use --profile paper)";
+  if (!opt.baselines.empty())
+    header << "; baselines optimised from the paper's start with the " << opt.profile
+           << " budgets, then played from the same random starts";
+  const json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
+                  {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
+                  {"training_seeds", opt.seeds}, {"seed", opt.seed}};
+
+  // Resume: rows already measured with the same settings are read back.
+  const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
+  json done = json::object();
+  if (!opt.out.empty()) {  // refuse a user's files before any work
+    check_replaceable(opt.out, table_ownership(opt.format));
+    check_replaceable(partial, partial_ownership());
+  }
+  if (!partial.empty() && std::filesystem::exists(partial)) {
+    try {
+      json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
+      // Rows of another version or other settings are not reused.
+      if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) done = p.value("rows", json::object());
+    } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
+    }
+  }
+
+  std::vector<LeaderboardRow> rows;
+  // The quick profile leaves out, unless asked for by name, the one row that alone would take
+  // longer than the rest: a kernel SVR fitted on DART's ~60,000 rows (200 s; its rows are O(n^2)).
+  auto skipped = [&](const std::string& learner, const std::string& regressor) {
+    return !paper && opt.regressors.empty() && learner == "dart" && regressor == "rbf_svr";
+  };
+  const std::size_t total = combos.size() * regressors.size();
+  // Progress in units of rows: one per (learner, map, regressor) and per baseline.
+  const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
+  std::size_t index = 0;
+  for (const auto& [learner_name, features] : combos) {
+    const Split& fsplit = split_for(features);
+    for (const auto& name : regressors) {
+      ++index;
+      if (skipped(learner_name, name)) continue;
+      const std::string key = learner_name + "/" + features + "/" + name;
+      if (done.contains(key)) {
+        rows.push_back(row_from(done[key]));
+        continue;
+      }
+      LeaderboardRow row{name, learner_name, features};
+      for (int s = 0; s < opt.seeds; ++s) {
+        const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(s);
+        const std::string row_text = "[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
+        // Where this row and seed stand: training is the first half of a seed's share, rollouts the second.
+        auto at = [&, s](double part) { return (static_cast<double>(index - 1) + (s + part) / opt.seeds) / units; };
+        say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
+        LearnContext c;
+        c.world = world;
+        c.regressor = name;
+        c.features = features;
+        c.seed = seed;
+        c.threads = opt.threads;
+        c.demos = train;
+        c.held_out = held_out;
+        std::string last_phase;
+        c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
+          const std::string phase = std::to_string(p.iteration) + p.phase;
+          const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
+                                   std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
+          report(text, at(0.5 * p.fraction), phase != last_phase);
+          last_phase = phase;
+        };
+        const auto t0 = std::chrono::steady_clock::now();
+        const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
+        row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
+        row.train_error += scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma) / opt.seeds;
+        if (fsplit.test.rows() == 0)
+          row.test_error = -1;  // no test episode: printed "-"
+        else
+          row.test_error += scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma) / opt.seeds;
+        const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
+        say(rollouts_text, at(0.5));
+        std::shared_ptr<const Model> model = learned.model;
+        const EvalStats st = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed,
+                                      opt.threads, InitialPush::none, nullptr, [&](int finished, int of) {
+                                        tick(rollouts_text, at(0.5 + 0.5 * finished / of));
+                                      });
+        add_outcomes(row, st, opt.seeds);
+      }
+      rows.push_back(row);
+      if (!partial.empty()) {
+        done[key] = row_json(row);
+        AtomicFile f(partial, partial_ownership());
+        f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
+        f.commit();
+      }
+    }
+  }
+  // The baselines without demonstrations (paper V), rolled out from the same random starts.
+  for (std::size_t b = 0; b < opt.baselines.size(); ++b) {
+    const std::string& name = opt.baselines[b];
+    say("baseline " + name, static_cast<double>(total + b) / units);
+    const auto t0 = std::chrono::steady_clock::now();
+    const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
+    LeaderboardRow row{name, "baseline"};
+    row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    row.train_error = row.test_error = -1;
+    for (int s = 0; s < opt.seeds; ++s) {
+      const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads,
+                                    InitialPush::none, nullptr, [&](int finished, int of) {
+                                      const double part = (s + static_cast<double>(finished) / of) / opt.seeds;
+                                      tick("baseline " + name, (static_cast<double>(total + b) + part) / units);
+                                    });
+      add_outcomes(row, st, opt.seeds);
+    }
+    rows.push_back(row);
+  }
+  // Playback of the demonstrations themselves (paper VI-A), for reference.
+  say("playback of the demonstrations", (units - 0.5) / units);
+  const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads);
+  LeaderboardRow playback{"(demonstrations)", "playback"};
+  playback.train_error = playback.test_error = -1;
+  playback.episodes = pb.episodes;
+  playback.stacked = static_cast<int>(std::lround(pb.stacked.value * pb.episodes));
+  playback.walls = static_cast<int>(std::lround(pb.wall_contact.value * pb.episodes));
+  playback.success = static_cast<int>(std::lround(pb.realistic_success.value * pb.episodes));
+  playback.dice_in_cup = pb.dice_in_cup_mean;
+  rows.push_back(playback);
+
+  Leaderboard board;
+  board.rows = std::move(rows);
+  board.header = header.str();
+  board.meta_json = meta.dump();
+  return board;
+}
+
+std::string render_leaderboard(const Leaderboard& board, const std::string& format) {
+  check_one_of("format", format, {"md", "csv", "latex", "json"});
+  return render(board.rows, format, board.header, json::parse(board.meta_json));
+}
+
+std::string leaderboard_row_json(const LeaderboardRow& row) { return row_json(row).dump(); }
+
+void write_leaderboard(const Leaderboard& board, const std::string& format, const std::filesystem::path& out) {
+  const std::string table = render_leaderboard(board, format);
+  AtomicFile f(out, table_ownership(format));
+  f.stream() << file_marker(format) << table;
+  f.commit();
+  const std::filesystem::path partial = out.string() + ".partial.json";
+  if (partial_ownership().recognises(partial)) std::filesystem::remove(partial);
+}
+
+}  // namespace dicestack
