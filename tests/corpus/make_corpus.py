@@ -167,7 +167,7 @@ def demo_cases():
         ("description_not_text", "a description that is a number", with_meta(lambda m: m.update(description=5)),
          "\"description\" must be a string"),
         ("episode_is_folder", "an episode file that is a folder",
-         {**{k: v for k, v in good_set().items() if k != "set/" + ep}, "set/" + ep: None}, ep),
+         {**{k: v for k, v in good_set().items() if k != "set/" + ep}, "set/" + ep + "/README": "a folder, not a file\n"}, ep),
     ]
     for name, why, files, expect in cases:
         write_case("demos", name, why, validate, [expect], files=files)
