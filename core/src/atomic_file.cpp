@@ -113,6 +113,33 @@ fs::path temporary_sibling(const fs::path& target, std::string_view tag) {
                    std::to_string(counter++) + "x" + std::to_string(rng() % 1000000000));
 }
 
+void replace_folder(const fs::path& dir, const std::function<bool(const fs::path&)>& is_ours,
+                    const std::function<void(const fs::path&)>& check, const std::function<void(const fs::path&)>& fill) {
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  std::error_code ec;
+  for (const auto& old : dead_leftovers(dir, "old")) {
+    if (!fs::exists(fs::symlink_status(dir, ec)) && is_ours(old)) fs::rename(old, dir, ec);
+    else if (is_ours(old) || fs::is_empty(old, ec)) fs::remove_all(old, ec);
+  }
+  for (const auto& tmp : dead_leftovers(dir, "tmp"))
+    if (fs::is_directory(fs::symlink_status(tmp, ec))) fs::remove_all(tmp, ec);
+  check(dir);
+  const fs::path tmp = temporary_sibling(dir, "tmp");
+  const fs::path old = temporary_sibling(dir, "old");
+  fs::create_directory(tmp);
+  try {
+    fill(tmp);
+    if (fs::exists(fs::symlink_status(dir, ec))) fs::rename(dir, old);
+    fs::rename(tmp, dir);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
+    throw;
+  }
+  fs::remove_all(old, ec);
+}
+
 std::vector<fs::path> dead_leftovers(const fs::path& target, std::string_view tag) {
   std::vector<fs::path> out;
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");

@@ -224,35 +224,6 @@ bool is_scratch_name(const std::string& name) {
   return false;
 }
 
-// Writes the folder next to its destination, then swaps it in whole. A dead run's scratch
-// folders of `dir` are removed first; if it died between moving the old set aside and moving
-// the new one in, its old set is put back (it is ours, and the only copy).
-void replace_folder(const fs::path& dir, const std::function<void(const fs::path&)>& fill) {
-  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-  fs::create_directories(parent);
-  std::error_code ec;
-  for (const auto& old : dead_leftovers(dir, "old")) {
-    if (!fs::exists(fs::symlink_status(dir, ec)) && is_own_demo_set(old)) fs::rename(old, dir, ec);
-    else if (is_own_demo_set(old) || fs::is_empty(old, ec)) fs::remove_all(old, ec);
-  }
-  for (const auto& tmp : dead_leftovers(dir, "tmp"))
-    if (fs::is_directory(fs::symlink_status(tmp, ec))) fs::remove_all(tmp, ec);
-  check_demo_set_replaceable(dir);
-  const fs::path tmp = temporary_sibling(dir, "tmp");
-  const fs::path old = temporary_sibling(dir, "old");
-  fs::create_directory(tmp);
-  try {
-    fill(tmp);
-    if (fs::exists(dir)) fs::rename(dir, old);
-    fs::rename(tmp, dir);
-  } catch (...) {
-    fs::remove_all(tmp, ec);
-    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
-    throw;
-  }
-  fs::remove_all(old, ec);
-}
-
 }  // namespace
 
 std::vector<std::string> episode_csv_columns(int version) {
@@ -520,7 +491,8 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
     check_episode(set.episodes[i]);
     files.push_back(episode_file_name(i));
   }
-  replace_folder(dir, [&](const fs::path& tmp) {
+  const auto ours = [](const fs::path& p) { return is_own_demo_set(p); };
+  replace_folder(dir, ours, check_demo_set_replaceable, [&](const fs::path& tmp) {
     for (std::size_t i = 0; i < set.episodes.size(); ++i) write_episode_csv(set.episodes[i], tmp / files[i], AtomicFile::Leftovers::skip);
     AtomicFile meta(tmp / "meta.json", meta_ownership());
     meta.stream() << meta_json(set, files).dump(2) << '\n';

@@ -165,29 +165,6 @@ nlohmann::json set_record(const DemoSet& set, const char* format) {
           {"provenance", set.provenance}};
 }
 
-void replace_folder(const std::filesystem::path& dir, const std::function<void(const std::filesystem::path&)>& fill) {
-  namespace fs = std::filesystem;
-  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-  fs::create_directories(parent);
-  std::error_code ec;
-  for (const auto& tmp : dead_leftovers(dir, "tmp")) fs::remove_all(tmp, ec);
-  for (const auto& old : dead_leftovers(dir, "old"))
-    if (!fs::exists(fs::symlink_status(dir, ec))) fs::rename(old, dir, ec);  // a dead run's only copy
-    else fs::remove_all(old, ec);
-  const fs::path tmp = temporary_sibling(dir, "tmp");
-  const fs::path old = temporary_sibling(dir, "old");
-  fs::create_directory(tmp);
-  try {
-    fill(tmp);
-    if (fs::exists(fs::symlink_status(dir, ec))) fs::rename(dir, old);
-    fs::rename(tmp, dir);
-  } catch (...) {
-    fs::remove_all(tmp, ec);
-    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
-    throw;
-  }
-  fs::remove_all(old, ec);
-}
 
 }  // namespace interop
 }  // namespace dicestack

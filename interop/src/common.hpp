@@ -40,9 +40,5 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& where
 /// The "dicestack" object both exports carry: marker, version, the writer's version, description, provenance.
 nlohmann::json set_record(const DemoSet& set, const char* format);
 
-/// Writes a whole folder beside `dir` and renames it into place (a previous `dir`, which the
-/// caller has checked is ours, is moved aside first and removed after). Dead runs' leftovers of
-/// `dir` are removed first.
-void replace_folder(const std::filesystem::path& dir, const std::function<void(const std::filesystem::path&)>& fill);
 
 }  // namespace dicestack::interop

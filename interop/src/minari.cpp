@@ -183,7 +183,11 @@ void export_minari(const DemoSet& set, const fs::path& dir, const std::string& d
                {"minari_version", kMinariVersion},
                {"dataset_size", std::round(static_cast<double>(bytes.size()) / 1e5) / 10.0},  // MB, one decimal
                {"dicestack", record}};
-  interop::replace_folder(dir, [&](const fs::path& tmp) {
+  const auto ours = [](const fs::path& p) {
+    std::string why;
+    return is_own_minari_folder(p, why);
+  };
+  replace_folder(dir, ours, check_minari_replaceable, [&](const fs::path& tmp) {
     fs::create_directory(tmp / "data");
     const Ownership fresh = Ownership::unchecked("file of a fresh folder");
     AtomicFile main(tmp / "data" / kMainFile, fresh, AtomicFile::Leftovers::skip);
