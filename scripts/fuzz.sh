@@ -36,7 +36,7 @@ while [ $# -gt 0 ]; do
     --jobs) [ $# -ge 2 ] || die "--jobs needs a value"; number --jobs "$2"; jobs=$2; shift 2 ;;
     --make-seeds) make_seeds=1; shift ;;
     --build-only) build_only=1; shift ;;
-    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) die "unknown option '$1' (see --help)" ;;
     *) [[ " ${all[*]} " == *" $1 "* ]] || die "unknown target '$1'; targets: ${all[*]}"; targets+=("$1"); shift ;;
   esac

@@ -16,13 +16,19 @@
 
 namespace dicestack::opencv {
 
-/// Runs fn, rethrowing OpenCV's errors as InputError("<who>: OpenCV: ...").
+/// Runs fn, rethrowing OpenCV's errors as InputError("<who>: OpenCV: ..."). OpenCV also lets
+/// standard exceptions out (its YAML parser throws std::length_error on an empty key in a
+/// nested map); those become InputError too. Our own errors pass through unchanged.
 template <class F>
 auto guarded(const std::string& who, F&& fn) {
   try {
     return fn();
+  } catch (const Error&) {
+    throw;
   } catch (const cv::Exception& e) {
     throw InputError(who + ": OpenCV: " + e.err + " (in " + e.func + ")");
+  } catch (const std::exception& e) {
+    throw InputError(who + ": OpenCV failed: " + e.what());
   }
 }
 

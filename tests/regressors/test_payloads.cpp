@@ -88,6 +88,10 @@ TEST(Payloads, RbfSvrModelsAreCheckedBeforeOpenCvReadsThem) {
   EXPECT_THAT(error(0, "rho", "      rho: 1e39"), HasSubstr("rbf_svr: model 0: rho and gamma must be finite"));
   EXPECT_THAT(load_error("rbf_svr", edit_svm(good, 1, [](std::string& y) { y = "<?xml version=\"1.0\"?><opencv_storage/>"; }), 4, 2),
               HasSubstr("rbf_svr: model 1 is not OpenCV YAML"));
+  // Found by fuzz/: OpenCV 4.6's YAML parser throws std::length_error (not cv::Exception) on an
+  // empty key inside a nested map; it escaped as a non-dicestack exception.
+  EXPECT_THAT(load_error("rbf_svr", edit_svm(good, 0, [](std::string& y) { y = "%YAML:1.0\nk:\n t: 1\n :\n"; }), 4, 2),
+              HasSubstr("rbf_svr: model 0: OpenCV failed: "));
 }
 
 // The matrix payload layout of knn, linear_svr, mlp and random_forest (regressors/src/payload.hpp).
