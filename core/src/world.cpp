@@ -554,6 +554,10 @@ WorldSnapshot World::snapshot() const {
     data->contacts.push_back({fixture_id(c->GetFixtureA()), fixture_id(c->GetFixtureB()), c->GetChildIndexA(),
                               c->GetChildIndexB(), get<detail::ContactFlags>(*c), *c->GetManifold(),
                               get<detail::ContactToiCount>(*c), get<detail::ContactToi>(*c)});
+    // Box2D sets a manifold's type only when the shapes touch: with no points it is whatever the
+    // contact's memory held before (never read by Box2D). Store a fixed value, never that byte.
+    b2Manifold& m = data->contacts.back().manifold;
+    if (m.pointCount == 0) m.type = b2Manifold::e_circles;
   }
   b2World& w = *sc.world;
   data->inv_dt0 = get<detail::WorldInvDt0>(w);

@@ -31,9 +31,11 @@ sleep 0.5
 xdotool key p
 sleep 0.5
 xdotool key Escape
-wait "$play_pid"
+play_status=0
+wait "$play_pid" || play_status=$?
 play_pid=""
 cat "$work/out.txt"
+[ "$play_status" -eq 0 ] || { echo "FAIL: dicestack play exited with status $play_status"; exit 1; }
 
 "$exe" dataset validate "$work/rec"
 csv="$work/rec/episode_0000.csv"
