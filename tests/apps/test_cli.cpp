@@ -307,6 +307,8 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
           videos + " --video-format gif");
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(run("dataset info " + rollouts.string()).output, HasSubstr("episodes 2"));
+  EXPECT_THAT(run("dataset info " + rollouts.string()).output,
+              HasSubstr("final state, rewards and end flags (format v2): 2 of 2 episodes"));
   // One video per rollout, named as the saved episodes are.
   EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0000.gif"), 1000u);
   EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0001.gif"), 1000u);
