@@ -49,8 +49,9 @@ int run_info(const DatasetOptions& opt) {
   const DemoSet set = read_demo_set(opt.dir);
   const Dataset all = make_dataset(set.episodes);
   std::map<std::string, std::size_t> sources;
-  std::size_t stacked = 0, success = 0, walls = 0, in_cup = 0, shortest = SIZE_MAX, longest = 0;
+  std::size_t stacked = 0, success = 0, walls = 0, in_cup = 0, shortest = SIZE_MAX, longest = 0, transitions = 0;
   for (const auto& e : set.episodes) {
+    transitions += e.has_transitions();
     stacked += e.outcome.stacked;
     success += e.outcome.realistic_success();
     walls += e.outcome.wall_contact;
@@ -75,6 +76,7 @@ int run_info(const DatasetOptions& opt) {
                               {"wall_contact", walls},
                               {"dice_in_cup_mean", in_cup / n},
                               {"sources", sources},
+                              {"with_transitions", transitions},
                               {"columns", columns},
                               {"description", set.description}}
                    .dump());
@@ -91,6 +93,8 @@ int run_info(const DatasetOptions& opt) {
   std::string src = "  sources:";
   for (const auto& [name, count] : sources) src += " " + name + " " + std::to_string(count);
   print_line(src);
+  print_line("  final state, rewards and end flags (format v2): " + std::to_string(transitions) + " of " +
+             std::to_string(set.episodes.size()) + " episodes");
   print_line("  column            min          max");
   const auto names = episode_csv_columns();
   for (Eigen::Index j = 0; j < all.x.cols() + all.y.cols(); ++j) {

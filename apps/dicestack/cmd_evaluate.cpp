@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <optional>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/report.hpp>
@@ -29,6 +30,8 @@ int run_evaluate(const EvaluateOptions& opt) {
   const WorldConfig world = opt.world.load();
   auto model = std::make_shared<const Model>(load_model(opt.model));
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
+  if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))
+    throw InputError(opt.video_dir.string() + ": --video-dir exists and is not a folder");
   const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
   std::vector<Episode> rollouts;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,

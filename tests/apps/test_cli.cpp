@@ -307,10 +307,17 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
           videos + " --video-format gif");
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(run("dataset info " + rollouts.string()).output, HasSubstr("episodes 2"));
+  EXPECT_THAT(run("dataset info " + rollouts.string()).output,
+              HasSubstr("final state, rewards and end flags (format v2): 2 of 2 episodes"));
   // One video per rollout, named as the saved episodes are.
   EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0000.gif"), 1000u);
   EXPECT_GT(std::filesystem::file_size(std::filesystem::path(videos) / "episode_0001.gif"), 1000u);
   std::filesystem::remove_all(videos);
+  { std::ofstream(videos) << "a file"; }
+  p = run("evaluate --model " + model.string() + " --episodes 1 --video-dir " + videos);
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("--video-dir exists and is not a folder"));
+  std::filesystem::remove(videos);
   std::filesystem::remove_all(rollouts);
   std::filesystem::create_directories(rollouts);
   { std::ofstream(rollouts / "notes.txt") << "mine"; }
