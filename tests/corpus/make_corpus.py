@@ -3,7 +3,7 @@
 that says how to run dicestack on it and what the error must say (tests/apps/test_corpus.cpp
 runs them all). The folders are committed; rerun this only to add or change cases:
 
-    /usr/bin/python3 tests/corpus/make_corpus.py build/apps/dicestack
+    /usr/bin/python3 tests/corpus/make_corpus.py build/apps/dicestack [KIND ...]
 
 It needs a built dicestack to fit the small models the model cases edit. Cases already in the
 corpus that this script does not make (the hand-made demonstration sets under demos/) are kept;
@@ -410,6 +410,110 @@ def checkpoint_cases():
         write_case("checkpoints", name, why, resume, [expect], files=files)
 
 
+# --- robomimic and Minari HDF5 -------------------------------------------------------------
+
+def interop_cases():
+    """Exports of a 2-episode, 10-step set, edited with h5py (HDF5 paths must be named)."""
+    import h5py
+    import numpy as np
+
+    world = default_world()
+    world["episode"]["max_steps"] = 10
+    scratch = tempfile.TemporaryDirectory()
+    tmp = scratch.name
+    with open(os.path.join(tmp, "world.json"), "w") as f:
+        json.dump(world, f)
+    run = lambda *a: subprocess.run([EXE, *a], check=True, capture_output=True)
+    run("record", "--expert", "scripted", "--episodes", "2", "--seed", "0", "--world", os.path.join(tmp, "world.json"),
+        "--out", os.path.join(tmp, "set"))
+    run("dataset", "export", os.path.join(tmp, "set"), "--format", "robomimic", "--out", os.path.join(tmp, "d.hdf5"))
+    run("dataset", "export", os.path.join(tmp, "set"), "--format", "minari", "--out", os.path.join(tmp, "mn"))
+    robomimic = read(os.path.join(tmp, "d.hdf5"), "rb")
+    minari_h5 = read(os.path.join(tmp, "mn", "data", "main_data.hdf5"), "rb")
+    minari_meta = read(os.path.join(tmp, "mn", "data", "metadata.json"))
+
+    def edited_h5(original, edit):
+        path = os.path.join(tmp, "edit.hdf5")
+        with open(path, "wb") as f:
+            f.write(original)
+        with h5py.File(path, "r+") as h:
+            edit(h)
+        # h5py leaves freed space behind; repack so the case stays small.
+        packed = os.path.join(tmp, "packed.hdf5")
+        with h5py.File(path, "r") as src, h5py.File(packed, "w") as dst:
+            for k, v in src.attrs.items():
+                dst.attrs[k] = v
+            for k in src:
+                src.copy(src[k], dst, name=k)
+        return read(packed, "rb")
+
+    def replace(h, path, data):
+        del h[path]
+        h[path] = data
+
+    def scaled(h, path, f):
+        replace(h, path, f(h[path][()]))
+
+    rm_run = "import robomimic {case}/d.hdf5 --out {case}/out"
+    rm_cases = [
+        ("not_hdf5", "a text file named .hdf5", b"not an HDF5 file\n", "not an HDF5 file"),
+        ("truncated", "the first half of an export", robomimic[: len(robomimic) // 2], "d.hdf5"),
+        ("no_data", "no data group", lambda h: h.__delitem__("data"), "data"),
+        ("no_env_args", "data lacks env_args", lambda h: h["data"].attrs.__delitem__("env_args"), "env_args"),
+        ("env_args_not_json", "env_args that is not JSON", lambda h: h["data"].attrs.__setitem__("env_args", "{"), "env_args"),
+        ("other_env", "env_args of another environment",
+         lambda h: h["data"].attrs.__setitem__("env_args", json.dumps({**json.loads(h["data"].attrs["env_args"]), "env_name": "Lift"})), "env_name"),
+        ("bad_world", "env_kwargs holding an impossible world",
+         lambda h: h["data"].attrs.__setitem__("env_args", json.dumps(
+             {**json.loads(h["data"].attrs["env_args"]),
+              "env_kwargs": {**json.loads(h["data"].attrs["env_args"])["env_kwargs"],
+                             "world": {**world, "physics": {**world["physics"], "gravity": [0.0, -1e30]}}}})), "gravity"),
+        ("stray_group", "a group that is not demo_<n>", lambda h: h["data"].create_group("notes"), "data/notes"),
+        ("no_actions", "a demo without actions", lambda h: h.__delitem__("data/demo_0/actions"), "data/demo_0/actions"),
+        ("actions_width", "actions of 2 columns", lambda h: scaled(h, "data/demo_0/actions", lambda a: a[:, :2]), "data/demo_0/actions"),
+        ("actions_nan", "a NaN action", lambda h: scaled(h, "data/demo_1/actions", lambda a: np.where(np.arange(a.size).reshape(a.shape) == 4, np.nan, a)),
+         "data/demo_1/actions"),
+        ("actions_outside", "an action of 3 (actions lie in [-1, 1])", lambda h: scaled(h, "data/demo_0/actions", lambda a: a * 0 + 3), "outside [-1, 1]"),
+        ("actions_text", "actions stored as strings", lambda h: replace(h, "data/demo_0/actions", np.array([b"x"] * 10)), "data/demo_0/actions"),
+        ("states_short", "states one row short", lambda h: scaled(h, "data/demo_0/states", lambda a: a[:-1]), "data/demo_0/states"),
+        ("num_samples_wrong", "num_samples disagreeing with actions", lambda h: h["data/demo_0"].attrs.__setitem__("num_samples", 99), "num_samples"),
+        ("obs_disagrees", "an observation that is not the state", lambda h: scaled(h, "data/demo_0/obs/cup_pose", lambda a: a + 1), "data/demo_0/obs/cup_pose"),
+        ("no_next_obs", "a missing next_obs key", lambda h: h.__delitem__("data/demo_1/next_obs/die2_vel"), "data/demo_1/next_obs/die2_vel"),
+        ("dones_two", "a done flag of 2", lambda h: scaled(h, "data/demo_0/dones", lambda a: a * 0 + 2), "data/demo_0/dones"),
+        ("total_wrong", "data/total disagreeing with the demos", lambda h: h["data"].attrs.__setitem__("total", 7), "total"),
+        ("newer_version", "a dicestack record of version 9",
+         lambda h: h["data"].attrs.__setitem__("dicestack", json.dumps({**json.loads(h["data"].attrs["dicestack"]), "version": 9})), "version 9"),
+        ("sources_bad", "per-step sources that do not add up",
+         lambda h: h["data/demo_0"].attrs.__setitem__("dicestack_sources", "expert:3"), "dicestack_sources"),
+    ]
+    for name, why, edit, expect in rm_cases:
+        content = edit if isinstance(edit, bytes) else edited_h5(robomimic, edit)
+        write_case("interop", "robomimic_" + name, why, rm_run, [expect], files={"d.hdf5": content})
+
+    mn_run = "import minari {case}/mn --out {case}/out"
+    mn_files = lambda h5=minari_h5, meta=minari_meta: {"mn/data/main_data.hdf5": h5, "mn/data/metadata.json": meta}
+    meta = json.loads(minari_meta)
+    mn_cases = [
+        ("no_metadata", "main_data.hdf5 without metadata.json", {"mn/data/main_data.hdf5": minari_h5}, "metadata.json"),
+        ("metadata_not_json", "metadata.json that is not JSON", mn_files(meta="{"), "metadata.json"),
+        ("not_hdf5_storage", "a dataset stored as arrow", mn_files(meta=json.dumps({**meta, "data_format": "arrow"})), "data_format"),
+        ("no_main_data", "metadata.json without main_data.hdf5", {"mn/data/metadata.json": minari_meta}, "main_data.hdf5"),
+        ("episodes_counted_wrong", "total_episodes of 3 for 2 episodes", mn_files(meta=json.dumps({**meta, "total_episodes": 3})), "total_episodes"),
+        ("gap", "episodes numbered 0 and 2", mn_files(h5=edited_h5(minari_h5, lambda h: h.move("episode_1", "episode_2"))), "episode_1"),
+        ("observations_short", "T observations instead of T + 1",
+         mn_files(h5=edited_h5(minari_h5, lambda h: scaled(h, "episode_0/observations", lambda a: a[:-1]))), "episode_0/observations"),
+        ("rewards_nan", "a NaN reward",
+         mn_files(h5=edited_h5(minari_h5, lambda h: scaled(h, "episode_1/rewards", lambda a: a * np.nan))), "episode_1/rewards"),
+        ("flags_two", "a termination flag of 2",
+         mn_files(h5=edited_h5(minari_h5, lambda h: scaled(h, "episode_0/terminations", lambda a: a.astype(np.int64) * 0 + 2))), "episode_0/terminations"),
+        ("action_too_big", "an action beyond the world's limit",
+         mn_files(h5=edited_h5(minari_h5, lambda h: scaled(h, "episode_0/actions", lambda a: a * 0 + 1e6))), "action.limit"),
+    ]
+    for name, why, files, expect in mn_cases:
+        write_case("interop", "minari_" + name, why, mn_run, [expect], files=files)
+    scratch.cleanup()
+
+
 # --- plugins and command-line values -------------------------------------------------------
 
 def plugin_and_argument_cases():
@@ -440,11 +544,13 @@ def plugin_and_argument_cases():
 
 if __name__ == "__main__":
     if not EXE:
-        sys.exit("usage: make_corpus.py PATH/TO/dicestack")
-    demo_cases()
-    world_cases()
-    model_cases()
-    checkpoint_cases()
-    plugin_and_argument_cases()
+        sys.exit("usage: make_corpus.py PATH/TO/dicestack [demos|worlds|models|checkpoints|interop|plugins ...]")
+    makers = {"demos": demo_cases, "worlds": world_cases, "models": model_cases, "checkpoints": checkpoint_cases,
+              "interop": interop_cases, "plugins": plugin_and_argument_cases}
+    chosen = sys.argv[2:] or list(makers)
+    for kind in chosen:
+        if kind not in makers:
+            sys.exit(f"make_corpus: unknown kind {kind!r} (one of {', '.join(makers)})")
+        makers[kind]()
     count = sum(1 for c in os.listdir(HERE) if os.path.isdir(os.path.join(HERE, c)) for _ in os.listdir(os.path.join(HERE, c)))
     print(f"make_corpus: {count} cases")
