@@ -12,6 +12,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/judge.hpp>
 #include <dicestack/core/world.hpp>
+#include <dicestack/datasets/replay.hpp>
 
 namespace dicestack {
 namespace {
@@ -102,14 +103,7 @@ void check_start_pose(const fs::path& file, const std::vector<double>& r, const 
 }
 
 Outcome judge_recording(const std::vector<State>& states, const State& last, const WorldConfig& world) {
-  Outcome o;
-  World probe(world);
-  for (const State& s : states) {
-    probe.set_state(s);
-    observe(o, s, probe.touching_walls(), world);
-  }
-  probe.set_state(last);
-  observe(o, last, probe.touching_walls(), world);
+  Outcome o = judge_states(states, last, world);
   if (!o.stacked) {
     // Recordings stop while a finished stack may still wobble: let it settle, cup held still.
     const Settled settled = settle(last, world);
@@ -117,7 +111,6 @@ Outcome judge_recording(const std::vector<State>& states, const State& last, con
     o.stacked_steps = settled.stacked ? 1 : 0;
     o.wall_contact = o.wall_contact || settled.wall_contact;
   }
-  o.steps = static_cast<int>(states.size());
   return o;
 }
 

@@ -5,6 +5,7 @@
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/world.hpp>
 
 namespace dicestack {
 
@@ -40,6 +41,19 @@ std::vector<std::string> recover_transitions(std::vector<Episode>& episodes, con
   for (auto& e : episodes)
     if (!recover_transitions(e, world, tolerance)) missing.push_back(e.name);
   return missing;
+}
+
+Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world) {
+  Outcome o;
+  World probe(world);
+  for (const State& s : states) {
+    probe.set_state(s);
+    observe(o, s, probe.touching_walls(), world);
+  }
+  probe.set_state(final_state);
+  observe(o, final_state, probe.touching_walls(), world);
+  o.steps = static_cast<int>(states.size());
+  return o;
 }
 
 }  // namespace dicestack

@@ -1,11 +1,12 @@
 #include "common.hpp"
 
 #include <charconv>
+#include <cstdio>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
-#include <dicestack/core/world.hpp>
+#include <dicestack/datasets/replay.hpp>
 #include <dicestack/interop/interop.hpp>
 #include <dicestack/version.hpp>
 
@@ -133,19 +134,33 @@ Outcome outcome_from_json(const nlohmann::json& j, const std::string& where) {
   return o;
 }
 
-Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world) {
-  Outcome o;
-  World probe(world);
-  for (const State& s : states) {
-    probe.set_state(s);
-    observe(o, s, probe.touching_walls(), world);
+void read_episode_record(hid_t group, const std::string& where, std::size_t index, const char* seed_attr,
+                         const std::string& default_origin, const WorldConfig& world, Episode& e) {
+  char fallback[32];
+  std::snprintf(fallback, sizeof fallback, "episode_%04zu", index);
+  e.name = h5::read_attr_string(group, "dicestack_name", where).value_or(fallback);
+  e.seed = h5::read_attr_u64(group, seed_attr, where).value_or(0);
+  e.origin = h5::read_attr_string(group, "dicestack_origin", where).value_or(default_origin);
+  const std::size_t steps = e.states.size();
+  const auto sources = h5::read_attr_string(group, "dicestack_sources", where);
+  e.sources = sources ? sources_from_text(*sources, steps, where + " attribute dicestack_sources")
+                      : std::vector<StepSource>(steps, StepSource::policy);
+  if (const auto outcome = h5::read_attr_string(group, "dicestack_outcome", where)) {
+    const std::string what = where + " attribute dicestack_outcome";
+    e.outcome = outcome_from_json(parse_json_text(*outcome, what), what);
+  } else {
+    e.outcome = judge_states(e.states, *e.final_state, world);
+    e.outcome.stacked_steps = e.outcome.stacked ? 1 : 0;  // as outcome_from_json and meta.json
+    e.outcome.dice_in_cup_now = e.outcome.dice_in_cup;
   }
-  probe.set_state(final_state);
-  observe(o, final_state, probe.touching_walls(), world);
-  o.steps = static_cast<int>(states.size());
-  o.stacked_steps = o.stacked ? 1 : 0;
-  o.dice_in_cup_now = o.dice_in_cup;
-  return o;
+}
+
+void check_read_episode(const Episode& e, const std::string& where) {
+  try {
+    check_episode(e);
+  } catch (const InputError& err) {
+    throw InputError(where + ": " + err.what());
+  }
 }
 
 nlohmann::json parse_json_text(const std::string& text, const std::string& where) {

@@ -30,9 +30,15 @@ std::vector<StepSource> sources_from_text(const std::string& text, std::size_t s
 nlohmann::json outcome_json(const Outcome& outcome);
 Outcome outcome_from_json(const nlohmann::json& j, const std::string& where);
 
-/// The judge run over an episode's states and its final state (no settling), for files that do
-/// not carry our outcome.
-Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world);
+/// The attributes both exports write on an episode's group (dicestack_name, the seed under
+/// `seed_attr`, dicestack_origin, dicestack_sources, dicestack_outcome) into `e`, whose states
+/// and final state are already read. Files of other tools lack them: episode_<index>, seed 0,
+/// `default_origin`, every step "policy", and the judge over the states (as meta.json is read).
+void read_episode_record(hid_t group, const std::string& where, std::size_t index, const char* seed_attr,
+                         const std::string& default_origin, const WorldConfig& world, Episode& e);
+
+/// check_episode, its message prefixed with `where` (the episode's path in the file).
+void check_read_episode(const Episode& e, const std::string& where);
 
 /// Parses JSON text from a file attribute, naming `where` if it is not JSON.
 nlohmann::json parse_json_text(const std::string& text, const std::string& where);

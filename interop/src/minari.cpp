@@ -283,23 +283,8 @@ DemoSet import_minari(const fs::path& dir, const WorldConfig& fallback_world) {
     e.rewards = rewards.values;
     e.terminated = terminations.back() != 0.0;
     e.truncated = truncations.back() != 0.0;
-    char fallback[32];
-    std::snprintf(fallback, sizeof fallback, "episode_%04zu", i);
-    e.name = h5::read_attr_string(g.get(), "dicestack_name", where).value_or(fallback);
-    e.seed = h5::read_attr_u64(g.get(), "seed", where).value_or(0);
-    e.origin = h5::read_attr_string(g.get(), "dicestack_origin", where).value_or("minari " + dir.string() + " " + name);
-    const auto sources = h5::read_attr_string(g.get(), "dicestack_sources", where);
-    e.sources = sources ? sources_from_text(*sources, steps, where + " attribute dicestack_sources")
-                        : std::vector<StepSource>(steps, StepSource::policy);
-    const auto outcome = h5::read_attr_string(g.get(), "dicestack_outcome", where);
-    e.outcome = outcome ? outcome_from_json(parse_json_text(*outcome, where + " attribute dicestack_outcome"),
-                                            where + " attribute dicestack_outcome")
-                        : judge_states(e.states, final_state, set.world);
-    try {
-      check_episode(e);
-    } catch (const InputError& err) {
-      throw InputError(where + ": " + err.what());
-    }
+    read_episode_record(g.get(), where, i, "seed", "minari " + dir.string() + " " + name, set.world, e);
+    check_read_episode(e, where);
     set.episodes.push_back(std::move(e));
   }
   if (steps_seen != total_steps)

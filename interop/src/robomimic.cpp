@@ -235,28 +235,12 @@ DemoSet import_robomimic(const fs::path& file) {
         e.actions[t][k] = a;
       }
 
-    const auto name = h5::read_attr_string(demo.get(), "dicestack_name", where);
-    char fallback[32];
-    std::snprintf(fallback, sizeof fallback, "episode_%04zu", i);
-    e.name = name ? *name : fallback;
-    e.seed = h5::read_attr_u64(demo.get(), "dicestack_seed", where).value_or(0);
-    e.origin = h5::read_attr_string(demo.get(), "dicestack_origin", where).value_or("robomimic " + F + " " + demos[i].second);
-    const auto sources = h5::read_attr_string(demo.get(), "dicestack_sources", where);
-    e.sources = sources ? sources_from_text(*sources, steps, where + " attribute dicestack_sources")
-                        : std::vector<StepSource>(steps, StepSource::policy);
-    const auto outcome = h5::read_attr_string(demo.get(), "dicestack_outcome", where);
-    e.outcome = outcome ? outcome_from_json(parse_json_text(*outcome, where + " attribute dicestack_outcome"),
-                                            where + " attribute dicestack_outcome")
-                        : judge_states(e.states, final_state, set.world);
+    read_episode_record(demo.get(), where, i, "dicestack_seed", "robomimic " + F + " " + demos[i].second, set.world, e);
     const auto terminated = h5::read_attr_int(demo.get(), "dicestack_terminated", where);
     const auto truncated = h5::read_attr_int(demo.get(), "dicestack_truncated", where);
     e.terminated = terminated ? *terminated != 0 : e.outcome.realistic_success();
     e.truncated = truncated ? *truncated != 0 : !e.terminated;
-    try {
-      check_episode(e);
-    } catch (const InputError& err) {
-      throw InputError(where + ": " + err.what());
-    }
+    check_read_episode(e, where);
     set.episodes.push_back(std::move(e));
   }
   if (const auto t = h5::read_attr_int(data.get(), "total", F + ": data"); t && *t != total)

@@ -1,9 +1,11 @@
 #pragma once
 // Recovering what demonstration format v1 did not store (the final state, the rewards and how an
-// episode ended) by replaying an episode in dicestack's deterministic world.
+// episode ended) by replaying an episode in dicestack's deterministic world, and judging
+// recorded states that came without our outcome.
 #include <string>
 #include <vector>
 
+#include <dicestack/core/judge.hpp>
 #include <dicestack/core/world_config.hpp>
 #include <dicestack/datasets/episode.hpp>
 
@@ -26,5 +28,10 @@ bool recover_transitions(Episode& episode, const WorldConfig& world, double tole
 /// recover_transitions for every episode; returns the names of those still without transitions.
 std::vector<std::string> recover_transitions(std::vector<Episode>& episodes, const WorldConfig& world,
                                              double tolerance = kReplayTolerance);
+
+/// The outcome judge over recorded states and the state after the last action, each placed in
+/// `world` (no simulation, no settling): for recordings and files that do not carry our outcome.
+/// steps is states.size().
+Outcome judge_states(const std::vector<State>& states, const State& final_state, const WorldConfig& world);
 
 }  // namespace dicestack
