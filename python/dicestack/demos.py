@@ -17,7 +17,10 @@ class Episode:
     """One demonstration: T states (before each action) and the T actions taken in them.
 
     `sources` says who chose each action (human, expert, policy or correction; default: policy);
-    the outcome fields are what the judge saw over the whole episode.
+    the outcome fields are what the judge saw over the whole episode. Format v2's transitions:
+    `final_state` (the state after the last action, shape (24,)), `rewards` (T) and the end flags
+    `terminated` / `truncated`; `final_state` and `rewards` are None where unknown (a format-v1
+    set whose final state could not be recovered by replay).
     """
 
     states: np.ndarray
@@ -32,10 +35,18 @@ class Episode:
     stacked: bool = False
     stacked_steps: int = 0
     wall_contact: bool = False
+    final_state: np.ndarray = None
+    rewards: np.ndarray = None
+    terminated: bool = False
+    truncated: bool = False
 
     def __post_init__(self):
         self.states = np.asarray(self.states, dtype=np.float64)
         self.actions = np.asarray(self.actions, dtype=np.float64)
+        if self.final_state is not None:
+            self.final_state = np.asarray(self.final_state, dtype=np.float64)
+        if self.rewards is not None:
+            self.rewards = np.asarray(self.rewards, dtype=np.float64)
         if self.sources is None:
             self.sources = ["policy"] * len(self.states)
 
@@ -53,6 +64,14 @@ class Episode:
         kinds = set(self.sources)
         return kinds.pop() if len(kinds) == 1 else "mixed"
 
+    @property
+    def observations(self):
+        """The T + 1 states (Minari's `observations`: `states` then `final_state`), or None
+        when the final state is unknown."""
+        if self.final_state is None:
+            return None
+        return np.vstack([self.states, self.final_state[None, :]])
+
     def _as_record(self):
         return {
             "name": self.name,
@@ -67,6 +86,10 @@ class Episode:
             "stacked": bool(self.stacked),
             "stacked_steps": int(self.stacked_steps),
             "wall_contact": bool(self.wall_contact),
+            "final_state": self.final_state,
+            "rewards": self.rewards,
+            "terminated": bool(self.terminated),
+            "truncated": bool(self.truncated),
         }
 
     @classmethod

@@ -29,6 +29,10 @@ py::dict episode_dict(const Episode& e) {
   d["stacked"] = e.outcome.stacked;
   d["stacked_steps"] = e.outcome.stacked_steps;
   d["wall_contact"] = e.outcome.wall_contact;
+  d["final_state"] = e.final_state ? py::object(to_array(*e.final_state)) : py::object(py::none());
+  d["rewards"] = e.final_state ? py::object(to_array(e.rewards)) : py::object(py::none());
+  d["terminated"] = e.terminated;
+  d["truncated"] = e.truncated;
   return d;
 }
 
@@ -47,6 +51,16 @@ Episode episode_from(const py::handle& obj) {
   e.outcome.stacked = d["stacked"].cast<bool>();
   e.outcome.stacked_steps = d["stacked_steps"].cast<int>();
   e.outcome.wall_contact = d["wall_contact"].cast<bool>();
+  // Format v2's additions: all or nothing (an episode without a final state has no rewards).
+  const auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
+  if (given("final_state") != given("rewards"))
+    throw py::value_error("episode " + e.name + ": final_state and rewards go together (both None, or both given)");
+  if (given("final_state")) {
+    e.final_state = state_from(d["final_state"], "episode final_state");
+    e.rewards = vector_from(d["rewards"], e.states.size(), "episode rewards");
+  }
+  e.terminated = d.contains("terminated") && d["terminated"].cast<bool>();
+  e.truncated = d.contains("truncated") && d["truncated"].cast<bool>();
   check_episode(e);
   return e;
 }

@@ -14,6 +14,10 @@ def test_builtin_set_shapes(builtin_episodes):
         assert len(e.sources) == len(e) and e.source == "expert"
         assert e.realistic_success and e.dice_in_cup == 3
         assert isinstance(e.seed, int)
+        # Format v2: the state after the last action, a reward per step, the end flags.
+        assert e.final_state.shape == (24,) and e.rewards.shape == (len(e),)
+        assert e.observations.shape == (len(e) + 1, 24)
+        assert e.terminated and not e.truncated
     assert builtin_episodes[0].name == "episode_0000"
 
 
@@ -28,6 +32,9 @@ def test_save_and_load_round_trip(tmp_path, builtin_episodes):
         np.testing.assert_array_equal(a.actions, b.actions)
         assert a.sources == b.sources and a.seed == b.seed
         assert (a.stacked, a.wall_contact, a.dice_in_cup) == (b.stacked, b.wall_contact, b.dice_in_cup)
+        np.testing.assert_array_equal(a.final_state, b.final_state)
+        np.testing.assert_array_equal(a.rewards, b.rewards)
+        assert (a.terminated, a.truncated) == (b.terminated, b.truncated)
     dicestack.save_demos(back[:1], folder)  # our own set may be replaced
     assert len(dicestack.load_demos(folder)) == 1
 
@@ -45,6 +52,35 @@ def test_episodes_made_in_python_save(tmp_path, rng):
     (back,) = dicestack.load_demos(tmp_path / "mine")
     assert back.source == "policy" and back.seed == 3
     np.testing.assert_array_equal(back.states, np.array(states))
+
+
+def test_transitions_match_the_environment(builtin_episodes):
+    """The stored final state and rewards are what stepping the world with the actions gives."""
+    e = builtin_episodes[0]
+    env = dicestack.DiceStackEnv()
+    obs, _ = env.reset(seed=e.seed)
+    np.testing.assert_array_equal(obs, e.states[0])
+    rewards = []
+    for t, action in enumerate(e.actions):
+        obs, reward, terminated, truncated, _ = env.step(action)
+        rewards.append(reward)
+    np.testing.assert_array_equal(obs, e.final_state)
+    np.testing.assert_array_equal(np.array(rewards), e.rewards)
+    assert (terminated, truncated) == (e.terminated, e.truncated)
+
+
+def test_transitions_are_all_or_nothing(tmp_path, builtin_episodes):
+    e = builtin_episodes[0]
+    no_final = dicestack.Episode(e.states, e.actions, seed=e.seed, rewards=e.rewards)
+    with pytest.raises(ValueError, match="final_state and rewards go together"):
+        dicestack.save_demos([no_final], tmp_path / "a")
+    short = dicestack.Episode(e.states, e.actions, final_state=e.final_state, rewards=e.rewards[:-1])
+    with pytest.raises(ValueError, match="rewards"):
+        dicestack.save_demos([short], tmp_path / "b")
+    without = dicestack.Episode(e.states, e.actions, seed=e.seed)
+    dicestack.save_demos([without], tmp_path / "c")
+    (back,) = dicestack.load_demos(tmp_path / "c")
+    assert back.final_state is None and back.rewards is None and back.observations is None
 
 
 def test_a_users_folder_is_never_replaced(tmp_path, builtin_episodes):
