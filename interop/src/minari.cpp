@@ -122,6 +122,21 @@ std::vector<double> end_flags(hid_t group, const char* name, const std::string& 
   return a.values;
 }
 
+// Gymnasium's EnvSpec.to_json of the environment `import dicestack` registers, with this world:
+// minari's recover_environment() makes it with gymnasium.make. Fields that differ between
+// Gymnasium versions (order_enforce, autoreset, apply_api_compatibility) are left to defaults.
+json env_spec(const WorldConfig& world) {
+  return {{"id", kGymEnvId},
+          {"entry_point", "dicestack.env:DiceStackEnv"},
+          {"reward_threshold", nullptr},
+          {"nondeterministic", false},
+          {"max_episode_steps", nullptr},  // the environment truncates at the world's episode.max_steps itself
+          {"disable_env_checker", false},
+          {"kwargs", {{"world", json::parse(to_json(world))}}},
+          {"additional_wrappers", json::array()},
+          {"vector_entry_point", "dicestack.vector_env:DiceStackVectorEnv"}};
+}
+
 }  // namespace
 
 std::string default_minari_dataset_id(const fs::path& set_dir) {
@@ -182,6 +197,7 @@ void export_minari(const DemoSet& set, const fs::path& dir, const std::string& d
                {"description", set.description},
                {"minari_version", kMinariVersion},
                {"dataset_size", std::round(static_cast<double>(bytes.size()) / 1e5) / 10.0},  // MB, one decimal
+               {"env_spec", env_spec(set.world).dump()},
                {"dicestack", record}};
   const auto ours = [](const fs::path& p) {
     std::string why;

@@ -106,6 +106,10 @@ def test_minari_layout(minari_dir, recorded):
     assert np.isinf(obs_space["high"][2])
     act_space = json.loads(m["action_space"])
     assert act_space["shape"] == [3] and act_space["high"] == [20.0, 20.0, 10.0]
+    # Gymnasium's EnvSpec.to_json, which minari's recover_environment() makes with gymnasium.make.
+    spec = json.loads(m["env_spec"])
+    assert spec["id"] == "dicestack/DiceStack-v0" and spec["entry_point"] == "dicestack.env:DiceStackEnv"
+    assert spec["kwargs"]["world"] == meta["world"] and spec["additional_wrappers"] == []
     with h5py.File(minari_dir / "data" / "main_data.hdf5", "r") as f:
         assert sorted(f.keys(), key=lambda k: int(k[8:])) == [f"episode_{i}" for i in range(7)]
         for i in range(7):

@@ -106,3 +106,26 @@ def test_bad_episodes_and_folders(tmp_path):
         dicestack.load_demos(tmp_path / "empty")
     with pytest.raises(TypeError):
         dicestack.save_demos([{"states": []}], tmp_path / "d")
+
+
+def test_a_minari_export_recovers_its_environment(tmp_path, cli, builtin_episodes):
+    """What minari's recover_environment() does with the export's env_spec (gymnasium.make of
+    the spec: entry point and kwargs) gives an environment that replays the stored episode."""
+    import importlib
+    import json
+    import subprocess
+
+    h5py = pytest.importorskip("h5py")
+    dicestack.save_demos(builtin_episodes[:2], tmp_path / "set")
+    subprocess.run([cli, "dataset", "export", str(tmp_path / "set"), "--format", "minari", "--out", str(tmp_path / "mn")],
+                   check=True, capture_output=True)
+    spec = json.loads(json.loads((tmp_path / "mn" / "data" / "metadata.json").read_text())["env_spec"])
+    assert spec["id"] == dicestack.ENV_ID and spec["additional_wrappers"] == []
+    module, name = spec["entry_point"].split(":")
+    env = getattr(importlib.import_module(module), name)(**spec["kwargs"])
+    with h5py.File(tmp_path / "mn" / "data" / "main_data.hdf5", "r") as f:
+        observations, actions = f["episode_1/observations"][()], f["episode_1/actions"][()]
+    obs, _ = env.reset(options={"state": observations[0]})
+    for a in actions:
+        obs, *_ = env.step(a)
+    np.testing.assert_array_equal(obs, observations[-1])
