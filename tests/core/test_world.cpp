@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/world.hpp>
 

@@ -8,7 +8,7 @@
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/metrics.hpp>
-#include <dicestack/datasets/standardizer.hpp>
+#include <dicestack/core/standardizer.hpp>
 
 namespace dicestack {
 namespace {

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/regressors/model.hpp>
 

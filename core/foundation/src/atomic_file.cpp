@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/json_depth.hpp>
-#include <dicestack/core/types.hpp>
 
 namespace dicestack {
 namespace {

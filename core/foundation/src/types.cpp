@@ -44,15 +44,6 @@ Action to_action(std::span<const double> values, std::string_view what) {
   return to_array<kActionDim>(values, what, "an action");
 }
 
-std::uint64_t fnv1a(std::string_view bytes, std::uint64_t seed) {
-  for (unsigned char c : bytes) seed = (seed ^ c) * 0x100000001b3ULL;
-  return seed;
-}
-
-std::uint64_t hash_state(const State& state, std::uint64_t seed) {
-  return fnv1a({reinterpret_cast<const char*>(state.data()), sizeof(State)}, seed);
-}
-
 void require_finite(std::span<const double> values, std::string_view what) {
   for (std::size_t i = 0; i < values.size(); ++i)
     if (!std::isfinite(values[i]))

@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/types.hpp>
 
 namespace dicestack::detail {

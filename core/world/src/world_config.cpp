@@ -1,3 +1,4 @@
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/world_config.hpp>
 
 #include <cmath>

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/registry_lookup.hpp>
 #include <dicestack/regressors/regressor.hpp>
 #include <dicestack/version.hpp>
 
@@ -47,27 +48,6 @@ template <class T>
 RegressorInfo regressor_info(std::string name, std::string description) {
   return {std::move(name), std::move(description), T::schema(), "",
           [](std::string n, Params p) -> std::unique_ptr<Regressor> { return std::make_unique<T>(std::move(n), std::move(p)); }};
-}
-
-/// The names in a registry's map, in order.
-template <class Map>
-std::vector<std::string> registered_names(const Map& entries) {
-  std::vector<std::string> out;
-  for (const auto& entry : entries) out.push_back(entry.first);
-  return out;
-}
-
-/// A registry's entry by name; throws ConfigError naming the `kind` ("regressor", "learner"),
-/// the unknown name and every registered one. Shared by the regressor and learner registries.
-template <class Map>
-const typename Map::mapped_type& registered_entry(const Map& entries, std::string_view name, std::string_view kind) {
-  const auto it = entries.find(name);
-  if (it == entries.end()) {
-    std::string list;
-    for (const auto& n : registered_names(entries)) list += (list.empty() ? "" : ", ") + n;
-    throw ConfigError("unknown " + std::string(kind) + " \"" + std::string(name) + "\"; registered: " + list);
-  }
-  return it->second;
 }
 
 class RegressorRegistry {

@@ -41,12 +41,6 @@ State to_state(std::span<const double> values, std::string_view what);
 /// An Action from `values`; throws InputError naming `what` if there are not 3 finite values.
 Action to_action(std::span<const double> values, std::string_view what);
 
-/// FNV-1a over `bytes`, chained from `seed`: fingerprints of runs, payloads and configs.
-std::uint64_t fnv1a(std::string_view bytes, std::uint64_t seed = 0xcbf29ce484222325ULL);
-
-/// FNV-1a over the bytes of `state`, chained from `seed`: a bit-exact fingerprint of a run.
-std::uint64_t hash_state(const State& state, std::uint64_t seed = 0xcbf29ce484222325ULL);
-
 /// Throws InputError naming `what` and the first index that is NaN or infinite.
 void require_finite(std::span<const double> values, std::string_view what);
 

@@ -1,4 +1,4 @@
-#include <dicestack/datasets/standardizer.hpp>
+#include <dicestack/core/standardizer.hpp>
 
 #include <cmath>
 
