@@ -20,4 +20,15 @@ void register_builtin_regressors(RegressorRegistry& registry) {
   register_rbf_svr(registry);
 }
 
+// Here rather than beside the registry (dicestack::regressor_api): the global registry holds
+// the built-ins, and the interface a plugin links must not pull them in.
+RegressorRegistry& RegressorRegistry::global() {
+  static RegressorRegistry* registry = [] {
+    auto* r = new RegressorRegistry;  // never destroyed: plugin code may run during exit
+    register_builtin_regressors(*r);
+    return r;
+  }();
+  return *registry;
+}
+
 }  // namespace dicestack

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/core/matrix.hpp>
 #include <dicestack/regressors/params.hpp>
 
 namespace dicestack {

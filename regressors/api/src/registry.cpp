@@ -10,15 +10,6 @@
 
 namespace dicestack {
 
-RegressorRegistry& RegressorRegistry::global() {
-  static RegressorRegistry* registry = [] {
-    auto* r = new RegressorRegistry;  // never destroyed: plugin code may run during exit
-    register_builtin_regressors(*r);
-    return r;
-  }();
-  return *registry;
-}
-
 void RegressorRegistry::add(RegressorInfo info) { add(std::move(info), registering_source_); }
 
 void RegressorRegistry::add(RegressorInfo info, std::string source) {
@@ -47,7 +38,7 @@ void RegressorRegistry::load_plugin(const std::filesystem::path& library) {
   if (std::find(loaded_.begin(), loaded_.end(), canonical) != loaded_.end()) return;
   if (!std::filesystem::exists(library)) throw PluginError(who + ": no such file");
   // RTLD_LOCAL keeps plugins apart; they share our libraries (one registry) through their
-  // own dependency on libdicestack_regressors. Handles stay open: registered factories live there.
+  // own dependency on libdicestack_regressor_api. Handles stay open: registered factories live there.
   void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw PluginError(who + ": cannot load: " + dlerror());
   using Entry = const DicestackPluginV1* (*)();

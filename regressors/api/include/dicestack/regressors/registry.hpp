@@ -3,6 +3,12 @@
 // registered on first use; plugins add theirs from shared libraries (`--plugin LIB`, or the
 // DICESTACK_PLUGIN_PATH variable) after an ABI handshake. A plugin author writes one class and
 // one DICESTACK_REGISTER_REGRESSOR line (docs/plugins.md).
+//
+// This header, regressor.hpp and params.hpp are the regressor interface, target
+// dicestack::regressor_api: all a plugin links (with the foundation), so that loading a plugin
+// loads no simulator, optimiser or OpenCV. The built-ins, Model and model files are
+// dicestack::regressors, which also defines RegressorRegistry::global() and
+// register_builtin_regressors(): a program that calls them links dicestack::regressors.
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -53,6 +59,7 @@ RegressorInfo regressor_info(std::string name, std::string description) {
 class RegressorRegistry {
  public:
   /// The process-wide registry (the one global in dicestack), with the built-ins registered.
+  /// Defined in dicestack::regressors (with the built-ins); plugins never call it.
   static RegressorRegistry& global();
 
   /// Adds a regressor. Throws ConfigError if the name is taken, naming both sources:
@@ -87,7 +94,8 @@ class RegressorRegistry {
   std::string registering_source_ = "built-in";
 };
 
-/// Registers the six built-ins; called once by RegressorRegistry::global().
+/// Registers the six built-ins; called once by RegressorRegistry::global(). Defined in
+/// dicestack::regressors (builtin_regressors.cpp).
 void register_builtin_regressors(RegressorRegistry& registry);
 
 }  // namespace dicestack
