@@ -3,7 +3,7 @@
 // (contact flags, the broad-phase tree, the previous step's inverse time step, body sweeps).
 // Box2D 2.4 has no snapshot API; this uses the standard rule that explicit template
 // instantiation may name private members. Include from exactly one translation unit
-// (world.cpp): each instantiation must appear once in the program.
+// (snapshot.cpp): each instantiation must appear once in the program.
 #include <box2d/box2d.h>
 
 namespace dicestack::detail {

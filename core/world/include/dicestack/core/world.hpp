@@ -36,7 +36,7 @@ class WorldSnapshot {
   /// Throws InputError naming what is wrong.
   static WorldSnapshot from_bytes(std::string_view bytes);
 
-  struct Data;  ///< Box2D-level contents, private to core/src
+  struct Data;  ///< Box2D-level contents, private to core/world/src/snapshot.cpp
 
  private:
   friend class World;
@@ -107,10 +107,5 @@ class World {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-/// Runs `episodes` episodes of `steps` control steps with random actions on a bare Box2D loop
-/// (the same bodies, no framework around it) and returns the seconds taken. The benchmark's
-/// baseline for the framework's own overhead (issue: bench sim).
-double bare_box2d_seconds(const WorldConfig& config, int episodes, int steps, std::uint64_t seed);
 
 }  // namespace dicestack
