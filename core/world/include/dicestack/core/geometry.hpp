@@ -3,6 +3,7 @@
 // physics, the outcome judge and the renderer so that all three agree on one geometry.
 #include <array>
 
+#include <dicestack/core/vec2.hpp>
 #include <dicestack/core/world_config.hpp>
 
 namespace dicestack {

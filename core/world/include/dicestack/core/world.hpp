@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <dicestack/core/types.hpp>
+#include <dicestack/core/vec2.hpp>
 #include <dicestack/core/world_config.hpp>
 
 namespace dicestack {

@@ -9,13 +9,9 @@
 #include <string_view>
 
 #include <dicestack/core/types.hpp>
+#include <dicestack/core/vec2.hpp>
 
 namespace dicestack {
-
-struct Vec2 {
-  double x = 0.0;
-  double y = 0.0;
-};
 
 /// The enclosure: four static rounded segments (floor, left, right, ceiling).
 struct WallsConfig {
