@@ -1,6 +1,7 @@
 #pragma once
 // Drawing a state to an image a person can read: walls, cup, dice (numbered by their pips),
-// time and the judge's outcome. OpenCV stays behind this header.
+// time and the judge's outcome; and a trajectory's plot over time. OpenCV stays behind this
+// header (video.hpp writes whole trajectories to video, GIF or PNG files).
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -37,6 +38,11 @@ Image render_state(const State& state, const WorldConfig& config, const Hud& hud
 /// Same, into `image`, reusing its memory (no allocation once sized): for per-frame drawing.
 void render_state_into(Image& image, const State& state, const WorldConfig& config, const Hud& hud,
                        const RenderOptions& options = {});
+
+/// The paper's Fig. 2 for `states` (one per control step): stacked panels of the cup's x, the
+/// dice's x and y, the cup's angle and its velocities over time, under `title`. 1000 px wide.
+/// Requires at least one state.
+Image render_plot(const std::vector<State>& states, const WorldConfig& config, const std::string& title);
 
 /// Writes a PNG atomically. Throws InputError if it cannot be written.
 void write_png(const Image& image, const std::filesystem::path& path);

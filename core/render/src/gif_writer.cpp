@@ -7,7 +7,7 @@
 
 #include <dicestack/core/error.hpp>
 
-namespace dicestack::cli {
+namespace dicestack {
 namespace {
 
 constexpr int kR = 6, kG = 7, kB = 6;  // 252 colours
@@ -74,4 +74,4 @@ void GifWriter::close() {
   if (EGifCloseFile(gif, &error) != GIF_OK) throw InputError(path_.string() + ": closing the GIF failed (" + GifErrorString(error) + ")");
 }
 
-}  // namespace dicestack::cli
+}  // namespace dicestack

@@ -1,12 +1,13 @@
 #pragma once
-// Animated GIF output for `dicestack render` (giflib: OpenCV 4.6 writes no GIF).
+// Animated GIF output for write_frames (giflib: OpenCV 4.6 writes no GIF). Private to core/render:
+// giflib stays behind it.
 #include <filesystem>
 
 #include <dicestack/core/render.hpp>
 
 struct GifFileType;
 
-namespace dicestack::cli {
+namespace dicestack {
 
 /// Writes frames of one size into a looping GIF. Colours map to a fixed 6 x 7 x 6 cube: the
 /// renders are flat colours, and a fixed palette keeps frames independent and the output
@@ -31,4 +32,4 @@ class GifWriter {
   int width_, height_;
 };
 
-}  // namespace dicestack::cli
+}  // namespace dicestack

@@ -1,6 +1,6 @@
 // Frames of a trajectory to a video, a GIF, a PNG or a folder of PNGs: `dicestack render` and
 // `dicestack evaluate --video-dir` draw with it.
-#include "video.hpp"
+#include <dicestack/core/video.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -14,7 +14,7 @@
 
 #include "gif_writer.hpp"
 
-namespace dicestack::cli {
+namespace dicestack {
 
 namespace fs = std::filesystem;
 
@@ -74,4 +74,4 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
   fs::rename(tmp, out);
 }
 
-}  // namespace dicestack::cli
+}  // namespace dicestack

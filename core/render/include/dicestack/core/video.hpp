@@ -1,5 +1,6 @@
 #pragma once
-// Drawing a trajectory to a file (the apps' shared video writer).
+// Drawing a trajectory to a file: `dicestack render` and `dicestack evaluate --video-dir` call it.
+// OpenCV (video) and giflib (GIF) stay behind this header.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -7,7 +8,7 @@
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/world_config.hpp>
 
-namespace dicestack::cli {
+namespace dicestack {
 
 /// Draws `states` (one frame each, with the judge's running outcome and `title`) to `out`:
 /// FILE.mp4 or FILE.avi (OpenCV), FILE.gif (giflib), FILE.png (the last frame) or, without an
@@ -16,4 +17,4 @@ namespace dicestack::cli {
 void write_frames(const std::vector<State>& states, const WorldConfig& world, const std::string& title,
                   const std::filesystem::path& out);
 
-}  // namespace dicestack::cli
+}  // namespace dicestack
