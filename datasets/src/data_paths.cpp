@@ -1,4 +1,4 @@
-#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/data_paths.hpp>
 
 #include <cstdio>
 #include <cstdlib>
