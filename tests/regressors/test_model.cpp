@@ -19,7 +19,7 @@
 #include <dicestack/core/rng.hpp>
 #include <dicestack/regressors/model.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

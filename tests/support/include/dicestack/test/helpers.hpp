@@ -1,5 +1,6 @@
 #pragma once
-// Small helpers shared by the core tests.
+// Small helpers shared by the test suites of every folder: target dicestack_test_support
+// (tests/CMakeLists.txt), which every suite links.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -7,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/matrix.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/world_config.hpp>
@@ -22,6 +24,14 @@ inline std::vector<Action> random_actions(const WorldConfig& c, std::uint64_t se
   for (auto& a : out)
     for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng.uniform(-1.0, 1.0) * c.action.scale[k];
   return out;
+}
+
+/// An n x d matrix of values uniform in [-1, 1), from `seed`.
+inline Matrix random_matrix(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
+  Rng rng(seed);
+  Matrix m(n, d);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = rng.uniform(-1.0, 1.0);
+  return m;
 }
 
 /// What a callable throws, as text; empty if it does not throw.
