@@ -8,6 +8,10 @@
 // right with its mouth aimed at a point below the table's centre (the humans' mouse-aim at the
 // bottom of the screen), so the walls scoop the dice up and press them into a column against
 // one side, then stops, and the column slides down onto the table. See docs/expert.md.
+//
+// Target dicestack::experts (core/experts/: this header, the experts and the swing plan). Where a
+// Policy is expected (rollouts, DAgger, DART), an expert is wrapped in ExpertPolicy
+// (learners/policy.hpp); docs/architecture.md says why the adapter lives there.
 #include <cstdint>
 #include <memory>
 #include <string>
