@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/regressors/model.hpp>

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/bare_box2d.hpp>
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>

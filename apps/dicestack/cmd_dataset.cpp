@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
-#include <dicestack/datasets/builtin.hpp>
 #include <dicestack/datasets/cupdice_import.hpp>
+#include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 

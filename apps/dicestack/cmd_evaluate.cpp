@@ -4,13 +4,13 @@
 #include <optional>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/video.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/report.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
-#include "video.hpp"
 
 namespace dicestack::cli {
 namespace {

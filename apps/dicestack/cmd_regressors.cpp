@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/atomic_file.hpp>
-#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/learner.hpp>

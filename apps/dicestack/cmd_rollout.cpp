@@ -7,6 +7,7 @@
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/render.hpp>
 

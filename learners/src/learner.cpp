@@ -3,6 +3,7 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/registry_lookup.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 

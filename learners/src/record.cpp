@@ -7,7 +7,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
-#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/policy.hpp>
 

@@ -3,7 +3,7 @@
 #include <chrono>
 
 #include <dicestack/core/error.hpp>
-#include <dicestack/datasets/builtin.hpp>
+#include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/record.hpp>

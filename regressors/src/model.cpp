@@ -1,3 +1,4 @@
+#include <dicestack/core/hash.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include <cmath>

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <dicestack/core/error.hpp>
-#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/core/matrix.hpp>
 
 namespace dicestack::payload {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/matrix.hpp>
 #include <dicestack/core/rng.hpp>
-#include <dicestack/datasets/dataset.hpp>
 
 namespace dicestack::forest {
 

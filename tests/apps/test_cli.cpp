@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/version.hpp>
 
 namespace dicestack {

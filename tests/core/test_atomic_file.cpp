@@ -9,7 +9,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -8,7 +8,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -8,7 +8,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/rng.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

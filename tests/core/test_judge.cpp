@@ -5,7 +5,7 @@
 
 #include <dicestack/core/judge.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

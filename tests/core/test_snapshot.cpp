@@ -5,7 +5,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/world.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

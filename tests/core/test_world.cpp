@@ -4,10 +4,11 @@
 #include <cmath>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/world.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

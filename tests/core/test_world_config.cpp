@@ -6,7 +6,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/world_config.hpp>
 
-#include "helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -12,7 +12,7 @@
 #include <dicestack/core/world.hpp>
 #include <dicestack/datasets/cupdice_import.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -9,7 +9,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

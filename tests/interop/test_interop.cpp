@@ -16,7 +16,7 @@
 #include <dicestack/interop/interop.hpp>
 #include <dicestack/learners/record.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

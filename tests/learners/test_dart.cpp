@@ -12,7 +12,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -16,7 +16,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/core/expert.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -12,7 +12,7 @@
 #include <dicestack/regressors/model.hpp>
 #include <dicestack/regressors/registry.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -15,10 +15,11 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/regressors/model.hpp>
 
-#include "../core/helpers.hpp"
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {

@@ -5,15 +5,11 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
+#include <dicestack/core/matrix.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/datasets/features.hpp>
 
 namespace dicestack {
-
-/// Row-major so that one row is a contiguous span (predict_row's input).
-using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// Stacked (state, action) pairs of some episodes.
 struct Dataset {

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/standardizer.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/datasets/features.hpp>
-#include <dicestack/datasets/standardizer.hpp>
 #include <dicestack/regressors/registry.hpp>
 
 namespace dicestack {

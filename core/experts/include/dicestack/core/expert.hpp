@@ -1,0 +1,108 @@
+#pragma once
+// Automatic experts: controllers that stack the dice the realistic way (paper III-C, no wall)
+// from any state, to generate demonstrations and to answer DAgger's queries (issue 4).
+//
+// Both experts drive the cup the way the human recordings do (data/cupdice: every one of the
+// 17,603 legacy frames and all three final ones keep the cup mouth-down): the cup hovers
+// mouth-down a few centimetres above the table with the dice caged under it, swings left and
+// right with its mouth aimed at a point below the table's centre (the humans' mouse-aim at the
+// bottom of the screen), so the walls scoop the dice up and press them into a column against
+// one side, then stops, and the column slides down onto the table. See docs/expert.md.
+//
+// Target dicestack::experts (core/experts/: this header, the experts and the swing plan). Where a
+// Policy is expected (rollouts, DAgger, DART), an expert is wrapped in ExpertPolicy
+// (learners/policy.hpp); docs/architecture.md says why the adapter lives there.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/core/env.hpp>
+
+namespace dicestack {
+
+/// One swing plan: a reference trajectory for the cup that a feedback controller tracks.
+/// Defaults are the tuned nominal plan (docs/expert.md); distances are metres, times control steps.
+struct SwingParams {
+  double first_direction = 1.0;   ///< sign of the first swing: +1 right, -1 left
+  double amplitude = 2.203;       ///< swing extremes sit this far from the swing centre, m (clamped off the walls)
+  double half_period = 23.422;    ///< duration of one left-to-right swing, steps (the first is 0.6 of it; rounded)
+  int half_swings = 6;            ///< number of swings before the stop, >= 0
+  double pivot_depth = 2.857;     ///< the mouth aims at a point this far below the cup's centre of mass, m
+  double clearance = 0.003;       ///< gap between the cup's lowest point and the table, m
+  double centre_offset = -0.157;  ///< swing centre relative to the dice' mean x, m
+  double stop_offset = -0.407;    ///< where the cup stops, relative to the swing centre, m
+  double stop_speed = 3.122;      ///< the last swing reaches the stop point at this speed and halts in one step, m/s
+  double final_duration = 27.731; ///< duration of the last swing, steps (rounded: the stop falls on a control step)
+  double end_tilt = -0.138;       ///< tilt from mouth-down the cup turns to after the stop, rad
+  double tilt_time = 4.520;       ///< time constant of that turn, steps
+  double settle_steps = 30.0;     ///< after the stop, the cup holds still this long while the column lands, steps
+  double release_steps = 20.0;    ///< then it centres itself over the dice and turns upright, steps
+  double lift_speed = 1.0;        ///< then it rises straight up at this speed, m/s (as the humans did)
+  double lift_height = 1.2;       ///< until it is this much higher than it hovered, m
+};
+
+/// Settings of every expert; make_expert() reads the fields its expert uses.
+struct ExpertConfig {
+  SwingParams swing;              ///< the nominal plan ("scripted" follows it, "mpc" searches around it)
+  double gain = 10.0;             ///< feedback gain of the cup's pose tracking, 1/s
+  double wall_margin = 0.10;      ///< the plan keeps the cup this far from the side walls, m
+  int search_budget = 64;         ///< "mpc": most plans simulated when it has no plan for this episode, >= 1
+  int replan_budget = 16;         ///< "mpc": most plans simulated when a state leaves its prediction, >= 1
+  /// "mpc": off its predicted trajectory, re-check and re-search the plan at most once per this
+  /// many steps and follow the current plan's feedback in between (cheap DAgger labels), >= 1.
+  int replan_interval = 10;
+  /// "mpc": false chooses the plan once, at the episode's first step, and only tracks it after:
+  /// its actions are then a function of the start, the step and the state (DART's labels).
+  bool replan = true;
+  double search_spread = 0.03;    ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
+};
+
+/// A policy that may use the simulator. act() works from any state of an episode, not only
+/// along its own trajectory: an expert re-derives where it is from the environment it is given.
+class Expert {
+ public:
+  virtual ~Expert() = default;
+
+  /// Starts a new episode; `seed` seeds every random choice the expert makes.
+  void reset(std::uint64_t seed);
+
+  /// The action (dvx, dvy, dw) for env's current state, within config.action.limit.
+  /// Throws InputError if the environment's state is not finite.
+  Action act(const DiceEnv& env);
+
+  /// The name make_expert() knows it by.
+  virtual std::string name() const = 0;
+
+ private:
+  virtual void do_reset(std::uint64_t seed) = 0;
+  virtual Action do_act(const DiceEnv& env) = 0;
+};
+
+/// Names make_expert() accepts, with a one-line description each.
+struct ExpertInfo {
+  std::string name;
+  std::string description;
+};
+std::vector<ExpertInfo> expert_list();
+
+/// Creates an expert by its command-line name: "scripted" (the swing plan, fixed parameters,
+/// feedback only) or "mpc" (searches swing plans in the simulator from the current state and
+/// replans when the world leaves its prediction). An "mpc" expert simulates with the WorldConfig
+/// of the first environment it is given; use one expert per world. Throws ConfigError for an
+/// unknown name or a bad config field.
+std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config = {});
+
+/// What one expert episode did.
+struct ExpertEpisode {
+  Outcome outcome;
+  std::vector<State> states;    ///< the state before each action (filled if requested)
+  std::vector<Action> actions;  ///< the actions taken (filled if requested)
+};
+
+/// Runs `expert` in `env` from env's current state until termination or the time limit.
+/// The caller starts the episode: env.reset(seed) (or reset_to) and expert.reset(seed).
+ExpertEpisode run_expert_episode(Expert& expert, DiceEnv& env, bool keep_trajectory = false);
+
+}  // namespace dicestack

@@ -1,0 +1,112 @@
+#pragma once
+// The Box2D scene of the dice-stacking task and one control step of it. Box2D types never leave
+// core/: everything here is SI and our own types (STYLE 9).
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/vec2.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// An exact copy of a World's dynamic state: the 24 observed numbers and what Box2D carries
+/// between steps (contact manifolds with their warm-starting impulses, the broad-phase tree,
+/// solver bookkeeping). Restoring it continues bit-for-bit like the run it was taken from.
+/// Cheap to copy (shared, immutable); valid for Worlds built from the same WorldConfig.
+class WorldSnapshot {
+ public:
+  WorldSnapshot();
+  ~WorldSnapshot();
+  WorldSnapshot(const WorldSnapshot&);
+  WorldSnapshot& operator=(const WorldSnapshot&);
+
+  /// The observed state when the snapshot was taken.
+  const State& state() const;
+  /// False for a default-constructed snapshot.
+  bool valid() const { return data_ != nullptr; }
+
+  /// The snapshot as a self-checking byte record (marker, version, checksum), for pickles and
+  /// files. Like the snapshot itself it is only meaningful for a World built from the same
+  /// config (callers store the config's hash beside it) and the same dicestack build.
+  /// Throws InputError for an empty snapshot.
+  std::string to_bytes() const;
+  /// Reads to_bytes()'s record, checking marker, version, checksum, sizes and every index.
+  /// Throws InputError naming what is wrong.
+  static WorldSnapshot from_bytes(std::string_view bytes);
+
+  struct Data;  ///< Box2D-level contents, private to core/world/src/snapshot.cpp
+
+ private:
+  friend class World;
+  std::shared_ptr<const Data> data_;
+};
+
+/// Which solid a shape belongs to, for drawing and for the outcome judge.
+enum class ShapeKind { floor, left_wall, right_wall, ceiling, cup, die };
+
+/// One shape in world coordinates: a convex polygon, rounded by `radius`, in metres.
+struct ShapeOutline {
+  ShapeKind kind = ShapeKind::floor;
+  int index = 0;  ///< segment index for the cup (0 left, 1 base, 2 right), die index for dice
+  std::vector<Vec2> points;
+  double radius = 0.0;
+};
+
+/// The physical world: walls, the three-segment cup and three octagonal dice (DESIGN table).
+/// Deterministic: the same state and actions give bit-identical results.
+class World {
+ public:
+  /// Builds the scene at the paper's start. Throws ConfigError if `config` is invalid.
+  explicit World(const WorldConfig& config);
+  /// Builds the scene at `state` (see set_state).
+  World(const WorldConfig& config, const State& state);
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const WorldConfig& config() const;
+
+  /// The 24 observed numbers (SI, cup at its centre of mass).
+  State state() const;
+
+  /// Rebuilds the scene at a bare 24-number state. Contacts start without warm-starting
+  /// impulses, so the continuation can differ slightly from a run that reached this state by
+  /// itself (measured in docs/world.md). state() afterwards returns `state` exactly.
+  /// Throws InputError if a value is not finite.
+  void set_state(const State& state);
+
+  /// An exact snapshot of the current state; see WorldSnapshot.
+  WorldSnapshot snapshot() const;
+
+  /// Restores a snapshot taken from a World with the same config; continues bit-for-bit.
+  /// Throws InputError if the snapshot is empty.
+  void restore(const WorldSnapshot& snapshot);
+
+  /// One control step: adds `dv` (m/s, m/s, rad/s) to the cup's velocity, then runs the
+  /// configured substeps. Returns true if the cup or a die touched a side wall or the ceiling
+  /// during the step. Throws InputError if `dv` is not finite. Does not clip.
+  bool step(const Action& dv);
+
+  /// Every shape, in world coordinates, for drawing.
+  std::vector<ShapeOutline> outlines() const;
+
+  /// True if any two shapes (cup, dice, walls) overlap by more than `tolerance` metres. Used on
+  /// probe worlds to reject random initial states: it builds the contacts without moving
+  /// anything, which a run that continues from here would do in its first step anyway.
+  bool has_overlaps(double tolerance = 0.005);
+
+  /// True if the cup or a die is within judge.wall_contact_distance of a side wall or the
+  /// ceiling now. Like has_overlaps, for probe worlds (e.g. judging recorded states).
+  bool touching_walls();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dicestack

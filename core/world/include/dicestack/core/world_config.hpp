@@ -1,0 +1,145 @@
+#pragma once
+// Every constant of the dice-stacking world, with the paper's values as defaults (DESIGN "The
+// world", paper III). SI units throughout; 1 m is 100 px of the original 900 x 700 px window.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <string_view>
+
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/vec2.hpp>
+
+namespace dicestack {
+
+/// The enclosure: four static rounded segments (floor, left, right, ceiling).
+struct WallsConfig {
+  double floor_y = 0.60;    ///< floor centre line, m; the table surface is floor_y + radius = 1.00
+  double left_x = 0.05;     ///< left wall centre line, m
+  double right_x = 8.95;    ///< right wall centre line, m
+  double ceiling_y = 6.95;  ///< ceiling centre line, m
+  double radius = 0.40;     ///< segment radius, m, > 0
+  double friction = 1.0;    ///< Coulomb coefficient, >= 0 (paper eq. 3)
+};
+
+/// The cup: three rounded segments on one rigid body, mouth up at angle 0 (paper III).
+struct CupConfig {
+  double base_width = 1.00;    ///< base segment length, m
+  double wall_height = 2.20;   ///< vertical rise of each side wall, m
+  double flare = 0.20;         ///< outward offset of each wall's top (the cup's outward tilt), m
+  double radius = 0.05;        ///< segment radius, m
+  double segment_mass = 5.0;   ///< kg per segment
+  double friction = 0.4;       ///< paper eq. 4
+  Vec2 start_anchor{4.00, 1.90};          ///< left end of the base before the start rotation, m
+  double start_angle = std::numbers::pi;  ///< rotation about the centre of mass at the start
+};
+
+/// The three dice: octagons, squares with cut corners (paper III).
+struct DiceConfig {
+  double half_size = 0.20;   ///< half the side of the square, m
+  double corner_cut = 0.05;  ///< length cut off each corner along both sides, m, < half_size
+  double mass = 1.0;         ///< kg (the original's value; the paper's text says 10 g)
+  double friction = 0.6;     ///< paper eq. 2
+  std::array<double, kDiceCount> start_x{4.08, 4.51, 4.93};  ///< m
+  double start_y = 1.25;     ///< m; the dice start 5 cm above the table and drop
+};
+
+/// Integration and simulation settings.
+struct PhysicsConfig {
+  Vec2 gravity{0.0, -4.0};        ///< m/s^2 (paper eq. 1)
+  double control_dt = 1.0 / 30.0; ///< one control step (one action), s
+  int substeps = 5;               ///< physics steps per control step
+  int velocity_iterations = 10;   ///< solver iterations per substep (paper III)
+  int position_iterations = 3;    ///< Box2D's position correction passes per substep
+  bool allow_sleep = false;       ///< let resting bodies sleep (faster; see docs/world.md)
+  double units_per_metre = 10.0;  ///< internal Box2D length scale; keeps its 0.01-unit skin at 1 mm
+  double action_noise = 0.0;      ///< std of Gaussian noise added to each action, as a fraction of
+                                  ///< ActionConfig::scale; 0 is deterministic (paper III non-determinism)
+};
+
+/// Action scaling and limits.
+struct ActionConfig {
+  /// What x = 1 means for optimisers working on [-1, 1]^3 (paper V-B: 100, 10, 0.5 px units).
+  std::array<double, kActionDim> scale{1.0, 0.1, 0.5};
+  /// Largest |dv| the environment accepts per step; larger actions are clipped (m/s, m/s, rad/s).
+  /// Human recordings reach 17 m/s with the stopping mechanic.
+  std::array<double, kActionDim> limit{20.0, 20.0, 10.0};
+};
+
+/// Randomised initial states for reset(seed). All zero gives the paper's start.
+struct RandomizationConfig {
+  double shift = 0.5;        ///< the whole scene (cup and dice) shifts by U(-shift, shift) in x, m
+  double die_jitter = 0.01;  ///< each die moves by U(-j, j) in x, m
+  double cup_lift = 0.2;     ///< the cup starts U(0, lift) higher, m
+  double cup_tilt = 0.05;    ///< the cup's start angle changes by U(-tilt, tilt), rad
+  bool die_quarter_turns = true;  ///< each die starts rotated by a random multiple of 90 degrees
+};
+
+/// Tolerances of the outcome judge (DESIGN "Outcome judge").
+struct JudgeConfig {
+  double column_tolerance = 0.10;  ///< max |x| offset between a die and the one below it, m
+  double gap_tolerance = 0.04;     ///< max deviation of centre spacing from one die side, m
+  double angle_tolerance = 0.15;   ///< max deviation of a die from a multiple of 90 degrees, rad
+  double rest_speed = 0.05;        ///< max die speed at rest, m/s
+  double rest_angular_speed = 0.2; ///< max die angular speed at rest, rad/s
+  double wall_contact_distance = 0.002;  ///< a gap at most this wide counts as touching, m
+  int success_hold_steps = 5;      ///< a realistic success must hold this many control steps
+};
+
+/// Episode limits.
+struct EpisodeConfig {
+  int max_steps = 400;  ///< time limit in control steps (truncated after it)
+};
+
+/// The optimisers' cost (paper eq. 6) and the environment's reward.
+struct CostConfig {
+  double gamma = 0.1;    ///< discount in [0, 1]; weight of step j is gamma^(T - j)
+  double goal_x = 4.51;  ///< x of the goal stack, m (the middle die's start)
+  /// Per-dimension scale of the L2 state distance (population std of the 68 human recordings,
+  /// converted to SI; see docs/world.md).
+  State sigma{};
+};
+
+/// Everything that defines a world. Plain data; validate() checks it.
+struct WorldConfig {
+  WallsConfig walls;
+  CupConfig cup;
+  DiceConfig dice;
+  PhysicsConfig physics;
+  ActionConfig action;
+  RandomizationConfig randomization;
+  JudgeConfig judge;
+  EpisodeConfig episode;
+  CostConfig cost = default_cost();
+
+  /// The cost defaults, with the measured per-dimension sigma.
+  static CostConfig default_cost();
+};
+
+/// Throws ConfigError naming the first field that is out of range, e.g.
+/// `world config: field "physics.substeps" must be >= 1, got 0`, or whose start does not fit:
+/// dice and cup inside the walls and the dice apart at every shift, jitter, lift and tilt.
+void validate(const WorldConfig& config);
+
+/// Parses JSON text; every field must be present, of the right type, finite and in range, and
+/// the start must fit inside the walls. Reads format versions 1 (no marker) and 2 ("format":
+/// "dicestack-world", "version": 2); docs/formats.md. `source` names the text in messages (a
+/// path, or "<string>"). Throws ConfigError.
+WorldConfig world_config_from_json(std::string_view text, std::string_view source = "<string>");
+
+/// Pretty-printed JSON holding the format marker, the version and every field.
+std::string to_json(const WorldConfig& config);
+
+/// FNV-1a of the fields alone (not the format version): the world's identity in cache names,
+/// checkpoints and snapshots, unchanged when only the file format moves on.
+std::uint64_t world_hash(const WorldConfig& config);
+
+/// Reads a JSON file; throws InputError if unreadable, ConfigError if invalid.
+WorldConfig load_world_config(const std::filesystem::path& path);
+
+/// Writes a JSON file atomically (temporary file, then rename). An existing file is replaced only
+/// if it is a JSON object of world config sections; anything else is refused (InputError).
+void save_world_config(const WorldConfig& config, const std::filesystem::path& path);
+
+}  // namespace dicestack

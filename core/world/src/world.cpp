@@ -1,0 +1,95 @@
+#include <dicestack/core/world.hpp>
+
+#include <vector>
+
+#include "scene.hpp"
+#include "world_impl.hpp"
+#include <dicestack/core/initial_state.hpp>
+
+namespace dicestack {
+
+using detail::kFirstCupFixture;
+using detail::kFirstDieFixture;
+using detail::kind_of_fixture;
+using detail::poses_of;
+using detail::Scene;
+
+World::World(const WorldConfig& config) : World(config, paper_start_state(config)) {}
+
+World::World(const WorldConfig& config, const State& state) : impl_(std::make_unique<Impl>(config)) {
+  set_state(state);
+}
+
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+const WorldConfig& World::config() const { return impl_->config; }
+
+State World::state() const { return impl_->state(); }
+
+void World::set_state(const State& state) {
+  require_finite(state, "world state");
+  impl_->rebuild(poses_of(state));
+}
+
+bool World::step(const Action& dv) {
+  require_finite(dv, "action");
+  Scene& sc = *impl_->scene;
+  b2Body* cup = sc.bodies[0];
+  b2Vec2 v = cup->GetLinearVelocity();
+  v.x += static_cast<float>(dv[0] * sc.u);
+  v.y += static_cast<float>(dv[1] * sc.u);
+  cup->SetLinearVelocity(v);
+  cup->SetAngularVelocity(cup->GetAngularVelocity() + static_cast<float>(dv[2]));
+  const int vel_it = impl_->config.physics.velocity_iterations, pos_it = impl_->config.physics.position_iterations;
+  bool wall = false;
+  for (int k = 0; k < impl_->config.physics.substeps; ++k) {
+    sc.world->Step(impl_->sub_dt, vel_it, pos_it);
+    wall = wall || impl_->touches_wall();
+  }
+  return wall;
+}
+
+std::vector<ShapeOutline> World::outlines() const {
+  const Scene& sc = *impl_->scene;
+  std::vector<ShapeOutline> out;
+  for (std::size_t id = 0; id < sc.fixtures.size(); ++id) {
+    const b2Fixture* f = sc.fixtures[id];
+    const auto* poly = static_cast<const b2PolygonShape*>(f->GetShape());
+    const b2Transform& xf = f->GetBody()->GetTransform();
+    ShapeOutline o;
+    o.kind = kind_of_fixture(static_cast<int>(id));
+    o.index = o.kind == ShapeKind::cup ? static_cast<int>(id) - kFirstCupFixture
+              : o.kind == ShapeKind::die ? static_cast<int>(id) - kFirstDieFixture
+                                         : 0;
+    o.radius = poly->m_radius / sc.u;
+    for (int32 i = 0; i < poly->m_count; ++i) {
+      const b2Vec2 p = b2Mul(xf, poly->m_vertices[i]);
+      o.points.push_back({p.x / sc.u, p.y / sc.u});
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+bool World::touching_walls() {
+  impl_->scene->world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
+  return impl_->touches_wall();
+}
+
+bool World::has_overlaps(double tolerance) {
+  Scene& sc = *impl_->scene;
+  sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
+  const float limit = static_cast<float>(-tolerance * sc.u);
+  for (b2Contact* c = sc.world->GetContactList(); c; c = c->GetNext()) {
+    if (!c->IsTouching()) continue;
+    b2WorldManifold wm;
+    c->GetWorldManifold(&wm);
+    for (int32 i = 0; i < c->GetManifold()->pointCount; ++i)
+      if (wm.separations[i] < limit) return true;
+  }
+  return false;
+}
+
+}  // namespace dicestack

@@ -1,0 +1,410 @@
+#include <dicestack/core/hash.hpp>
+#include <dicestack/core/world_config.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/geometry.hpp>
+#include <dicestack/core/json_depth.hpp>
+
+namespace dicestack {
+namespace {
+
+using nlohmann::json;
+
+struct Bounds {
+  double lo = -HUGE_VAL;
+  double hi = HUGE_VAL;
+  bool lo_open = false;  // lo itself is excluded
+};
+
+constexpr Bounds kAny{};
+constexpr Bounds kNonNegative{0.0, HUGE_VAL, false};
+// Physical ranges: wide enough for any experiment, narrow enough that Box2D (single precision,
+// 10 units per metre) stays meaningful. A world 2 km wide, a 1 g die or 100 m/s^2 are refused.
+constexpr Bounds kCoordinate{-1000.0, 1000.0};
+constexpr Bounds kLength{0.0, 100.0, true};
+constexpr Bounds kMass{1e-3, 1e3};
+constexpr Bounds kFriction{0.0, 10.0};
+constexpr Bounds kAcceleration{-100.0, 100.0};
+
+constexpr const char* kFormat = "dicestack-world";
+// 1: no marker, every field of WorldConfig required. 2: adds "format" and "version"; same fields.
+// A field added in a later version gets, in files of older versions, the value those versions
+// implied (documented in docs/formats.md), never a new default.
+constexpr int kVersion = 2;
+
+std::string number_text(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+// A value as the file wrote it, cut to 60 characters: messages never echo an unbounded value.
+std::string excerpt(const std::string& dumped) {
+  return dumped.size() <= 60 ? dumped : dumped.substr(0, 57) + "...";
+}
+
+std::string bound_text(const Bounds& b) {
+  if (b.lo > -HUGE_VAL && b.hi < HUGE_VAL)
+    return "in " + std::string(b.lo_open ? "(" : "[") + number_text(b.lo) + ", " + number_text(b.hi) + "]";
+  if (b.lo > -HUGE_VAL) return std::string(b.lo_open ? "> " : ">= ") + number_text(b.lo);
+  return "<= " + number_text(b.hi);
+}
+
+// Visits every field of a WorldConfig with its JSON path and bounds; one list serves reading,
+// writing and validation, so a new field cannot be forgotten by one of them.
+template <class Config, class Visitor>
+void visit_fields(Config& c, Visitor&& v) {
+  v("walls.floor_y", c.walls.floor_y, kCoordinate);
+  v("walls.left_x", c.walls.left_x, kCoordinate);
+  v("walls.right_x", c.walls.right_x, kCoordinate);
+  v("walls.ceiling_y", c.walls.ceiling_y, kCoordinate);
+  v("walls.radius", c.walls.radius, kLength);
+  v("walls.friction", c.walls.friction, kFriction);
+  v("cup.base_width", c.cup.base_width, kLength);
+  v("cup.wall_height", c.cup.wall_height, kLength);
+  v("cup.flare", c.cup.flare, Bounds{0.0, 100.0});
+  v("cup.radius", c.cup.radius, kLength);
+  v("cup.segment_mass", c.cup.segment_mass, kMass);
+  v("cup.friction", c.cup.friction, kFriction);
+  v("cup.start_anchor", c.cup.start_anchor, kCoordinate);
+  v("cup.start_angle", c.cup.start_angle, Bounds{-10.0, 10.0});
+  v("dice.half_size", c.dice.half_size, Bounds{0.01, 100.0});
+  v("dice.corner_cut", c.dice.corner_cut, kNonNegative);
+  v("dice.mass", c.dice.mass, kMass);
+  v("dice.friction", c.dice.friction, kFriction);
+  v("dice.start_x", c.dice.start_x, kCoordinate);
+  v("dice.start_y", c.dice.start_y, kCoordinate);
+  v("physics.gravity", c.physics.gravity, kAcceleration);
+  v("physics.control_dt", c.physics.control_dt, Bounds{0.0, 1.0, true});
+  v("physics.substeps", c.physics.substeps, Bounds{1, 1000});
+  v("physics.velocity_iterations", c.physics.velocity_iterations, Bounds{1, 1000});
+  v("physics.position_iterations", c.physics.position_iterations, Bounds{0, 1000});
+  v("physics.allow_sleep", c.physics.allow_sleep, kAny);
+  v("physics.units_per_metre", c.physics.units_per_metre, Bounds{1.0, 1000.0});
+  v("physics.action_noise", c.physics.action_noise, Bounds{0.0, 10.0});
+  v("action.scale", c.action.scale, Bounds{0.0, 1000.0, true});
+  v("action.limit", c.action.limit, Bounds{0.0, 1000.0, true});
+  v("randomization.shift", c.randomization.shift, Bounds{0.0, 100.0});
+  v("randomization.die_jitter", c.randomization.die_jitter, Bounds{0.0, 100.0});
+  v("randomization.cup_lift", c.randomization.cup_lift, Bounds{0.0, 100.0});
+  v("randomization.cup_tilt", c.randomization.cup_tilt, Bounds{0.0, 3.2});
+  v("randomization.die_quarter_turns", c.randomization.die_quarter_turns, kAny);
+  v("judge.column_tolerance", c.judge.column_tolerance, kLength);
+  v("judge.gap_tolerance", c.judge.gap_tolerance, kLength);
+  v("judge.angle_tolerance", c.judge.angle_tolerance, Bounds{0.0, 0.785, true});
+  v("judge.rest_speed", c.judge.rest_speed, Bounds{0.0, 1000.0, true});
+  v("judge.rest_angular_speed", c.judge.rest_angular_speed, Bounds{0.0, 1000.0, true});
+  v("judge.wall_contact_distance", c.judge.wall_contact_distance, Bounds{0.0, 100.0});
+  v("judge.success_hold_steps", c.judge.success_hold_steps, Bounds{1, 1e6});
+  v("episode.max_steps", c.episode.max_steps, Bounds{1, 1e7});
+  v("cost.gamma", c.cost.gamma, Bounds{0.0, 1.0});
+  v("cost.goal_x", c.cost.goal_x, kCoordinate);
+  v("cost.sigma", c.cost.sigma, Bounds{0.0, 1e6, true});
+}
+
+[[noreturn]] void fail(std::string_view source, std::string_view path, const std::string& what) {
+  throw ConfigError("world config " + std::string(source) + ": field \"" + std::string(path) + "\" " + what);
+}
+
+void check_number(std::string_view source, std::string_view path, double v, const Bounds& b) {
+  if (!std::isfinite(v)) fail(source, path, "must be finite, got " + number_text(v));
+  const bool low = b.lo_open ? !(v > b.lo) : !(v >= b.lo);
+  if (low || v > b.hi) fail(source, path, "must be " + bound_text(b) + ", got " + number_text(v));
+}
+
+// Checks the bounds of every field (no JSON involved).
+struct RangeChecker {
+  std::string_view source;
+  void operator()(std::string_view p, const double& v, const Bounds& b) const { check_number(source, p, v, b); }
+  void operator()(std::string_view p, const int& v, const Bounds& b) const { check_number(source, p, v, b); }
+  void operator()(std::string_view, const bool&, const Bounds&) const {}
+  void operator()(std::string_view p, const Vec2& v, const Bounds& b) const {
+    check_number(source, std::string(p) + "[0]", v.x, b);
+    check_number(source, std::string(p) + "[1]", v.y, b);
+  }
+  template <std::size_t N>
+  void operator()(std::string_view p, const std::array<double, N>& a, const Bounds& b) const {
+    for (std::size_t i = 0; i < N; ++i) check_number(source, std::string(p) + "[" + std::to_string(i) + "]", a[i], b);
+  }
+};
+
+std::vector<std::string> split_path(std::string_view path) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const auto dot = path.find('.', start);
+    parts.emplace_back(path.substr(start, dot - start));
+    if (dot == std::string_view::npos) break;
+    start = dot + 1;
+  }
+  return parts;
+}
+
+struct JsonWriter {
+  json& root;
+  json& slot(std::string_view path) const {
+    json* node = &root;
+    for (const auto& part : split_path(path)) node = &(*node)[part];
+    return *node;
+  }
+  template <class T>
+  void operator()(std::string_view p, const T& v, const Bounds&) const { slot(p) = v; }
+  void operator()(std::string_view p, const Vec2& v, const Bounds&) const { slot(p) = {v.x, v.y}; }
+};
+
+struct JsonReader {
+  const json& root;
+  std::string_view source;
+  std::set<std::string>* seen;
+
+  const json& find(std::string_view path) const {
+    const json* node = &root;
+    for (const auto& part : split_path(path)) {
+      if (!node->is_object() || !node->contains(part)) fail(source, path, "is missing");
+      node = &(*node)[part];
+    }
+    seen->insert(std::string(path));
+    return *node;
+  }
+  double number(std::string_view path, const json& j) const {
+    if (!j.is_number()) fail(source, path, "must be a number, got " + excerpt(j.dump()));
+    return j.get<double>();
+  }
+  void operator()(std::string_view p, double& v, const Bounds&) const { v = number(p, find(p)); }
+  void operator()(std::string_view p, int& v, const Bounds&) const {
+    const json& j = find(p);
+    if (!j.is_number_integer()) fail(source, p, "must be an integer, got " + excerpt(j.dump()));
+    const auto wide = j.get<long long>();
+    if (wide < -(1LL << 31) || wide >= (1LL << 31)) fail(source, p, "is out of range: " + excerpt(j.dump()));
+    v = static_cast<int>(wide);
+  }
+  void operator()(std::string_view p, bool& v, const Bounds&) const {
+    const json& j = find(p);
+    if (!j.is_boolean()) fail(source, p, "must be true or false, got " + excerpt(j.dump()));
+    v = j.get<bool>();
+  }
+  template <std::size_t N>
+  void read_array(std::string_view p, std::array<double, N>& a) const {
+    const json& j = find(p);
+    if (!j.is_array() || j.size() != N)
+      fail(source, p, "must be an array of " + std::to_string(N) + " numbers, got " + excerpt(j.dump()));
+    for (std::size_t i = 0; i < N; ++i) a[i] = number(std::string(p) + "[" + std::to_string(i) + "]", j[i]);
+  }
+  template <std::size_t N>
+  void operator()(std::string_view p, std::array<double, N>& a, const Bounds&) const { read_array(p, a); }
+  void operator()(std::string_view p, Vec2& v, const Bounds&) const {
+    std::array<double, 2> a{};
+    read_array(p, a);
+    v = {a[0], a[1]};
+  }
+};
+
+void collect_leaves(const json& j, const std::string& prefix, std::vector<std::string>& out) {
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items())
+      collect_leaves(value, prefix.empty() ? key : prefix + "." + key, out);
+  } else {
+    out.push_back(prefix);
+  }
+}
+
+// "field "k" value v" for the first number in `message` (quoted by nlohmann) found in `text`.
+std::string overflow_context(std::string_view text, std::string_view message) {
+  const auto open = message.find('\''), close = message.rfind('\'');
+  if (open == std::string_view::npos || close <= open) return "a number";
+  const std::string_view token = message.substr(open + 1, close - open - 1);
+  const auto at = text.find(token);
+  if (at == std::string_view::npos) return "number " + std::string(token);
+  const auto colon = text.rfind(':', at);
+  const auto key_end = colon == std::string_view::npos ? colon : text.rfind('"', colon);
+  const auto key_begin = key_end == std::string_view::npos || key_end == 0 ? key_end : text.rfind('"', key_end - 1);
+  if (key_begin == std::string_view::npos) return "number " + std::string(token);
+  return "field \"" + std::string(text.substr(key_begin + 1, key_end - key_begin - 1)) + "\" value " + std::string(token);
+}
+
+// Where the enclosure's inside begins and ends, m.
+struct Inside {
+  double left, right, bottom, top;
+};
+
+// The fixed extremes of the random start: every die must lie inside the walls and apart from
+// its neighbours at any shift and jitter, and the cup inside the walls at any shift, lift and
+// tilt (its capsules' ends checked at 17 angles across the tilt range).
+void validate_start_region(const WorldConfig& c, std::string_view source) {
+  const Inside in{c.walls.left_x + c.walls.radius, c.walls.right_x - c.walls.radius, table_height(c.walls),
+                  c.walls.ceiling_y - c.walls.radius};
+  const auto& r = c.randomization;
+  const double h = c.dice.half_size, reach = r.shift + r.die_jitter + h;
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    const double x = c.dice.start_x[i];
+    const std::string field = "dice.start_x[" + std::to_string(i) + "]";
+    if (x - reach < in.left || x + reach > in.right)
+      fail(source, field,
+           "puts die " + std::to_string(i) + " outside the walls: with half_size, randomization.shift and die_jitter it spans [" +
+               number_text(x - reach) + ", " + number_text(x + reach) + "] m, the inside is [" + number_text(in.left) + ", " +
+               number_text(in.right) + "]");
+    for (std::size_t j = 0; j < i; ++j) {
+      const double apart = std::abs(x - c.dice.start_x[j]) - 2.0 * r.die_jitter;
+      if (apart < 2.0 * h - 1e-6)
+        fail(source, field,
+             "overlaps die " + std::to_string(j) + ": centres " + number_text(std::abs(x - c.dice.start_x[j])) +
+                 " m apart, less than one side (2 * dice.half_size) plus 2 * randomization.die_jitter");
+    }
+  }
+  if (c.dice.start_y - h < in.bottom - 1e-6 || c.dice.start_y + h > in.top)
+    fail(source, "dice.start_y",
+         "puts the dice outside the walls: they span [" + number_text(c.dice.start_y - h) + ", " +
+             number_text(c.dice.start_y + h) + "] m, between the table at " + number_text(in.bottom) +
+             " and the ceiling at " + number_text(in.top));
+  const CupGeometry cup = cup_geometry(c.cup);
+  const Vec2 centre{c.cup.start_anchor.x + cup.com_from_anchor.x, c.cup.start_anchor.y + cup.com_from_anchor.y};
+  constexpr int kAngles = 17;
+  for (int k = 0; k < kAngles; ++k) {
+    const double angle = c.cup.start_angle + r.cup_tilt * (2.0 * k / (kAngles - 1) - 1.0);
+    for (const auto& s : cup.segments)
+      for (const Vec2 p : {s.a, s.b}) {
+        const Vec2 w = to_world(centre, angle, p);
+        const double lo_x = w.x - r.shift - s.radius, hi_x = w.x + r.shift + s.radius;
+        const double lo_y = w.y - s.radius, hi_y = w.y + r.cup_lift + s.radius;
+        if (lo_x < in.left || hi_x > in.right || lo_y < in.bottom || hi_y > in.top)
+          fail(source, "cup.start_anchor",
+               "puts the cup outside the walls: at start_angle " + number_text(angle) +
+                   " (with randomization.shift, cup_lift and cup_tilt) a point of it reaches (" + number_text(w.x) + ", " +
+                   number_text(w.y) + ") m, the inside is [" + number_text(in.left) + ", " + number_text(in.right) +
+                   "] x [" + number_text(in.bottom) + ", " + number_text(in.top) + "]");
+      }
+  }
+}
+
+void validate_relations(const WorldConfig& c, std::string_view source) {
+  if (!(c.walls.left_x + c.walls.radius < c.walls.right_x - c.walls.radius))
+    fail(source, "walls.right_x", "must be greater than walls.left_x + 2 * walls.radius");
+  if (!(c.walls.floor_y + c.walls.radius < c.walls.ceiling_y - c.walls.radius))
+    fail(source, "walls.ceiling_y", "must be greater than walls.floor_y + 2 * walls.radius");
+  if (!(c.dice.corner_cut < c.dice.half_size))
+    fail(source, "dice.corner_cut", "must be smaller than dice.half_size (" + number_text(c.dice.half_size) + "), got " +
+                                        number_text(c.dice.corner_cut));
+  const double speed_cap = 2.0 * c.physics.substeps / c.physics.control_dt / c.physics.units_per_metre;
+  if (speed_cap <= c.action.limit[0] || speed_cap <= c.action.limit[1])
+    fail(source, "physics.units_per_metre",
+         "leaves Box2D's speed cap at " + number_text(speed_cap) + " m/s, not above the action limit");
+  validate_start_region(c, source);
+}
+
+// The version a config's JSON object declares: 1 without a marker, else its "version".
+int declared_version(const json& root, std::string_view source) {
+  const bool marked = root.contains("format"), versioned = root.contains("version");
+  if (!marked && !versioned) return 1;
+  if (!marked || !root["format"].is_string() || root["format"].get<std::string>() != kFormat)
+    fail(source, "format", "must be \"" + std::string(kFormat) + "\" beside \"version\"");
+  if (!versioned) fail(source, "version", "is missing (\"format\" is set)");
+  const json& v = root["version"];
+  if (!v.is_number_integer() || v.get<long long>() < 1)
+    fail(source, "version", "must be a positive integer, got " + excerpt(v.dump()));
+  if (v.get<long long>() > kVersion)
+    throw ConfigError("world config " + std::string(source) + ": format version " + v.dump() +
+                      " is newer than this dicestack reads (" + std::to_string(kVersion) + "); upgrade dicestack");
+  return static_cast<int>(v.get<long long>());
+}
+
+json fields_json(const WorldConfig& config) {
+  json root = json::object();
+  visit_fields(config, JsonWriter{root});
+  return root;
+}
+
+}  // namespace
+
+CostConfig WorldConfig::default_cost() {
+  CostConfig cost;
+  // Population std per state column over the 68 human recordings as imported (18,016 frames,
+  // SI, cup at its centre of mass): see docs/world.md, "Cost and reward".
+  cost.sigma = {1.2734, 0.7895, 0.4477, 1.2717, 0.6337, 1.8692, 4.8822, 1.0365,
+                2.2418, 1.2166, 0.5323, 1.9605, 4.6541, 0.9885, 2.1754, 1.2364,
+                0.6161, 2.5361, 4.6858, 1.0288, 2.4331, 4.9580, 1.1083, 1.7183};
+  return cost;
+}
+
+void validate(const WorldConfig& config) {
+  visit_fields(config, RangeChecker{"<value>"});
+  validate_relations(config, "<value>");
+}
+
+WorldConfig world_config_from_json(std::string_view text, std::string_view source) {
+  json root;
+  try {
+    root = parse_json_limited<json>(text, "world config " + std::string(source));
+  } catch (const json::out_of_range& e) {
+    // JSON has no NaN or infinity; the only way to write one is a number that overflows.
+    throw ConfigError("world config " + std::string(source) + ": " + overflow_context(text, e.what()) +
+                      " is not a finite number");
+  } catch (const json::exception& e) {
+    throw ConfigError("world config " + std::string(source) + ": not valid JSON: " + e.what());
+  }
+  if (!root.is_object()) throw ConfigError("world config " + std::string(source) + ": must be a JSON object");
+  // Versions 1 and 2 hold the same fields; a later version's new field will be read here only
+  // when declared_version() says the file has it.
+  declared_version(root, source);
+  root.erase("format");
+  root.erase("version");
+  WorldConfig config;
+  std::set<std::string> seen;
+  visit_fields(config, JsonReader{root, source, &seen});
+  std::vector<std::string> leaves;
+  collect_leaves(root, "", leaves);
+  for (const auto& leaf : leaves)
+    if (!seen.contains(leaf)) fail(source, excerpt(leaf), "is not a world config field");
+  visit_fields(config, RangeChecker{source});
+  validate_relations(config, source);
+  return config;
+}
+
+std::string to_json(const WorldConfig& config) {
+  nlohmann::ordered_json root{{"format", kFormat}, {"version", kVersion}};  // the marker first, then the sections
+  const json fields = fields_json(config);
+  for (const auto& [section, values] : fields.items()) root[section] = nlohmann::ordered_json::parse(values.dump());
+  return root.dump(2) + "\n";
+}
+
+std::uint64_t world_hash(const WorldConfig& config) { return fnv1a(fields_json(config).dump(2) + "\n"); }
+
+WorldConfig load_world_config(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open world config");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return world_config_from_json(text.str(), path.string());
+}
+
+void save_world_config(const WorldConfig& config, const std::filesystem::path& path) {
+  validate(config);
+  // Ours: a JSON object whose sections are all world config sections (the fields we write).
+  static const json sections = json::parse(to_json(WorldConfig{}));
+  const Ownership ours{"dicestack world config", [](const std::filesystem::path& p) {
+                         std::ifstream in(p, std::ios::binary);
+                         json j;
+                         try {
+                           j = parse_json_limited<json>(in, p.string());
+                         } catch (const std::exception&) {
+                           return false;
+                         }
+                         if (!j.is_object() || j.empty()) return false;
+                         for (const auto& [key, value] : j.items())
+                           if (!sections.contains(key)) return false;
+                         return true;
+                       }};
+  AtomicFile file(path, ours);
+  file.stream() << to_json(config);
+  file.commit();
+}
+
+}  // namespace dicestack

@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/parallel.hpp>
+#include <dicestack/core/rng.hpp>
+
+namespace dicestack {
+namespace {
+
+TEST(ResolveThreads, PositiveIsItselfAndZeroIsTheCoreCount) {
+  EXPECT_EQ(resolve_threads(1), 1);
+  EXPECT_EQ(resolve_threads(3), 3);
+  EXPECT_GE(resolve_threads(0), 1);
+}
+
+TEST(ParallelFor, CallsEveryIndexOnceWithAWorkerInRange) {
+  for (const int threads : {1, 2, 4}) {
+    const std::size_t n = 1000;
+    std::vector<std::atomic<int>> calls(n);
+    std::atomic<bool> bad_worker{false};
+    parallel_for(n, threads, [&](std::size_t i, int worker) {
+      if (worker < 0 || worker >= resolve_threads(threads)) bad_worker = true;
+      ++calls[i];
+    });
+    EXPECT_FALSE(bad_worker) << threads << " threads";
+    for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(calls[i], 1) << "index " << i << ", " << threads << " threads";
+  }
+}
+
+TEST(ParallelFor, NoTwoCallsShareAWorkerAtOnce) {
+  const int threads = 4;
+  std::vector<std::atomic<int>> busy(static_cast<std::size_t>(resolve_threads(threads)));
+  std::atomic<bool> shared{false};
+  parallel_for(400, threads, [&](std::size_t i, int worker) {
+    auto& flag = busy[static_cast<std::size_t>(worker)];
+    if (flag.fetch_add(1) != 0) shared = true;
+    double x = static_cast<double>(i);  // a little work so that calls overlap
+    for (int k = 0; k < 2000; ++k) x = std::sqrt(x + k);
+    if (x < 0) shared = true;
+    flag.fetch_sub(1);
+  });
+  EXPECT_FALSE(shared);
+}
+
+TEST(ParallelFor, SlotResultsDoNotDependOnTheThreadCount) {
+  // Work item i writes only slot i from its own seeded stream (STYLE 15).
+  auto run = [](int threads) {
+    std::vector<double> slots(257);
+    parallel_for(slots.size(), threads, [&](std::size_t i, int) {
+      Rng rng(derive_seed(42, i));
+      double s = 0.0;
+      for (int k = 0; k < 100; ++k) s += rng.normal();
+      slots[i] = s;
+    });
+    return slots;
+  };
+  const auto one = run(1);
+  EXPECT_EQ(run(2), one);
+  EXPECT_EQ(run(4), one);
+}
+
+TEST(ParallelFor, RethrowsTheExceptionOfAnItem) {
+  for (const int threads : {1, 2, 4}) {
+    std::atomic<int> after{0};
+    try {
+      parallel_for(10000, threads, [&](std::size_t i, int) {
+        if (i == 17) throw std::runtime_error("item 17 failed");
+        if (i > 5000) ++after;
+      });
+      FAIL() << "no exception with " << threads << " threads";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "item 17 failed");
+    }
+    if (threads == 1) EXPECT_EQ(after, 0);  // the sequential loop stops at the throw
+  }
+}
+
+TEST(ParallelFor, EmptyAndSingleItemLoops) {
+  int calls = 0;
+  parallel_for(0, 4, [&](std::size_t, int) { ++calls; });
+  EXPECT_EQ(calls, 0);
+  parallel_for(1, 4, [&](std::size_t i, int worker) {
+    EXPECT_EQ(i, 0u);
+    EXPECT_EQ(worker, 0);
+    ++calls;
+  });
+  EXPECT_EQ(calls, 1);
+}
+
+}  // namespace
+}  // namespace dicestack

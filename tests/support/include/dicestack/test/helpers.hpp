@@ -1,0 +1,57 @@
+#pragma once
+// Small helpers shared by the test suites of every folder: target dicestack_test_support
+// (tests/CMakeLists.txt), which every suite links.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/matrix.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack::test {
+
+inline bool bit_equal(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
+
+/// `n` actions uniform in the optimisers' scale, from `seed`.
+inline std::vector<Action> random_actions(const WorldConfig& c, std::uint64_t seed, int n) {
+  Rng rng(seed);
+  std::vector<Action> out(static_cast<std::size_t>(n));
+  for (auto& a : out)
+    for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng.uniform(-1.0, 1.0) * c.action.scale[k];
+  return out;
+}
+
+/// An n x d matrix of values uniform in [-1, 1), from `seed`.
+inline Matrix random_matrix(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
+  Rng rng(seed);
+  Matrix m(n, d);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = rng.uniform(-1.0, 1.0);
+  return m;
+}
+
+/// What a callable throws, as text; empty if it does not throw.
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return {};
+}
+
+/// The pid of a child that has exited and been reaped: a process that no longer runs.
+inline long dead_pid() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  return static_cast<long>(child);
+}
+
+}  // namespace dicestack::test
