@@ -137,7 +137,7 @@ class Dad final : public Learner {
   static std::vector<ParamSpec> schema() {
     return {{"windows", ParamType::integer, "10", 1, 1000, "window sizes: k/windows of each demonstration, k = 1..windows", {}},
             {"iterations", ParamType::integer, "3", 1, 1000, "iterations per window", {}},
-            {"corrector", ParamType::choice, "cmaes", 0, 0, "optimiser of each window's actions", {"cmaes", "de"}},
+            {"corrector", ParamType::choice, "cmaes", 0, 0, "optimiser of each window's actions", {"cmaes", "de", "basinhop", "bayes"}},
             {"corrector_iterations", ParamType::integer, "50", 1, 100000, "generations per correction", {}},
             {"sigma0", ParamType::real, "0.25", 1e-6, 100, "initial spread around the policy's actions, scaled action units", {}},
             {"population", ParamType::integer, "0", 0, 100000, "candidates per generation; 0: 4 + floor(3 ln n)", {}},

@@ -76,7 +76,7 @@ TEST_P(CorrectorTest, LabelsAreInTheDemonstrationsUnits) {
   for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(fix.actions[k], demo.actions[20 + k]) << "step " << k;
 }
 
-INSTANTIATE_TEST_SUITE_P(Dad, CorrectorTest, ::testing::Values("cmaes", "de"));
+INSTANTIATE_TEST_SUITE_P(Dad, CorrectorTest, ::testing::ValuesIn(corrector_names()));
 
 TEST(Dad, UnknownCorrectorIsRejected) {
   EXPECT_THROW(make_corrector("annealing", {}), ConfigError);

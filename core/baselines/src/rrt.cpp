@@ -5,11 +5,10 @@
 #include <numbers>
 #include <optional>
 
-#include <dicestack/core/cmaes.hpp>
+#include <dicestack/core/action_sequence.hpp>
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
-#include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
 
 namespace dicestack {
@@ -40,18 +39,15 @@ State sample_state(const WorldConfig& w, const State& goal, double goal_bias, Rn
   return s;
 }
 
-Action scaled(const double* x, const WorldConfig& w) {
-  Action a;
-  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(x[k], -1.0, 1.0) * w.action.scale[k];
-  return a;
-}
-
 }  // namespace
 
 RrtResult rrt(const WorldConfig& config, const RrtOptions& o, const std::function<void(int, double)>& progress) {
   if (o.nodes < 0 || o.extend_steps < 1 || o.extend_iterations < 1 || o.max_depth_steps < 1)
     throw ConfigError("rrt: nodes >= 0, extend_steps, extend_iterations and max_depth_steps >= 1 expected");
   if (!(o.goal_bias >= 0.0 && o.goal_bias <= 1.0)) throw ConfigError("rrt: goal_bias must be in [0, 1]");
+  const auto names = minimiser_names();
+  if (std::find(names.begin(), names.end(), o.method) == names.end())
+    throw ConfigError("rrt: unknown method \"" + o.method + "\"; expected cmaes, de, basinhop or bayes");
   WorldConfig world = config;
   validate(world);
   world.episode.max_steps = std::max(world.episode.max_steps, o.max_depth_steps + o.extend_steps);
@@ -69,7 +65,6 @@ RrtResult rrt(const WorldConfig& config, const RrtOptions& o, const std::functio
   std::size_t best = 0;
   double best_d = state_distance(tree[0].state, goal, world.cost);
   Rng rng(o.seed);
-  const auto n = static_cast<Eigen::Index>(o.extend_steps * static_cast<int>(kActionDim));
   for (int k = 1; k <= o.nodes; ++k) {
     const State target = sample_state(world, goal, o.goal_bias, rng);
     std::size_t near = tree.size();
@@ -82,35 +77,27 @@ RrtResult rrt(const WorldConfig& config, const RrtOptions& o, const std::functio
     if (near == tree.size()) break;  // every node is as deep as allowed
     const Node& from = tree[near];
     // Extension: a few steps of actions from the node's exact world, optimised towards the target.
-    CmaesOptions co;
-    co.sigma0 = 0.5;
-    co.max_iterations = o.extend_iterations;
-    co.seed = derive_seed(o.seed, static_cast<std::uint64_t>(k));
-    Cmaes es(Eigen::VectorXd::Zero(n), co);
-    auto final_distance = [&](DiceEnv& env, const double* x) {
-      env.restore(from.snapshot);
-      for (int t = 0; t < o.extend_steps; ++t) env.step(scaled(x + 3 * t, world));
-      return tracking_distance_sq(env.get_state(), target, world.cost);
-    };
-    while (!es.done()) {
-      const Eigen::MatrixXd& xs = es.ask();
-      std::vector<double> values(static_cast<std::size_t>(xs.rows()));
-      parallel_for(values.size(), o.threads, [&](std::size_t i, int w) {
-        const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
-        values[i] = final_distance(env_of(w), row.data());
-      });
-      result.simulated_steps += static_cast<long long>(values.size()) * o.extend_steps;
-      es.tell(values);
-    }
+    const ActionSequenceProblem extension(world, o.extend_steps, ActionBox::unit,
+                                          [&](DiceEnv& env, const std::vector<Action>& actions) {
+                                            env.restore(from.snapshot);
+                                            for (const Action& a : actions) env.step(a);
+                                            return tracking_distance_sq(env.get_state(), target, world.cost);
+                                          });
+    MinimiseOptions mo;
+    mo.method = o.method;
+    mo.sigma0 = 0.5;
+    mo.iterations = o.extend_iterations;
+    mo.seed = derive_seed(o.seed, static_cast<std::uint64_t>(k));
+    SequenceEvaluator evaluator(envs, o.threads);
+    const MinimiseResult found = minimise(extension, evaluator, mo);
+    result.simulated_steps += static_cast<long long>(found.evaluations) * o.extend_steps;
     DiceEnv& env = env_of(0);
     env.restore(from.snapshot);
     Node node;
     node.parent = static_cast<int>(near);
     node.depth = from.depth + o.extend_steps;
-    for (int t = 0; t < o.extend_steps; ++t) {
-      node.actions.push_back(scaled(es.best().data() + 3 * t, world));
-      env.step(node.actions.back());
-    }
+    node.actions = extension.actions(found.best.data());
+    for (const Action& a : node.actions) env.step(a);
     result.simulated_steps += o.extend_steps;
     node.snapshot = env.snapshot();
     node.state = env.get_state();

@@ -1,7 +1,8 @@
 #pragma once
 // DaD's corrector (paper eq. 11): from the world a policy drifted into, find the next w actions
-// whose simulated states follow the demonstration's next w states. Pluggable: CMA-ES (ours) by
-// default, differential evolution from pagmo as the alternative.
+// whose simulated states follow the demonstration's next w states. Any method of
+// core/action_sequence.hpp: CMA-ES (ours) by default, pagmo's differential evolution, basin
+// hopping, Bayesian optimisation.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -43,12 +44,15 @@ class Corrector {
 };
 
 struct CorrectorOptions {
-  int iterations = 50;   ///< generations
+  int iterations = 50;   ///< generations (basinhop, bayes: iterations x population evaluations)
   double sigma0 = 0.25;  ///< initial spread in scaled action units
   int population = 0;    ///< 0: pycma's 4 + floor(3 ln n)
 };
 
-/// "cmaes" or "de"; throws ConfigError for another name.
+/// The correctors' names: cmaes, de, basinhop, bayes.
+std::vector<std::string> corrector_names();
+
+/// One of corrector_names(); throws ConfigError for another name.
 std::unique_ptr<Corrector> make_corrector(std::string_view name, const CorrectorOptions& options);
 
 }  // namespace dicestack

@@ -1,9 +1,10 @@
 #pragma once
 // The paper's baselines without demonstrations (Section V-B): optimise an open-loop action
-// sequence from the paper's start so that the dice end up in the goal stack. Four optimisers:
-// CMA-ES (ours), differential evolution (pagmo), basin hopping (scipy's Metropolis variant with
-// NLopt's COBYLA as the local minimiser) and Bayesian optimisation (a small Gaussian process with
-// expected improvement on Eigen: no packaged C++ library exists).
+// sequence from the paper's start so that the dice end up in the goal stack, with any of the
+// four methods of action_sequence.hpp: CMA-ES (ours), differential evolution (pagmo), basin
+// hopping (scipy's Metropolis variant with NLopt's COBYLA as the local minimiser) and Bayesian
+// optimisation (a small Gaussian process with expected improvement on Eigen: no packaged C++
+// library exists). The cost, eq. 6, is one ActionSequenceProblem.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <dicestack/core/action_sequence.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -31,6 +33,8 @@ class OpenLoopProblem {
  public:
   /// Throws ConfigError for a bad world or settings.
   OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads = 0);
+  OpenLoopProblem(const OpenLoopProblem&) = delete;  // its sequence's cost refers to it
+  OpenLoopProblem& operator=(const OpenLoopProblem&) = delete;
 
   std::size_t dim() const { return static_cast<std::size_t>(settings_.steps) * kActionDim; }
   const WorldConfig& world() const { return world_; }
@@ -39,21 +43,24 @@ class OpenLoopProblem {
   double cost(const double* x);
   /// Every row of `xs` (lambda x dim), in parallel.
   std::vector<double> cost_batch(const Eigen::MatrixXd& xs);
-  int evaluations() const { return evaluations_; }
+  int evaluations() const;
+  /// The problem as minimise() takes it, and the pool it evaluates in.
+  const ActionSequenceProblem& sequence() const { return *sequence_; }
+  SequenceEvaluator& evaluator() { return *evaluator_; }
 
  private:
-  double run(DiceEnv& env, const double* x) const;
+  double run(DiceEnv& env, const std::vector<Action>& actions) const;
 
   WorldConfig world_;
   OpenLoopSettings settings_;
   State start_, goal_;
-  int threads_;
   std::optional<EnvPool> envs_;  ///< made once the world is checked and stretched
-  int evaluations_ = 0;
+  std::optional<ActionSequenceProblem> sequence_;
+  std::optional<SequenceEvaluator> evaluator_;
 };
 
 struct OptimiseOptions {
-  std::string method = "cmaes";  ///< cmaes, de, basinhop or bayes
+  std::string method = "cmaes";  ///< minimiser_names(): cmaes, de, basinhop or bayes
   int evaluations = 5000;        ///< budget
   double sigma0 = 0.25;          ///< CMA-ES's initial step, DE's initial spread, basin hopping's step
   std::uint64_t seed = 0;
