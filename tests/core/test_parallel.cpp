@@ -76,7 +76,9 @@ TEST(ParallelFor, RethrowsTheExceptionOfAnItem) {
     } catch (const std::runtime_error& e) {
       EXPECT_EQ(std::string(e.what()), "item 17 failed");
     }
-    if (threads == 1) EXPECT_EQ(after, 0);  // the sequential loop stops at the throw
+    if (threads == 1) {
+      EXPECT_EQ(after, 0);  // the sequential loop stops at the throw
+    }
   }
 }
 
