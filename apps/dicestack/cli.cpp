@@ -33,7 +33,7 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   add_evaluate_command(app, cluster);
   add_leaderboard_command(app, cluster);
   add_learners_command(app);
-  add_optimise_command(app);
+  add_optimise_command(app, cluster);
   add_reinforce_command(app);
   add_rrt_command(app);
   add_play_command(app);
@@ -45,7 +45,7 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   if (cluster.size() > 1)
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
       const std::string name = sub->get_name();
-      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard")
+      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard" && name != "optimise")
         sub->preparse_callback([&cluster](std::size_t) {
           if (!cluster.is_root()) throw RootOnly{};
         });

@@ -16,8 +16,8 @@ using FailFn = std::function<int(const std::string& message, int code)>;
 
 /// Parses argv, runs the chosen subcommand and returns the process exit status: 0 on success,
 /// 1 for a dicestack::Error (message on stderr), CLI11's codes for usage errors.
-/// With several ranks in `cluster`, evaluate, record, train and leaderboard share their work
-/// among them; every other subcommand runs on the root alone while the others wait.
+/// With several ranks in `cluster`, evaluate, record, train, leaderboard and optimise (CMA-ES)
+/// share their work among them; every other subcommand runs on the root alone while the others wait.
 int run(int argc, char** argv, Cluster& cluster = local_cluster(), const FailFn& fail = {});
 
 // Each subcommand file registers itself on the top-level app.
@@ -38,7 +38,7 @@ void add_bench_load_command(CLI::App& bench);        // under `bench`
 void add_bench_dataset_command(CLI::App& bench);     // under `bench`
 void add_interop_commands(CLI::App& import, CLI::App& dataset);  // import robomimic|minari, dataset export
 void add_bench_optimise_command(CLI::App& bench);    // under `bench`
-void add_optimise_command(CLI::App& app);
+void add_optimise_command(CLI::App& app, Cluster& cluster);
 void add_reinforce_command(CLI::App& app);
 void add_rrt_command(CLI::App& app);
 

@@ -21,8 +21,8 @@
 
 namespace dicestack {
 
-OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads)
-    : world_(world), settings_(settings), threads_(threads) {
+OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads, Cluster& cluster)
+    : world_(world), settings_(settings), threads_(threads), cluster_(&cluster) {
   validate(world_);
   if (settings.steps < 1) throw ConfigError("open-loop steps must be at least 1, got " + std::to_string(settings.steps));
   if (settings.repeats < 1) throw ConfigError("open-loop repeats must be at least 1, got " + std::to_string(settings.repeats));
@@ -57,11 +57,13 @@ double OpenLoopProblem::cost(const double* x) {
 }
 
 std::vector<double> OpenLoopProblem::cost_batch(const Eigen::MatrixXd& xs) {
-  std::vector<double> out(static_cast<std::size_t>(xs.rows()));
-  parallel_for(out.size(), threads_, [&](std::size_t i, int w) {
-    const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
-    out[i] = run(envs_->at(w), row.data());
-  });
+  const std::vector<double> out = distributed_map<double>(
+      *cluster_, static_cast<std::size_t>(xs.rows()), threads_,
+      [&](std::size_t i, int w) {
+        const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
+        return run(envs_->at(w), row.data());
+      },
+      [](const double& v) { return Packer().put(v).take(); }, [](std::string_view b) { return Unpacker(b, "cost").get<double>(); });
   evaluations_ += static_cast<int>(out.size());
   return out;
 }

@@ -422,10 +422,12 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   // Progress in units of rows: one per (learner, map, regressor) and per baseline.
   const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
 
-  // The rows still to measure, in table order: (learner, map, regressor) rows, then baselines.
+  // The work still to do, in table order: each (learner, map, regressor) row once per training
+  // seed, then each baseline whole (its seeds share one optimisation).
   struct Job {
     std::size_t index = 0;  // 1-based place among the learner rows; 0 for a baseline
     std::string learner, features, regressor, key;
+    int seed = 0;  // which training seed of the row (learner rows)
     std::size_t baseline = 0;
   };
   std::vector<Job> jobs;
@@ -434,82 +436,113 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     for (const auto& name : regressors) {
       ++index;
       const std::string key = learner_name + "/" + features + "/" + name;
-      if (!skipped(learner_name, name) && !done.contains(key)) jobs.push_back({index, learner_name, features, name, key, 0});
+      if (!skipped(learner_name, name) && !done.contains(key))
+        for (int s = 0; s < opt.seeds; ++s) jobs.push_back({index, learner_name, features, name, key, s, 0});
     }
-  for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", b});
+  for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", 0, b});
 
-  // One row, on this rank alone when several share the run (`inner` is then the single process);
-  // its progress fraction runs from `from` to `from + span`.
-  auto measure = [&](const Job& job, Cluster& inner, double from, double span) {
-    if (job.index == 0) {
-      const std::string& name = job.regressor;
-      say("baseline " + name, from);
-      const auto t0 = std::chrono::steady_clock::now();
-      const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
-      LeaderboardRow row{name, "baseline"};
-      row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      row.train_error = row.test_error = -1;
-      for (int s = 0; s < opt.seeds; ++s) {
-        const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads,
-                                      InitialPush::none, nullptr, [&](int finished, int of) {
-                                        tick("baseline " + name, from + span * (s + static_cast<double>(finished) / of) / opt.seeds);
-                                      }, inner);
-        add_outcomes(row, st, opt.seeds);
-      }
-      return row;
-    }
-    const std::string& learner_name = job.learner;
-    const std::string& features = job.features;
+  // A learner row's measurements for one training seed; rows add their seeds up in seed order.
+  struct SeedResult {
+    double fit_s = 0.0, train_error = 0.0, test_error = 0.0;
+    bool has_test = false;
+    EvalStats stats;
+  };
+  auto pack_seed = [](const SeedResult& r) {
+    return Packer().put(r.fit_s).put(r.train_error).put(r.test_error).put<std::uint8_t>(r.has_test).put(r.stats).take();
+  };
+  auto unpack_seed = [](std::string_view bytes) {
+    Unpacker u(bytes, "leaderboard seed result");
+    SeedResult r;
+    r.fit_s = u.get<double>();
+    r.train_error = u.get<double>();
+    r.test_error = u.get<double>();
+    r.has_test = u.get<std::uint8_t>() != 0;
+    r.stats = u.get<EvalStats>();
+    return r;
+  };
+
+  // One baseline row, or one seed of a learner row, on this rank alone when several share the
+  // run (`inner` is then the single process); its progress fraction runs from `from` to `from + span`.
+  auto measure_baseline = [&](const Job& job, Cluster& inner, double from, double span) {
     const std::string& name = job.regressor;
-    const Split& fsplit = split_for(features);
-    LeaderboardRow row{name, learner_name, features};
+    say("baseline " + name, from);
+    const auto t0 = std::chrono::steady_clock::now();
+    const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
+    LeaderboardRow row{name, "baseline"};
+    row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    row.train_error = row.test_error = -1;
     for (int s = 0; s < opt.seeds; ++s) {
-      const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(s);
-      const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
-      // Where this row and seed stand: training is the first half of a seed's share, rollouts the second.
-      auto at = [&, s](double part) { return from + span * (s + part) / opt.seeds; };
-      say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
-      LearnContext c;
-      c.world = world;
-      c.regressor = name;
-      c.features = features;
-      c.seed = seed;
-      c.threads = opt.threads;
-      c.demos = train;
-      c.held_out = held_out;
-      c.cluster = &inner;
-      std::string last_phase;
-      c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
-        const std::string phase = std::to_string(p.iteration) + p.phase;
-        const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
-                                 std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
-        report(text, at(0.5 * p.fraction), phase != last_phase);
-        last_phase = phase;
-      };
-      const auto t0 = std::chrono::steady_clock::now();
-      const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
-      row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
-      row.train_error += scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma) / opt.seeds;
-      if (fsplit.test.rows() == 0)
-        row.test_error = -1;  // no test episode: printed "-"
-      else
-        row.test_error += scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma) / opt.seeds;
-      const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
-      say(rollouts_text, at(0.5));
-      std::shared_ptr<const Model> model = learned.model;
-      const EvalStats st = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed,
-                                    opt.threads, InitialPush::none, nullptr, [&](int finished, int of) {
-                                      tick(rollouts_text, at(0.5 + 0.5 * finished / of));
+      const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads,
+                                    InitialPush::none, nullptr, [&](int finished, int of) {
+                                      tick("baseline " + name, from + span * (s + static_cast<double>(finished) / of) / opt.seeds);
                                     }, inner);
       add_outcomes(row, st, opt.seeds);
     }
     return row;
   };
+  auto measure_seed = [&](const Job& job, Cluster& inner, double from, double span) {
+    const std::string& learner_name = job.learner;
+    const std::string& name = job.regressor;
+    const Split& fsplit = split_for(job.features);
+    const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(job.seed);
+    const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
+    // Training is the first half of a seed's share, rollouts the second.
+    auto at = [&](double part) { return from + span * part; };
+    say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
+    LearnContext c;
+    c.world = world;
+    c.regressor = name;
+    c.features = job.features;
+    c.seed = seed;
+    c.threads = opt.threads;
+    c.demos = train;
+    c.held_out = held_out;
+    c.cluster = &inner;
+    std::string last_phase;
+    c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
+      const std::string phase = std::to_string(p.iteration) + p.phase;
+      const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
+                               std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
+      report(text, at(0.5 * p.fraction), phase != last_phase);
+      last_phase = phase;
+    };
+    SeedResult r;
+    const auto t0 = std::chrono::steady_clock::now();
+    const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
+    r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.train_error = scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma);
+    r.has_test = fsplit.test.rows() > 0;
+    if (r.has_test) r.test_error = scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma);
+    const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
+    say(rollouts_text, at(0.5));
+    std::shared_ptr<const Model> model = learned.model;
+    r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed, opt.threads,
+                       InitialPush::none, nullptr, [&](int finished, int of) {
+                         tick(rollouts_text, at(0.5 + 0.5 * finished / of));
+                       }, inner);
+    return r;
+  };
+  // A learner row from its seeds, added up in seed order (the same sums for any deal).
+  auto combine = [&](const Job& job, const std::vector<SeedResult>& seeds) {
+    LeaderboardRow row{job.regressor, job.learner, job.features};
+    for (const SeedResult& r : seeds) {
+      row.fit_s += r.fit_s / opt.seeds;
+      row.train_error += r.train_error / opt.seeds;
+      if (!r.has_test)
+        row.test_error = -1;  // no test episode: printed "-"
+      else
+        row.test_error += r.test_error / opt.seeds;
+      add_outcomes(row, r.stats, opt.seeds);
+    }
+    return row;
+  };
 
-  // Finished rows by job; a learner row also goes to <out>.partial.json as soon as the root has it.
+  // Finished rows by their first job; a learner row goes to <out>.partial.json as soon as the
+  // root has all its seeds.
   std::vector<std::optional<LeaderboardRow>> measured(jobs.size());
+  std::vector<std::optional<SeedResult>> seed_results(jobs.size());
   std::size_t finished_jobs = 0;
-  auto keep = [&](std::size_t j, LeaderboardRow row) {
+  auto keep_row = [&](std::size_t j, LeaderboardRow row) {
     if (!jobs[j].key.empty() && !partial.empty() && cluster.is_root()) {
       done[jobs[j].key] = row_json(row);
       AtomicFile f(partial, partial_ownership());
@@ -517,31 +550,74 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
       f.commit();
     }
     measured[j] = std::move(row);
+  };
+  // Job j's result (a packed SeedResult or baseline row) has arrived.
+  auto keep = [&](std::size_t j, std::string_view bytes) {
     ++finished_jobs;
+    if (jobs[j].index == 0) {
+      Unpacker u(bytes, "leaderboard baseline row");
+      keep_row(j, unpack_row(u));
+      return;
+    }
+    seed_results[j] = unpack_seed(bytes);
+    const std::size_t first = j - static_cast<std::size_t>(jobs[j].seed);
+    std::vector<SeedResult> seeds;
+    for (std::size_t k = first; k < first + static_cast<std::size_t>(opt.seeds); ++k) {
+      if (!seed_results[k]) return;  // more seeds to come
+      seeds.push_back(*seed_results[k]);
+    }
+    keep_row(first, combine(jobs[first], seeds));
+  };
+  auto run_job = [&](std::size_t j, Cluster& inner, double from, double span) {
+    if (jobs[j].index == 0) {
+      Packer p;
+      pack_row(p, measure_baseline(jobs[j], inner, from, span));
+      return p.take();
+    }
+    return pack_seed(measure_seed(jobs[j], inner, from, span));
   };
   if (cluster.size() == 1) {
     for (std::size_t j = 0; j < jobs.size(); ++j) {
-      const double from = jobs[j].index ? static_cast<double>(jobs[j].index - 1) : static_cast<double>(total + jobs[j].baseline);
-      keep(j, measure(jobs[j], cluster, from / units, 1.0 / units));
+      const double from = jobs[j].index ? static_cast<double>(jobs[j].index - 1) + static_cast<double>(jobs[j].seed) / opt.seeds
+                                        : static_cast<double>(total + jobs[j].baseline);
+      keep(j, run_job(j, cluster, from / units, (jobs[j].index ? 1.0 / opt.seeds : 1.0) / units));
     }
   } else {
-    // Several ranks: each row is trained and rolled out whole on the rank the deal gives it (the
-    // most expensive rows first, each to the least loaded rank); a non-root rank sends each row to
-    // the root as it finishes. The root takes them in between (and during) its own rows, writes
-    // the progress file, and at the end waits for the rest and broadcasts the whole table.
+    // Several ranks: each job (one seed of a row, or a baseline) runs whole on the rank the deal
+    // gives it (the most expensive first, each to the least loaded rank); a non-root rank sends
+    // each result to the root as it finishes. The root takes them in between (and during) its
+    // own jobs, writes the progress file, and at the end waits for the rest and broadcasts them.
     std::vector<double> cost(jobs.size());
     for (std::size_t j = 0; j < jobs.size(); ++j)
       cost[j] = estimated_row_cost(jobs[j].index ? jobs[j].learner : "baseline", jobs[j].regressor, jobs[j].features,
-                                   paper, episodes * opt.seeds);
+                                   paper, jobs[j].index ? episodes : episodes * opt.seeds);
     const std::vector<int> owner = deal_items(jobs.size(), cluster.size(), cost);
     const double job_units = static_cast<double>(jobs.size()) + 0.5;
+    {  // the deal, on one line: which rank runs each job, and the estimated load of each rank
+      std::vector<double> load(static_cast<std::size_t>(cluster.size()), 0.0);
+      std::string ranks_of;
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        load[static_cast<std::size_t>(owner[j])] += cost[j];
+        ranks_of += (j ? " " : "") + std::to_string(owner[j]);
+      }
+      std::string loads;
+      for (double l : load) loads += (loads.empty() ? "" : " ") + std::to_string(static_cast<long>(std::lround(l)));
+      say("deal: " + std::to_string(jobs.size()) + " jobs on " + std::to_string(cluster.size()) +
+              " ranks, estimated seconds per rank " + loads + "; rank of each job in table order: " + ranks_of,
+          0.0);
+    }
+    std::vector<std::string> results(jobs.size());
     auto take_arrivals = [&](bool wait) {
       for (auto& [from_rank, bytes] : cluster.receive(wait)) {
-        Unpacker u(bytes, "leaderboard row from rank " + std::to_string(from_rank));
+        Unpacker u(bytes, "leaderboard result from rank " + std::to_string(from_rank));
         const auto j = static_cast<std::size_t>(u.get<std::uint64_t>());
-        if (j >= jobs.size() || measured[j]) throw Error("leaderboard: rank " + std::to_string(from_rank) + " sent row " + std::to_string(j) + " unexpectedly");
-        keep(j, unpack_row(u));
-        say("row " + (jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " : std::string("baseline ")) + jobs[j].regressor +
+        if (j >= jobs.size() || !results[j].empty())
+          throw Error("leaderboard: rank " + std::to_string(from_rank) + " sent result " + std::to_string(j) + " unexpectedly");
+        results[j] = u.get_string();
+        keep(j, results[j]);
+        say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
+                                 std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
+                           : "baseline " + jobs[j].regressor) +
                 " finished on rank " + std::to_string(from_rank),
             static_cast<double>(finished_jobs) / job_units);
       }
@@ -549,8 +625,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     std::chrono::steady_clock::time_point last_poll{};
     std::atomic<bool> polling{false};
     if (cluster.is_root()) {
-      // While it works on its own rows, the root looks for other ranks' finished rows at most
-      // once a second, from whichever thread reports (one at a time; not from inside a poll).
+      // While it works on its own jobs, the root looks for other ranks' results at most once a
+      // second, from whichever thread reports (one at a time; not from inside a poll).
       const auto user_report = report;
       report = [&, user_report](const std::string& text, double fraction, bool milestone) {
         user_report(text, fraction, milestone);
@@ -570,26 +646,26 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     }
     for (std::size_t j = 0; j < jobs.size(); ++j) {
       if (owner[j] != cluster.rank()) continue;
-      LeaderboardRow row = measure(jobs[j], local_cluster(), static_cast<double>(finished_jobs) / job_units, 1.0 / job_units);
+      std::string bytes = run_job(j, local_cluster(), static_cast<double>(finished_jobs) / job_units, 1.0 / job_units);
       if (cluster.is_root()) {
-        keep(j, std::move(row));
+        results[j] = std::move(bytes);
+        keep(j, results[j]);
         take_arrivals(false);
       } else {
-        Packer p;
-        p.put<std::uint64_t>(j);
-        pack_row(p, row);
-        cluster.send_to_root(p.take());
+        cluster.send_to_root(Packer().put<std::uint64_t>(j).put_string(bytes).take());
       }
     }
     if (cluster.is_root())
       while (finished_jobs < jobs.size()) take_arrivals(true);
     Packer all;
     if (cluster.is_root())
-      for (std::size_t j = 0; j < jobs.size(); ++j) pack_row(all, *measured[j]);
+      for (const std::string& r : results) all.put_string(r);
     std::string bytes = all.take();
     cluster.broadcast(bytes);
-    Unpacker u(bytes, "leaderboard rows from rank 0");
-    for (std::size_t j = 0; j < jobs.size(); ++j) measured[j] = unpack_row(u);
+    if (!cluster.is_root()) {
+      Unpacker u(bytes, "leaderboard results from rank 0");
+      for (std::size_t j = 0; j < jobs.size(); ++j) keep(j, u.get_string());
+    }
   }
 
   // The table in its order: learner rows (measured now or read back), then the baselines.
@@ -600,8 +676,12 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     for (const auto& name : regressors) {
       ++index;
       if (skipped(learner_name, name)) continue;
-      if (next < jobs.size() && jobs[next].index == index) rows.push_back(*measured[next++]);
-      else rows.push_back(row_from(done[learner_name + "/" + features + "/" + name]));
+      if (next < jobs.size() && jobs[next].index == index) {
+        rows.push_back(*measured[next]);
+        next += static_cast<std::size_t>(opt.seeds);
+      } else {
+        rows.push_back(row_from(done[learner_name + "/" + features + "/" + name]));
+      }
     }
   for (; next < jobs.size(); ++next) rows.push_back(*measured[next]);
   // Playback of the demonstrations themselves (paper VI-A), for reference.

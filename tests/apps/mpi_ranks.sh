@@ -3,7 +3,7 @@
 # under mpirun -np 2 and -np 3 (with 1 and 2 threads per rank), outputs compared byte for byte
 # (timing fields removed from JSON). `failure` checks that a rank that fails or dies ends the
 # whole run quickly with a clear message.
-#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | evaluate | dagger | dad | dart | leaderboard | failure
+#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | evaluate | dagger | dad | dart | leaderboard | optimise | failure
 set -euo pipefail
 exe="$1"
 mpirun="$2"
@@ -28,7 +28,7 @@ untimed() {
 import json, sys
 def strip(v):
     if isinstance(v, dict):
-        return {k: strip(x) for k, x in v.items() if k not in ("seconds", "fit_s", "us_per_step", "seconds_per_episode")}
+        return {k: strip(x) for k, x in v.items() if k not in ("seconds", "fit_s", "us_per_step", "seconds_per_episode", "evaluations_per_second")}
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v
@@ -92,7 +92,7 @@ case "$mode" in
     for run in "1 2" "2 1" "3 1"; do
       set -- $run
       ranks "$1" leaderboard --demos "$work/demos" --regressors knn,linear_svr --learners bc,dagger --option expert=scripted \
-        --episodes 4 --threads "$2" --format json --out "$work/lb-$1.json" "${world[@]}" > /dev/null
+        --episodes 4 --seeds 2 --threads "$2" --format json --out "$work/lb-$1.json" "${world[@]}" > /dev/null
       untimed "$work/lb-$1.json" > "$work/lb-$1.txt"
       [ ! -e "$work/lb-$1.json.partial.json" ] || fail "the progress file was left behind"
     done
@@ -110,10 +110,24 @@ json.dump({"format": "dicestack-leaderboard-partial", "version": 1, "meta": meta
           open(sys.argv[2], "w"))
 PY
     ranks 3 leaderboard --demos "$work/demos" --regressors knn,linear_svr --learners bc,dagger --option expert=scripted \
-      --episodes 4 --threads 1 --format json --out "$work/lb-r.json" "${world[@]}" > /dev/null
+      --episodes 4 --seeds 2 --threads 1 --format json --out "$work/lb-r.json" "${world[@]}" > /dev/null
     grep -q '"fit_s": 1234.5' "$work/lb-r.json" || fail "the finished row in the progress file was not reused"
     untimed "$work/lb-r.json" > "$work/lb-r.txt"
     same "$work/lb-1.txt" "$work/lb-r.txt"
+    ;;
+  optimise)  # CMA-ES's generations shared among the ranks
+    for run in "1 2" "2 1" "3 2"; do
+      set -- $run
+      ranks "$1" optimise --method cmaes --steps 12 --evaluations 150 --seed 2 --threads "$2" --out "$work/opt-$1" \
+        "${world[@]}" > /dev/null
+      untimed "$work/opt-$1/optimise.json" | grep -v '"out":' > "$work/opt-$1.txt"  # its own folder
+      rm "$work/opt-$1/optimise.json"
+    done
+    grep -q '"best_cost"' "$work/opt-1.txt" || fail "no optimisation result"
+    same "$work/opt-1.txt" "$work/opt-2.txt"
+    same "$work/opt-1.txt" "$work/opt-3.txt"
+    same "$work/opt-1" "$work/opt-2"
+    same "$work/opt-1" "$work/opt-3"
     ;;
   failure)
     "$exe" train --regressor knn --demos "$work/demos" --out "$work/knn.dsm" "${world[@]}" > /dev/null

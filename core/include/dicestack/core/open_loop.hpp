@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -29,15 +30,18 @@ struct OpenLoopSettings {
 /// not depend on the thread count.
 class OpenLoopProblem {
  public:
-  /// Throws ConfigError for a bad world or settings.
-  OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads = 0);
+  /// Throws ConfigError for a bad world or settings. With several ranks in `cluster`, every rank
+  /// makes the same problem and calls the same methods in the same order: cost_batch deals its
+  /// rows among the ranks (docs/scaling.md); cost() runs on each rank.
+  OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads = 0,
+                  Cluster& cluster = local_cluster());
 
   std::size_t dim() const { return static_cast<std::size_t>(settings_.steps) * kActionDim; }
   const WorldConfig& world() const { return world_; }
   std::vector<Action> actions(const double* x) const;
   /// One evaluation on the calling thread's world 0 (for sequential optimisers).
   double cost(const double* x);
-  /// Every row of `xs` (lambda x dim), in parallel.
+  /// Every row of `xs` (lambda x dim), in parallel (collective over the cluster).
   std::vector<double> cost_batch(const Eigen::MatrixXd& xs);
   int evaluations() const { return evaluations_; }
 
@@ -48,6 +52,7 @@ class OpenLoopProblem {
   OpenLoopSettings settings_;
   State start_, goal_;
   int threads_;
+  Cluster* cluster_;
   std::optional<EnvPool> envs_;  ///< made once the world is checked and stretched
   int evaluations_ = 0;
 };
