@@ -87,6 +87,14 @@ case "$mode" in
     same "$work/$mode-1.dsm.curve.csv" "$work/$mode-2.dsm.curve.csv"
     same "$work/$mode-1.dsm.curve.csv" "$work/$mode-3.dsm.curve.csv"
     [ "$(ls "$work/$mode-2.dsm.checkpoint" | wc -l)" -ge 2 ] || fail "no checkpoint written under mpirun"
+    if [ "$mode" = dagger ]; then  # one more round resumed on 3 ranks = three rounds alone
+      three=("${opts[@]/iterations=2/iterations=3}")
+      "$exe" train --regressor knn --demos "$work/demos" --seed 4 --out "$work/three.dsm" "${three[@]}" "${world[@]}" > /dev/null
+      ranks 3 train --regressor knn --demos "$work/demos" --seed 4 --out "$work/$mode-2.dsm" "${three[@]}" --resume \
+        "${world[@]}" > /dev/null
+      same "$work/three.dsm" "$work/$mode-2.dsm"
+      same "$work/three.dsm.curve.csv" "$work/$mode-2.dsm.curve.csv"
+    fi
     ;;
   leaderboard)
     for run in "1 2" "2 1" "3 1"; do
