@@ -28,6 +28,7 @@ packages=(
   python3-pytest python3-sklearn python3-matplotlib  # its tests and examples
   libhdf5-dev             # robomimic and Minari HDF5 export/import (dicestack_interop)
   python3-h5py            # the tests that read the exported HDF5 files
+  libopenmpi-dev openmpi-bin  # running on MPI ranks (docs/scaling.md); without them the tool runs alone
 )
 
 if [ "${1:-}" = "--python" ]; then

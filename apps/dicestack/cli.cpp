@@ -9,7 +9,18 @@
 
 namespace dicestack::cli {
 
-int run(int argc, char** argv) {
+namespace {
+
+// Thrown on a rank other than the root when the subcommand runs on the root alone.
+struct RootOnly {};
+
+}  // namespace
+
+int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
+  const FailFn fail = fail_fn ? fail_fn : [](const std::string& message, int code) {
+    std::cerr << message << '\n';
+    return code;
+  };
   CLI::App app{"dicestack: imitation learning for dynamic dice stacking", "dicestack"};
   app.set_version_flag("--version", "dicestack " DICESTACK_VERSION);
   app.require_subcommand(1);
@@ -19,29 +30,37 @@ int run(int argc, char** argv) {
   add_bench_command(app);
   add_config_command(app);
   add_dataset_commands(app);
-  add_evaluate_command(app);
-  add_leaderboard_command(app);
+  add_evaluate_command(app, cluster);
+  add_leaderboard_command(app, cluster);
   add_learners_command(app);
-  add_optimise_command(app);
+  add_optimise_command(app, cluster);
   add_reinforce_command(app);
   add_rrt_command(app);
   add_play_command(app);
-  add_train_command(app);
-  add_record_command(app);
+  add_train_command(app, cluster);
+  add_record_command(app, cluster);
   add_regressors_command(app);
   add_render_command(app);
   add_rollout_command(app);
+  if (cluster.size() > 1)
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+      const std::string name = sub->get_name();
+      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard" && name != "optimise")
+        sub->preparse_callback([&cluster](std::size_t) {
+          if (!cluster.is_root()) throw RootOnly{};
+        });
+    }
   try {
     RegressorRegistry::global().load_plugins_from_environment();
     app.parse(argc, argv);
+  } catch (const RootOnly&) {
+    return 0;  // the root runs this subcommand
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const Error& e) {
-    std::cerr << "dicestack: error: " << e.what() << '\n';
-    return 1;
+    return fail(std::string("dicestack: error: ") + e.what(), 1);
   } catch (const std::exception& e) {
-    std::cerr << "dicestack: internal error: " << e.what() << '\n';
-    return 2;
+    return fail(std::string("dicestack: internal error: ") + e.what(), 2);
   }
   return 0;
 }

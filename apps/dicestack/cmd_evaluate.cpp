@@ -26,7 +26,7 @@ struct EvaluateOptions {
   bool json = false;
 };
 
-int run_evaluate(const EvaluateOptions& opt) {
+int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   auto model = std::make_shared<const Model>(load_model(opt.model));
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
@@ -35,7 +35,8 @@ int run_evaluate(const EvaluateOptions& opt) {
   const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
   std::vector<Episode> rollouts;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,
-                               opt.threads, initial_push_from(opt.push), keep ? &rollouts : nullptr);
+                               opt.threads, initial_push_from(opt.push), keep ? &rollouts : nullptr, {}, cluster);
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   if (!opt.video_dir.empty()) {
     // One video per rollout, named as --save-rollouts names its episodes (as robomimic's
     // run_trained_agent writes one per rollout).
@@ -86,7 +87,7 @@ int run_evaluate(const EvaluateOptions& opt) {
 
 }  // namespace
 
-void add_evaluate_command(CLI::App& app) {
+void add_evaluate_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<EvaluateOptions>();
   CLI::App* cmd = app.add_subcommand("evaluate", "Roll a trained policy out and report its outcomes");
   opt->world.add_to(*cmd);
@@ -106,7 +107,7 @@ void add_evaluate_command(CLI::App& app) {
       ->check(CLI::IsMember({"mp4", "avi", "gif"}))
       ->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] { run_evaluate(*opt); });
+  cmd->callback([opt, &cluster] { run_evaluate(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

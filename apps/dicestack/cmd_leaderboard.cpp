@@ -19,13 +19,15 @@ struct LeaderboardOptions {
   LeaderboardRequest request;
 };
 
-int run_leaderboard(const LeaderboardOptions& opt) {
+int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
   LeaderboardRequest request = opt.request;
   request.world = opt.world.load();
-  request.demos = opt.demos.resolve(request.world);
+  request.demos = opt.demos.resolve(request.world, cluster);
+  request.cluster = &cluster;
   const Leaderboard board = dicestack::run_leaderboard(request, [](const LeaderboardProgress& p) {
     if (p.milestone) print_progress(p.text);
   });
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   const std::string table = render_leaderboard(board, request.format);
   if (request.out.empty()) {
     std::cout << table << std::flush;
@@ -38,7 +40,7 @@ int run_leaderboard(const LeaderboardOptions& opt) {
 
 }  // namespace
 
-void add_leaderboard_command(CLI::App& app) {
+void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<LeaderboardOptions>();
   LeaderboardRequest& r = opt->request;
   CLI::App* cmd = app.add_subcommand("leaderboard", "Train every regressor under every learner and print Table I");
@@ -67,7 +69,7 @@ void add_leaderboard_command(CLI::App& app) {
   cmd->add_option("--format", r.format, "md, csv, latex or json")->check(CLI::IsMember({"md", "csv", "latex", "json"}))->capture_default_str();
   cmd->add_option("--out", r.out, "Also write the table to this file (atomically)");
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
-  cmd->callback([opt] { run_leaderboard(*opt); });
+  cmd->callback([opt, &cluster] { run_leaderboard(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

@@ -10,10 +10,14 @@
 namespace dicestack::cli {
 namespace {
 
-int run_optimise(OptimiseCommandOptions opt) {
+int run_optimise(OptimiseCommandOptions opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = open_loop_world(opt);
-  OpenLoopProblem problem(world, opt.settings, opt.threads);
+  // CMA-ES evaluates a generation as one batch, which the ranks share; the other methods
+  // evaluate one point at a time and run on the root alone.
+  const bool shared = opt.optimiser.method == "cmaes";
+  if (!shared && !cluster.is_root()) return 0;
+  OpenLoopProblem problem(world, opt.settings, opt.threads, shared ? cluster : local_cluster());
   ProgressBar bar;
   const OptimiseResult r = optimise(problem, opt.optimiser, [&](int evaluations, double best) {
     char text[160];
@@ -22,6 +26,7 @@ int run_optimise(OptimiseCommandOptions opt) {
     bar.update(static_cast<double>(evaluations) / opt.optimiser.evaluations, text);
   });
   bar.finish();
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   // With noise, the first repeat's noise seed.
   const Episode best = replay(problem.world(), problem.actions(r.best.data()), derive_seed(opt.settings.seed, 0), "dicestack optimise");
   write_episode_set(problem.world(), best, "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method,
@@ -46,7 +51,7 @@ int run_optimise(OptimiseCommandOptions opt) {
 
 }  // namespace
 
-void add_optimise_command(CLI::App& app) {
+void add_optimise_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<OptimiseCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
       "optimise", "Optimise an open-loop action sequence to the goal stack (paper V-B): cmaes, de, basinhop, bayes");
@@ -59,9 +64,9 @@ void add_optimise_command(CLI::App& app) {
   add_problem_options(*cmd, *opt);
   cmd->add_option("--out", opt->out, "Folder for the best sequence (a demonstration set) and optimise.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] {
+  cmd->callback([opt, &cluster] {
     opt->settings.seed = opt->optimiser.seed;
-    run_optimise(*opt);
+    run_optimise(*opt, cluster);
   });
 }
 

@@ -24,14 +24,15 @@ struct RecordOptions {
   bool json = false;
 };
 
-int run_record(const RecordOptions& opt) {
+int run_record(const RecordOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
   std::vector<Episode> eps = record_expert(opt.expert, expert, world, opt.episodes, opt.seed, opt.threads,
-                                         {opt.noise, opt.noise, opt.noise});
+                                         {opt.noise, opt.noise, opt.noise}, cluster);
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int success = 0, stacked = 0, walls = 0;
   double cup = 0.0;
@@ -83,7 +84,7 @@ int run_record(const RecordOptions& opt) {
 
 }  // namespace
 
-void add_record_command(CLI::App& app) {
+void add_record_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<RecordOptions>();
   std::string experts;
   for (const auto& e : expert_list()) experts += "\n  " + e.name + ": " + e.description;
@@ -104,7 +105,7 @@ void add_record_command(CLI::App& app) {
                 "the start, the step and the state)");
   cmd->add_flag("--successes-only", opt->successes_only, "Keep only realistic successes");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] { run_record(*opt); });
+  cmd->callback([opt, &cluster] { run_record(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

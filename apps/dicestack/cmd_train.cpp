@@ -23,10 +23,10 @@ struct TrainOptions {
   bool json = false, resume = false;
 };
 
-int run_train(const TrainOptions& opt) {
+int run_train(const TrainOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   check_replaceable(opt.out, model_ownership());  // refuse a user's file before any work
-  const auto dir = opt.demos.resolve(world);
+  const auto dir = opt.demos.resolve(world, cluster);
   TrainRequest request;
   request.world = world;
   request.demos = read_demo_set(dir).episodes;
@@ -41,6 +41,7 @@ int run_train(const TrainOptions& opt) {
   request.threads = opt.threads;
   request.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
   request.resume = opt.resume;
+  request.cluster = &cluster;
   ProgressBar bar;
   request.progress = [&](const Progress& p) {
     std::string text = opt.learner + " " + opt.regressor + ": iteration " + std::to_string(p.iteration) + "/" +
@@ -52,6 +53,7 @@ int run_train(const TrainOptions& opt) {
   };
   const TrainReport r = train_model(request);
   bar.finish();
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   save_model(*r.result.model, opt.out);
   const std::filesystem::path curve_path = opt.out.string() + ".curve.csv";
   if (!r.result.curve.empty()) write_curve_csv(r.result.curve, curve_path);
@@ -74,7 +76,7 @@ int run_train(const TrainOptions& opt) {
 
 }  // namespace
 
-void add_train_command(CLI::App& app) {
+void add_train_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<TrainOptions>();
   CLI::App* cmd = app.add_subcommand("train", "Train a policy: a learner fits a regressor to demonstrations");
   opt->world.add_to(*cmd);
@@ -98,7 +100,7 @@ void add_train_command(CLI::App& app) {
                   "Folder for an iterative learner's checkpoints (default: MODEL.checkpoint); kept after the run");
   cmd->add_flag("--resume", opt->resume, "Continue from the checkpoint's last finished iteration");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] { run_train(*opt); });
+  cmd->callback([opt, &cluster] { run_train(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

@@ -71,6 +71,10 @@ void DemosOption::add_to(CLI::App& app) {
 
 std::filesystem::path DemosOption::resolve(const WorldConfig& world) const { return resolve_demo_set(path, world); }
 
+std::filesystem::path DemosOption::resolve(const WorldConfig& world, Cluster& cluster) const {
+  return on_root(cluster, [&] { return resolve(world).string(); });
+}
+
 CLI::Validator seed_check() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/world_config.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
@@ -51,6 +52,9 @@ struct DemosOption {
   void add_to(CLI::App& app);
   /// The folder to read (the built-in set is prepared on first use).
   std::filesystem::path resolve(const WorldConfig& world) const;
+  /// The same, resolved by the root alone (which makes the built-in set, once) and given to every
+  /// rank: every rank must see that path (docs/scaling.md). Collective.
+  std::filesystem::path resolve(const WorldConfig& world, Cluster& cluster) const;
 };
 
 }  // namespace dicestack::cli

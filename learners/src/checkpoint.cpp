@@ -183,7 +183,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
 CurvePoint measure_policy(const std::shared_ptr<const Model>& model, const LearnContext& c,
                           const std::vector<Episode>& fallback, int iteration, std::size_t rows) {
   const auto& demos = c.held_out.empty() ? fallback : c.held_out;
-  const Tracking t = track_demos([&] { return std::make_unique<ModelPolicy>(model); }, demos, c.world, c.threads);
+  const Tracking t = track_demos([&] { return std::make_unique<ModelPolicy>(model); }, demos, c.world, c.threads, *c.cluster);
   return {iteration, 0, rows, t.deviation, t.stats.stacked.value, t.stats.realistic_success.value, t.stats.dice_in_cup_mean};
 }
 

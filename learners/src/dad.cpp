@@ -83,14 +83,22 @@ class Dad final : public Learner {
       report("rollouts", 0, 0);
       const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, envs, c.threads);
 
-      std::vector<Correction> fixes(tasks.size());
+      // Every rank cut the same windows (the rollouts are deterministic); the corrections, the
+      // heavy part, are dealt among the ranks by window length and gathered in index order.
       std::atomic<int> finished{0};
+      const int ranks = c.cluster->size();
       const std::uint64_t round_seed = derive_seed(c.seed, 1000003u + static_cast<std::uint64_t>(k));
-      parallel_for(tasks.size(), c.threads, [&](std::size_t i, int w) {
-        fixes[i] = corrector->correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
-        const int done = ++finished;
-        if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
-      });
+      std::vector<double> cost(tasks.size());
+      for (std::size_t i = 0; i < tasks.size(); ++i) cost[i] = static_cast<double>(tasks[i].problem.target.size());
+      const std::vector<Correction> fixes = distributed_map<Correction>(
+          *c.cluster, tasks.size(), c.threads,
+          [&](std::size_t i, int w) {
+            Correction fix = corrector->correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
+            const int done = std::min(static_cast<int>(tasks.size()), ++finished * ranks);
+            if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
+            return fix;
+          },
+          pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
 
       for (std::size_t i = 0; i < tasks.size(); ++i) {
         if (params().boolean("filter") && !(fixes[i].cost < fixes[i].warm_cost)) {
@@ -110,7 +118,7 @@ class Dad final : public Learner {
         best_deviation = point.deviation;
         best_iteration = k;
       }
-      if (!c.checkpoint_dir.empty()) {
+      if (!c.checkpoint_dir.empty() && c.cluster->is_root()) {
         // The best model is named by its iteration and written before the state that names it.
         const std::string best_file = "best-" + std::to_string(best_iteration) + ".model";
         fs::create_directories(c.checkpoint_dir);
@@ -204,6 +212,23 @@ class Dad final : public Learner {
     for (auto& v : per_demo)
       for (auto& t : v) tasks.push_back(std::move(t));
     return tasks;
+  }
+
+  static std::string pack_correction(const Correction& fix) {
+    Packer p;
+    p.put_vector(fix.states).put_vector(fix.actions).put(fix.cost).put(fix.warm_cost).put(fix.evaluations);
+    return p.take();
+  }
+
+  static Correction unpack_correction(std::string_view bytes) {
+    Unpacker u(bytes, "correction");
+    Correction fix;
+    fix.states = u.get_vector<State>();
+    fix.actions = u.get_vector<Action>();
+    fix.cost = u.get<double>();
+    fix.warm_cost = u.get<double>();
+    fix.evaluations = u.get<int>();
+    return fix;
   }
 
   static Episode as_episode(const Correction& fix, const Episode& demo, std::size_t t, int iteration) {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <optional>
@@ -6,6 +7,7 @@
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/datasets/episode_bytes.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/policy.hpp>
@@ -45,24 +47,29 @@ class Dagger final : public Learner {
     std::vector<std::unique_ptr<Expert>> experts(workers);
     for (int i = first; i <= iterations; ++i) {
       const double beta = beta_at(i, iterations);
-      std::vector<Episode> fresh(static_cast<std::size_t>(rollouts));
       std::atomic<int> finished{0};
-      parallel_for(fresh.size(), c.threads, [&](std::size_t k, int w) {
-        auto& expert = experts[static_cast<std::size_t>(w)];
-        if (!expert) expert = make_expert(expert_name, expert_config);
-        fresh[k] = mixture_rollout(envs.at(w), *expert, model.get(), beta,
-                                   training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
-        const int done = ++finished;
-        if (c.progress && w == 0)  // one thread reports
-          c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
-      });
+      const int ranks = c.cluster->size();
+      // Dealt among the ranks, gathered in index order on every rank.
+      std::vector<Episode> fresh = distributed_map<Episode>(
+          *c.cluster, static_cast<std::size_t>(rollouts), c.threads,
+          [&](std::size_t k, int w) {
+            auto& expert = experts[static_cast<std::size_t>(w)];
+            if (!expert) expert = make_expert(expert_name, expert_config);
+            Episode e = mixture_rollout(envs.at(w), *expert, model.get(), beta,
+                                        training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
+            const int done = std::min(rollouts, ++finished * ranks);
+            if (c.progress && w == 0)  // one thread reports
+              c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
+            return e;
+          },
+          [](const Episode& e) { return episode_to_bytes(e); }, [](std::string_view b) { return episode_from_bytes(b); });
       for (auto& e : fresh) data.push_back(std::move(e));
       if (c.progress) c.progress({"fit", i, iterations, 0, 0, 0, 1, static_cast<double>(i) / iterations});
       model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(i)));
       std::size_t rows = 0;
       for (const auto& e : data) rows += e.size();
       result.curve.push_back(measure_policy(model, c, c.demos, i, rows));
-      if (!c.checkpoint_dir.empty())
+      if (!c.checkpoint_dir.empty() && c.cluster->is_root())
         save_checkpoint(c.checkpoint_dir, i,
                         {{"run", run_settings(c, params(), extendable())}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
                         "dagger.json", c, data, "DAgger aggregate after round " + std::to_string(i));

@@ -26,7 +26,7 @@ class Dart final : public Learner {
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
-    auto recorded = record_expert(params().choice("expert"), expert, c.world, episodes, c.seed, c.threads, fraction);
+    auto recorded = record_expert(params().choice("expert"), expert, c.world, episodes, c.seed, c.threads, fraction, *c.cluster);
     int successes = 0;
     const bool successes_only = params().boolean("successes_only");
     for (auto& e : recorded) {

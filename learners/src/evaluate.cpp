@@ -11,6 +11,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
+#include <dicestack/datasets/episode_bytes.hpp>
 
 namespace dicestack {
 
@@ -115,28 +116,65 @@ EvalStats summarise(const std::vector<Episode>& eps, double policy_seconds, doub
 
 }  // namespace
 
+namespace {
+
+// One rollout and the time its policy took, as it travels between ranks.
+struct Timed {
+  Episode episode;
+  double policy_seconds = 0.0;
+};
+
+std::string pack_timed(const Timed& t) {
+  Packer p;
+  pack_episode(p, t.episode);
+  p.put(t.policy_seconds);
+  return p.take();
+}
+
+Timed unpack_timed(std::string_view bytes) {
+  Unpacker u(bytes, "rollout");
+  Timed t;
+  t.episode = unpack_episode(u);
+  t.policy_seconds = u.get<double>();
+  return t;
+}
+
+std::string pack_one(const Episode& e) { return episode_to_bytes(e); }
+Episode unpack_one(std::string_view bytes) { return episode_from_bytes(bytes); }
+
+}  // namespace
+
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
-                   int threads, InitialPush push, std::vector<Episode>* rollouts, const RolloutProgress& progress) {
+                   int threads, InitialPush push, std::vector<Episode>* rollouts, const RolloutProgress& progress,
+                   Cluster& cluster) {
   RolloutOptions options;
   options.push = push;
   const int workers = resolve_threads(threads);
   EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
-  std::vector<double> policy_seconds(static_cast<std::size_t>(workers), 0.0);
-  std::vector<Episode> eps(static_cast<std::size_t>(episodes));
   std::atomic<int> finished{0};
+  const int ranks = cluster.size();
   const auto t0 = std::chrono::steady_clock::now();
-  parallel_for(eps.size(), threads, [&](std::size_t i, int w) {
-    const auto slot = static_cast<std::size_t>(w);
-    if (!policies[slot]) policies[slot] = make_policy();
-    TimedPolicy timed(*policies[slot], policy_seconds[slot]);
-    const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
-    const State start = random_start_state(world, episode_seed);
-    eps[i] = rollout(envs.at(w), timed, start, episode_seed, StepSource::policy, options);
-    if (progress) progress(++finished, episodes);
-  });
+  std::vector<Timed> done = distributed_map<Timed>(
+      cluster, static_cast<std::size_t>(std::max(0, episodes)), threads,
+      [&](std::size_t i, int w) {
+        const auto slot = static_cast<std::size_t>(w);
+        if (!policies[slot]) policies[slot] = make_policy();
+        Timed t;
+        TimedPolicy timed(*policies[slot], t.policy_seconds);
+        const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
+        const State start = random_start_state(world, episode_seed);
+        t.episode = rollout(envs.at(w), timed, start, episode_seed, StepSource::policy, options);
+        if (progress) progress(std::min(episodes, ++finished * ranks), episodes);
+        return t;
+      },
+      pack_timed, unpack_timed);
+  std::vector<Episode> eps(done.size());
   double total_policy = 0.0;
-  for (double s : policy_seconds) total_policy += s;
+  for (std::size_t i = 0; i < done.size(); ++i) {
+    total_policy += done[i].policy_seconds;
+    eps[i] = std::move(done[i].episode);
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EvalStats stats = summarise(eps, total_policy, wall);
   if (rollouts) *rollouts = std::move(eps);
@@ -148,32 +186,34 @@ namespace {
 // Rolls a policy out from every demonstration's first state. Long recordings must not be cut by
 // the time limit; leave two seconds to settle.
 std::vector<Episode> rollouts_from_demos(const std::function<std::unique_ptr<Policy>(std::size_t)>& make_policy,
-                                         const std::vector<Episode>& demos, const WorldConfig& config, int threads) {
+                                         const std::vector<Episode>& demos, const WorldConfig& config, int threads,
+                                         Cluster& cluster) {
   WorldConfig world = config;
   for (const auto& d : demos)
     world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 60);
   EnvPool envs(world, threads);
-  std::vector<Episode> eps(demos.size());
-  parallel_for(demos.size(), threads, [&](std::size_t i, int w) {
-    const auto policy = make_policy(i);
-    eps[i] = rollout(envs.at(w), *policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
-  });
-  return eps;
+  return distributed_map<Episode>(
+      cluster, demos.size(), threads,
+      [&](std::size_t i, int w) {
+        const auto policy = make_policy(i);
+        return rollout(envs.at(w), *policy, demos[i].states.front(), demos[i].seed, StepSource::policy);
+      },
+      pack_one, unpack_one);
 }
 
 }  // namespace
 
-EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads) {
+EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads, Cluster& cluster) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto eps = rollouts_from_demos([&](std::size_t i) { return std::make_unique<PlaybackPolicy>(demos[i]); },
-                                       demos, world, threads);
+                                       demos, world, threads, cluster);
   return summarise(eps, 0.0, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 Tracking track_demos(const PolicyFactory& make_policy, const std::vector<Episode>& demos, const WorldConfig& world,
-                     int threads) {
+                     int threads, Cluster& cluster) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto eps = rollouts_from_demos([&](std::size_t) { return make_policy(); }, demos, world, threads);
+  const auto eps = rollouts_from_demos([&](std::size_t) { return make_policy(); }, demos, world, threads, cluster);
   Tracking t;
   for (std::size_t i = 0; i < demos.size(); ++i) {
     const std::size_t n = std::min(demos[i].size(), eps[i].size());

@@ -7,11 +7,13 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/atomic_file.hpp>
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/open_loop.hpp>
@@ -109,6 +111,59 @@ LeaderboardRow row_from(const json& j) {
   r.us_per_step = j.at("us_per_step");
   return r;
 }
+
+void pack_row(Packer& p, const LeaderboardRow& r) {
+  p.put_string(r.regressor).put_string(r.learner).put_string(r.features);
+  p.put(r.train_error).put(r.test_error).put(r.fit_s).put(r.us_per_step).put(r.dice_in_cup);
+  p.put(r.episodes).put(r.stacked).put(r.walls).put(r.success);
+}
+
+LeaderboardRow unpack_row(Unpacker& u) {
+  LeaderboardRow r;
+  r.regressor = u.get_string();
+  r.learner = u.get_string();
+  r.features = u.get_string();
+  r.train_error = u.get<double>();
+  r.test_error = u.get<double>();
+  r.fit_s = u.get<double>();
+  r.us_per_step = u.get<double>();
+  r.dice_in_cup = u.get<double>();
+  r.episodes = u.get<int>();
+  r.stacked = u.get<int>();
+  r.walls = u.get<int>();
+  r.success = u.get<int>();
+  return r;
+}
+
+}  // namespace
+
+double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
+                          bool paper, int rollouts) {
+  // Seconds on one core, from the measured quick and paper leaderboards (docs/learners.md,
+  // docs/scaling.md). Only the ratios matter: they decide which rank gets which row.
+  if (learner == "baseline") {
+    const double quick = regressor == "bayes" ? 60.0 : regressor == "reinforce" ? 40.0 : regressor == "rrt" ? 20.0 : 30.0;
+    return (paper ? 5.0 : 1.0) * quick + rollouts * 0.01;
+  }
+  auto pick = [](const std::map<std::string, double>& table, const std::string& key, double otherwise) {
+    const auto it = table.find(key);
+    return it == table.end() ? otherwise : it->second;
+  };
+  // One fit on the demonstrations (80 episodes, ~20,000 rows), and the time per policy step.
+  const double fit = pick({{"gbt", 10.0}, {"rbf_svr", 10.0}, {"mlp", 1.0}, {"random_forest", 0.2}, {"knn", 0.01}, {"linear_svr", 0.02}}, regressor, 2.0);
+  double step_us = pick({{"knn", 60.0}, {"rbf_svr", 80.0}, {"gbt", 10.0}}, regressor, 2.0);
+  if (features != "state" && features != "-") step_us *= regressor == "knn" ? 10.0 : 1.5;
+  // What a learner adds: its data relative to the demonstrations (fits grow with it, a kernel
+  // SVR's with its square), its fits, and its own simulation (expert rollouts, corrections).
+  const double rows = pick({{"bc", 1.0}, {"dagger", paper ? 3.0 : 1.5}, {"dart", 3.0}, {"dad", 1.5}}, learner, 2.0);
+  const double fits = pick({{"bc", 1.0}, {"dagger", paper ? 6.0 : 3.0}, {"dart", 1.0}, {"dad", paper ? 31.0 : 3.0}}, learner, 3.0);
+  const double own = pick({{"bc", 0.0}, {"dagger", paper ? 80.0 : 4.0}, {"dart", 2.0}, {"dad", paper ? 400.0 : 20.0}}, learner, 10.0);
+  const double fit_cost = fits * fit * (regressor == "rbf_svr" ? rows * rows : rows);
+  const double rollout_steps = (rollouts + (learner == "dagger" || learner == "dad" ? fits * 16 : 0)) * 300.0;
+  return fit_cost + own + rollout_steps * (step_us + 25.0) * 1e-6;
+}
+
+namespace {
 
 std::string pct(int k, int n) {
   const Rate r = wilson(k, n);
@@ -227,7 +282,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   check_one_of("format", opt.format, {"md", "csv", "latex", "json"});
   if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
   if (opt.seeds < 1) throw ConfigError("leaderboard: seeds must be at least 1, got " + std::to_string(opt.seeds));
-  auto report = [&](const std::string& text, double fraction, bool milestone) {
+  Cluster& cluster = *opt.cluster;
+  std::function<void(const std::string&, double, bool)> report = [&](const std::string& text, double fraction, bool milestone) {
     if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
   };
   auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
@@ -337,23 +393,26 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
                   {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
 
-  // Resume: rows already measured with the same settings are read back.
+  // Resume: rows already measured with the same settings are read back (by the root, which
+  // alone writes the file; the other ranks get its reading).
   const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
-  json done = json::object();
   if (!opt.out.empty()) {  // refuse a user's files before any work
     check_replaceable(opt.out, table_ownership(opt.format));
     check_replaceable(partial, partial_ownership());
   }
-  if (!partial.empty() && std::filesystem::exists(partial)) {
-    try {
-      json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
-      // Rows of another version or other settings are not reused.
-      if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) done = p.value("rows", json::object());
-    } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
+  json done = json::parse(on_root(cluster, [&] {
+    json rows_done = json::object();
+    if (!partial.empty() && std::filesystem::exists(partial)) {
+      try {
+        json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
+        // Rows of another version or other settings are not reused.
+        if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) rows_done = p.value("rows", json::object());
+      } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
+      }
     }
-  }
+    return rows_done.dump();
+  }));
 
-  std::vector<LeaderboardRow> rows;
   // The quick profile leaves out, unless asked for by name, the one row that alone would take
   // longer than the rest: a kernel SVR fitted on DART's ~60,000 rows (200 s; its rows are O(n^2)).
   auto skipped = [&](const std::string& learner, const std::string& regressor) {
@@ -362,70 +421,51 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   const std::size_t total = combos.size() * regressors.size();
   // Progress in units of rows: one per (learner, map, regressor) and per baseline.
   const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
+
+  // The work still to do, in table order: each (learner, map, regressor) row once per training
+  // seed, then each baseline whole (its seeds share one optimisation).
+  struct Job {
+    std::size_t index = 0;  // 1-based place among the learner rows; 0 for a baseline
+    std::string learner, features, regressor, key;
+    int seed = 0;  // which training seed of the row (learner rows)
+    std::size_t baseline = 0;
+  };
+  std::vector<Job> jobs;
   std::size_t index = 0;
-  for (const auto& [learner_name, features] : combos) {
-    const Split& fsplit = split_for(features);
+  for (const auto& [learner_name, features] : combos)
     for (const auto& name : regressors) {
       ++index;
-      if (skipped(learner_name, name)) continue;
       const std::string key = learner_name + "/" + features + "/" + name;
-      if (done.contains(key)) {
-        rows.push_back(row_from(done[key]));
-        continue;
-      }
-      LeaderboardRow row{name, learner_name, features};
-      for (int s = 0; s < opt.seeds; ++s) {
-        const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(s);
-        const std::string row_text = "[" + std::to_string(index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
-        // Where this row and seed stand: training is the first half of a seed's share, rollouts the second.
-        auto at = [&, s](double part) { return (static_cast<double>(index - 1) + (s + part) / opt.seeds) / units; };
-        say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
-        LearnContext c;
-        c.world = world;
-        c.regressor = name;
-        c.features = features;
-        c.seed = seed;
-        c.threads = opt.threads;
-        c.demos = train;
-        c.held_out = held_out;
-        std::string last_phase;
-        c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
-          const std::string phase = std::to_string(p.iteration) + p.phase;
-          const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
-                                   std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
-          report(text, at(0.5 * p.fraction), phase != last_phase);
-          last_phase = phase;
-        };
-        const auto t0 = std::chrono::steady_clock::now();
-        const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
-        row.fit_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / opt.seeds;
-        row.train_error += scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma) / opt.seeds;
-        if (fsplit.test.rows() == 0)
-          row.test_error = -1;  // no test episode: printed "-"
-        else
-          row.test_error += scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma) / opt.seeds;
-        const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
-        say(rollouts_text, at(0.5));
-        std::shared_ptr<const Model> model = learned.model;
-        const EvalStats st = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed,
-                                      opt.threads, InitialPush::none, nullptr, [&](int finished, int of) {
-                                        tick(rollouts_text, at(0.5 + 0.5 * finished / of));
-                                      });
-        add_outcomes(row, st, opt.seeds);
-      }
-      rows.push_back(row);
-      if (!partial.empty()) {
-        done[key] = row_json(row);
-        AtomicFile f(partial, partial_ownership());
-        f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
-        f.commit();
-      }
+      if (!skipped(learner_name, name) && !done.contains(key))
+        for (int s = 0; s < opt.seeds; ++s) jobs.push_back({index, learner_name, features, name, key, s, 0});
     }
-  }
-  // The baselines without demonstrations (paper V), rolled out from the same random starts.
-  for (std::size_t b = 0; b < opt.baselines.size(); ++b) {
-    const std::string& name = opt.baselines[b];
-    say("baseline " + name, static_cast<double>(total + b) / units);
+  for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", 0, b});
+
+  // A learner row's measurements for one training seed; rows add their seeds up in seed order.
+  struct SeedResult {
+    double fit_s = 0.0, train_error = 0.0, test_error = 0.0;
+    bool has_test = false;
+    EvalStats stats;
+  };
+  auto pack_seed = [](const SeedResult& r) {
+    return Packer().put(r.fit_s).put(r.train_error).put(r.test_error).put<std::uint8_t>(r.has_test).put(r.stats).take();
+  };
+  auto unpack_seed = [](std::string_view bytes) {
+    Unpacker u(bytes, "leaderboard seed result");
+    SeedResult r;
+    r.fit_s = u.get<double>();
+    r.train_error = u.get<double>();
+    r.test_error = u.get<double>();
+    r.has_test = u.get<std::uint8_t>() != 0;
+    r.stats = u.get<EvalStats>();
+    return r;
+  };
+
+  // One baseline row, or one seed of a learner row, on this rank alone when several share the
+  // run (`inner` is then the single process); its progress fraction runs from `from` to `from + span`.
+  auto measure_baseline = [&](const Job& job, Cluster& inner, double from, double span) {
+    const std::string& name = job.regressor;
+    say("baseline " + name, from);
     const auto t0 = std::chrono::steady_clock::now();
     const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
     LeaderboardRow row{name, "baseline"};
@@ -434,16 +474,219 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     for (int s = 0; s < opt.seeds; ++s) {
       const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads,
                                     InitialPush::none, nullptr, [&](int finished, int of) {
-                                      const double part = (s + static_cast<double>(finished) / of) / opt.seeds;
-                                      tick("baseline " + name, (static_cast<double>(total + b) + part) / units);
-                                    });
+                                      tick("baseline " + name, from + span * (s + static_cast<double>(finished) / of) / opt.seeds);
+                                    }, inner);
       add_outcomes(row, st, opt.seeds);
     }
-    rows.push_back(row);
+    return row;
+  };
+  auto measure_seed = [&](const Job& job, Cluster& inner, double from, double span) {
+    const std::string& learner_name = job.learner;
+    const std::string& name = job.regressor;
+    const Split& fsplit = split_for(job.features);
+    const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(job.seed);
+    const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
+    // Training is the first half of a seed's share, rollouts the second.
+    auto at = [&](double part) { return from + span * part; };
+    say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
+    LearnContext c;
+    c.world = world;
+    c.regressor = name;
+    c.features = job.features;
+    c.seed = seed;
+    c.threads = opt.threads;
+    c.demos = train;
+    c.held_out = held_out;
+    c.cluster = &inner;
+    std::string last_phase;
+    c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
+      const std::string phase = std::to_string(p.iteration) + p.phase;
+      const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
+                               std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
+      report(text, at(0.5 * p.fraction), phase != last_phase);
+      last_phase = phase;
+    };
+    SeedResult r;
+    const auto t0 = std::chrono::steady_clock::now();
+    const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
+    r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.train_error = scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma);
+    r.has_test = fsplit.test.rows() > 0;
+    if (r.has_test) r.test_error = scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma);
+    const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
+    say(rollouts_text, at(0.5));
+    std::shared_ptr<const Model> model = learned.model;
+    r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed, opt.threads,
+                       InitialPush::none, nullptr, [&](int finished, int of) {
+                         tick(rollouts_text, at(0.5 + 0.5 * finished / of));
+                       }, inner);
+    return r;
+  };
+  // A learner row from its seeds, added up in seed order (the same sums for any deal).
+  auto combine = [&](const Job& job, const std::vector<SeedResult>& seeds) {
+    LeaderboardRow row{job.regressor, job.learner, job.features};
+    for (const SeedResult& r : seeds) {
+      row.fit_s += r.fit_s / opt.seeds;
+      row.train_error += r.train_error / opt.seeds;
+      if (!r.has_test)
+        row.test_error = -1;  // no test episode: printed "-"
+      else
+        row.test_error += r.test_error / opt.seeds;
+      add_outcomes(row, r.stats, opt.seeds);
+    }
+    return row;
+  };
+
+  // Finished rows by their first job; a learner row goes to <out>.partial.json as soon as the
+  // root has all its seeds.
+  std::vector<std::optional<LeaderboardRow>> measured(jobs.size());
+  std::vector<std::optional<SeedResult>> seed_results(jobs.size());
+  std::size_t finished_jobs = 0;
+  auto keep_row = [&](std::size_t j, LeaderboardRow row) {
+    if (!jobs[j].key.empty() && !partial.empty() && cluster.is_root()) {
+      done[jobs[j].key] = row_json(row);
+      AtomicFile f(partial, partial_ownership());
+      f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
+      f.commit();
+    }
+    measured[j] = std::move(row);
+  };
+  // Job j's result (a packed SeedResult or baseline row) has arrived.
+  auto keep = [&](std::size_t j, std::string_view bytes) {
+    ++finished_jobs;
+    if (jobs[j].index == 0) {
+      Unpacker u(bytes, "leaderboard baseline row");
+      keep_row(j, unpack_row(u));
+      return;
+    }
+    seed_results[j] = unpack_seed(bytes);
+    const std::size_t first = j - static_cast<std::size_t>(jobs[j].seed);
+    std::vector<SeedResult> seeds;
+    for (std::size_t k = first; k < first + static_cast<std::size_t>(opt.seeds); ++k) {
+      if (!seed_results[k]) return;  // more seeds to come
+      seeds.push_back(*seed_results[k]);
+    }
+    keep_row(first, combine(jobs[first], seeds));
+  };
+  auto run_job = [&](std::size_t j, Cluster& inner, double from, double span) {
+    if (jobs[j].index == 0) {
+      Packer p;
+      pack_row(p, measure_baseline(jobs[j], inner, from, span));
+      return p.take();
+    }
+    return pack_seed(measure_seed(jobs[j], inner, from, span));
+  };
+  if (cluster.size() == 1) {
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      const double from = jobs[j].index ? static_cast<double>(jobs[j].index - 1) + static_cast<double>(jobs[j].seed) / opt.seeds
+                                        : static_cast<double>(total + jobs[j].baseline);
+      keep(j, run_job(j, cluster, from / units, (jobs[j].index ? 1.0 / opt.seeds : 1.0) / units));
+    }
+  } else {
+    // Several ranks: each job (one seed of a row, or a baseline) runs whole on the rank the deal
+    // gives it (the most expensive first, each to the least loaded rank); a non-root rank sends
+    // each result to the root as it finishes. The root takes them in between (and during) its
+    // own jobs, writes the progress file, and at the end waits for the rest and broadcasts them.
+    std::vector<double> cost(jobs.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j)
+      cost[j] = estimated_row_cost(jobs[j].index ? jobs[j].learner : "baseline", jobs[j].regressor, jobs[j].features,
+                                   paper, jobs[j].index ? episodes : episodes * opt.seeds);
+    const std::vector<int> owner = deal_items(jobs.size(), cluster.size(), cost);
+    const double job_units = static_cast<double>(jobs.size()) + 0.5;
+    {  // the deal, on one line: which rank runs each job, and the estimated load of each rank
+      std::vector<double> load(static_cast<std::size_t>(cluster.size()), 0.0);
+      std::string ranks_of;
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        load[static_cast<std::size_t>(owner[j])] += cost[j];
+        ranks_of += (j ? " " : "") + std::to_string(owner[j]);
+      }
+      std::string loads;
+      for (double l : load) loads += (loads.empty() ? "" : " ") + std::to_string(static_cast<long>(std::lround(l)));
+      say("deal: " + std::to_string(jobs.size()) + " jobs on " + std::to_string(cluster.size()) +
+              " ranks, estimated seconds per rank " + loads + "; rank of each job in table order: " + ranks_of,
+          0.0);
+    }
+    std::vector<std::string> results(jobs.size());
+    auto take_arrivals = [&](bool wait) {
+      for (auto& [from_rank, bytes] : cluster.receive(wait)) {
+        Unpacker u(bytes, "leaderboard result from rank " + std::to_string(from_rank));
+        const auto j = static_cast<std::size_t>(u.get<std::uint64_t>());
+        if (j >= jobs.size() || !results[j].empty())
+          throw Error("leaderboard: rank " + std::to_string(from_rank) + " sent result " + std::to_string(j) + " unexpectedly");
+        results[j] = u.get_string();
+        keep(j, results[j]);
+        say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
+                                 std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
+                           : "baseline " + jobs[j].regressor) +
+                " finished on rank " + std::to_string(from_rank),
+            static_cast<double>(finished_jobs) / job_units);
+      }
+    };
+    std::chrono::steady_clock::time_point last_poll{};
+    std::atomic<bool> polling{false};
+    if (cluster.is_root()) {
+      // While it works on its own jobs, the root looks for other ranks' results at most once a
+      // second, from whichever thread reports (one at a time; not from inside a poll).
+      const auto user_report = report;
+      report = [&, user_report](const std::string& text, double fraction, bool milestone) {
+        user_report(text, fraction, milestone);
+        if (polling.exchange(true)) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_poll > std::chrono::seconds(1)) {
+          last_poll = now;
+          try {
+            take_arrivals(false);
+          } catch (...) {
+            polling = false;
+            throw;
+          }
+        }
+        polling = false;
+      };
+    }
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      if (owner[j] != cluster.rank()) continue;
+      std::string bytes = run_job(j, local_cluster(), static_cast<double>(finished_jobs) / job_units, 1.0 / job_units);
+      if (cluster.is_root()) {
+        results[j] = std::move(bytes);
+        keep(j, results[j]);
+        take_arrivals(false);
+      } else {
+        cluster.send_to_root(Packer().put<std::uint64_t>(j).put_string(bytes).take());
+      }
+    }
+    if (cluster.is_root())
+      while (finished_jobs < jobs.size()) take_arrivals(true);
+    Packer all;
+    if (cluster.is_root())
+      for (const std::string& r : results) all.put_string(r);
+    std::string bytes = all.take();
+    cluster.broadcast(bytes);
+    if (!cluster.is_root()) {
+      Unpacker u(bytes, "leaderboard results from rank 0");
+      for (std::size_t j = 0; j < jobs.size(); ++j) keep(j, u.get_string());
+    }
   }
+
+  // The table in its order: learner rows (measured now or read back), then the baselines.
+  std::vector<LeaderboardRow> rows;
+  std::size_t next = 0;
+  index = 0;
+  for (const auto& [learner_name, features] : combos)
+    for (const auto& name : regressors) {
+      ++index;
+      if (skipped(learner_name, name)) continue;
+      if (next < jobs.size() && jobs[next].index == index) {
+        rows.push_back(*measured[next]);
+        next += static_cast<std::size_t>(opt.seeds);
+      } else {
+        rows.push_back(row_from(done[learner_name + "/" + features + "/" + name]));
+      }
+    }
+  for (; next < jobs.size(); ++next) rows.push_back(*measured[next]);
   // Playback of the demonstrations themselves (paper VI-A), for reference.
   say("playback of the demonstrations", (units - 0.5) / units);
-  const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads);
+  const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads, cluster);
   LeaderboardRow playback{"(demonstrations)", "playback"};
   playback.train_error = playback.test_error = -1;
   playback.episodes = pb.episodes;

@@ -41,8 +41,9 @@ std::unique_ptr<Learner> LearnerRegistry::create(std::string_view name, const st
 
 std::vector<std::string> LearnerRegistry::names() const { return registered_names(entries_); }
 
-std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
-  if (data.empty()) throw InputError("no demonstrations to learn from");
+namespace {
+
+std::shared_ptr<Model> fit_here(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
   const FeatureMap& features = feature_map(c.features);
   const Dataset d = make_dataset(data, features);
   auto model = std::make_shared<Model>(
@@ -51,6 +52,20 @@ std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episod
   model->record["rows"] = std::to_string(d.rows());
   model->record["episodes"] = std::to_string(d.episodes());
   model->record["seed"] = std::to_string(seed);
+  return model;
+}
+
+}  // namespace
+
+std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
+  if (data.empty()) throw InputError("no demonstrations to learn from");
+  if (c.cluster->size() == 1) return fit_here(c, data, seed);
+  std::shared_ptr<Model> model;
+  const std::string bytes = on_root(*c.cluster, [&] {
+    model = fit_here(c, data, seed);
+    return model_to_bytes(*model);
+  });
+  if (!model) model = std::make_shared<Model>(parse_model_file(bytes, "model broadcast by rank 0", *c.registry));
   return model;
 }
 

@@ -8,13 +8,14 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/data_paths.hpp>
+#include <dicestack/datasets/episode_bytes.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/policy.hpp>
 
 namespace dicestack {
 
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads, const Action& noise) {
+                                   int episodes, std::uint64_t seed, int threads, const Action& noise, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
   RolloutOptions options;
   for (std::size_t k = 0; k < kActionDim; ++k) {
@@ -26,19 +27,21 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
   EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Expert>> experts(workers);
-  std::vector<Episode> out(static_cast<std::size_t>(std::max(0, episodes)));
-  parallel_for(out.size(), threads, [&](std::size_t i, int w) {
-    DiceEnv& env = envs.at(w);
-    auto& expert = experts[static_cast<std::size_t>(w)];
-    if (!expert) expert = make_expert(name, config);
-    const std::uint64_t s = training_start_seed(seed, i);
-    ExpertPolicy policy(*expert, env);
-    RolloutOptions o = options;
-    o.noise_seed = derive_seed(s, 2);
-    out[i] = rollout(env, policy, random_start_state(world, s), s, StepSource::expert, o);
-    out[i].origin = "expert " + name;
-  });
-  return out;
+  return distributed_map<Episode>(
+      cluster, static_cast<std::size_t>(std::max(0, episodes)), threads,
+      [&](std::size_t i, int w) {
+        DiceEnv& env = envs.at(w);
+        auto& expert = experts[static_cast<std::size_t>(w)];
+        if (!expert) expert = make_expert(name, config);
+        const std::uint64_t s = training_start_seed(seed, i);
+        ExpertPolicy policy(*expert, env);
+        RolloutOptions o = options;
+        o.noise_seed = derive_seed(s, 2);
+        Episode e = rollout(env, policy, random_start_state(world, s), s, StepSource::expert, o);
+        e.origin = "expert " + name;
+        return e;
+      },
+      [](const Episode& e) { return episode_to_bytes(e); }, [](std::string_view b) { return episode_from_bytes(b); });
 }
 
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {

@@ -41,6 +41,7 @@ TrainReport train_model(const TrainRequest& request) {
   c.checkpoint_dir = request.checkpoint_dir;
   c.resume = request.resume;
   c.progress = request.progress;
+  c.cluster = request.cluster;
 
   TrainReport report;
   report.features = features.name();

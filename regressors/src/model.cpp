@@ -156,17 +156,11 @@ Matrix Model::predict(const Matrix& rows) const {
 
 Ownership model_ownership() { return Ownership::json_first_line("dicestack model file", kModelFormat); }
 
-void save_model(const Model& model, const std::filesystem::path& path) {
+namespace {
+
+// The model file's first line: its JSON header, which describes `payload`.
+std::string model_header(const Model& model, const std::string& payload) {
   const Regressor& r = model.regressor();
-  const auto* pickled = dynamic_cast<const PickledRegressor*>(&r);
-  std::string payload, pickle;
-  if (pickled) {
-    if (!r.fitted()) throw InputError(r.name() + ": cannot save a model that was never fitted");
-    pickle = pickled->pickle();  // once: the payload describes exactly these bytes
-    payload = pickled_record(pickle, pickled->object_type()).dump();
-  } else {
-    payload = r.save_payload();
-  }
   json params = json::object();
   for (const auto& [k, v] : r.params().as_text()) params[k] = v;
   json header{{"format", kModelFormat},
@@ -188,6 +182,29 @@ void save_model(const Model& model, const std::filesystem::path& path) {
                     {"payload_bytes", payload.size()},
                     {"payload_fnv1a", fnv1a_hex(payload)}};
   header["checksum"] = whole_checksum(header, payload);
+  return header.dump();
+}
+
+}  // namespace
+
+std::string model_to_bytes(const Model& model) {
+  if (dynamic_cast<const PickledRegressor*>(&model.regressor()))
+    throw InputError(model.regressor().name() + ": a Python regressor's model cannot travel between MPI ranks");
+  const std::string payload = model.regressor().save_payload();
+  return model_header(model, payload) + '\n' + payload;
+}
+
+void save_model(const Model& model, const std::filesystem::path& path) {
+  const Regressor& r = model.regressor();
+  const auto* pickled = dynamic_cast<const PickledRegressor*>(&r);
+  std::string payload, pickle;
+  if (pickled) {
+    if (!r.fitted()) throw InputError(r.name() + ": cannot save a model that was never fitted");
+    pickle = pickled->pickle();  // once: the payload describes exactly these bytes
+    payload = pickled_record(pickle, pickled->object_type()).dump();
+  } else {
+    payload = r.save_payload();
+  }
   // Both outputs are checked before either is written. The pickle is committed first, so that
   // a model file never names a pickle that is not there.
   const std::filesystem::path pkl = pickle_path(path);
@@ -196,7 +213,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
   AtomicFile file(path, model_ownership());
   std::error_code ec;
   const bool stale_pickle = !pickled && std::filesystem::is_regular_file(pkl, ec) && pickle_ownership(path).recognises(pkl);
-  file.stream() << header.dump() << '\n' << payload;
+  file.stream() << model_header(model, payload) << '\n' << payload;
   if (pickle_file) {
     pickle_file->stream() << pickle;
     pickle_file->commit();

@@ -56,7 +56,13 @@ std::vector<double> SequenceEvaluator::costs(const ActionSequenceProblem& proble
     out[i] = problem.cost(env, row.data());
   };
   if (pool_) {
-    parallel_for(out.size(), threads_, [&](std::size_t i, int w) { one(i, pool_->at(w)); });
+    out = distributed_map<double>(
+        *cluster_, out.size(), threads_,
+        [&](std::size_t i, int w) {
+          const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
+          return problem.cost(pool_->at(w), row.data());
+        },
+        [](const double& v) { return Packer().put(v).take(); }, [](std::string_view b) { return Unpacker(b, "cost").get<double>(); });
   } else {
     for (std::size_t i = 0; i < out.size(); ++i) one(i, *env_);
   }

@@ -13,7 +13,7 @@
 
 namespace dicestack {
 
-OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads)
+OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads, Cluster& cluster)
     : world_(world), settings_(settings) {
   validate(world_);
   if (settings.steps < 1) throw ConfigError("open-loop steps must be at least 1, got " + std::to_string(settings.steps));
@@ -23,7 +23,7 @@ OpenLoopProblem::OpenLoopProblem(const WorldConfig& world, const OpenLoopSetting
   goal_ = goal_state(world_);
   envs_.emplace(world_, threads);
   sequence_.emplace(world_, settings.steps, ActionBox::unit, [this](DiceEnv& env, const std::vector<Action>& a) { return run(env, a); });
-  evaluator_.emplace(*envs_, threads);
+  evaluator_.emplace(*envs_, threads, cluster);
 }
 
 std::vector<Action> OpenLoopProblem::actions(const double* x) const { return sequence_->actions(x); }

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/policy.hpp>
@@ -70,12 +71,18 @@ using RolloutProgress = std::function<void(int finished, int total)>;
 
 /// Rolls a policy out from `episodes` random starts (evaluation_start_seed(seed, i)), in parallel
 /// on `threads` threads with one world each; the result does not depend on the thread count.
+/// Collective over `cluster`: the rollouts are dealt round-robin among its ranks and gathered
+/// in index order, so every rank gets the same result for any number of ranks (timings aside:
+/// policy_us_per_step sums every rank's policy time, seconds is this rank's wall time).
+/// `progress` counts this rank's rollouts, scaled to the whole.
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
                    int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr,
-                   const RolloutProgress& progress = {});
+                   const RolloutProgress& progress = {}, Cluster& cluster = local_cluster());
 
-/// Replays every demonstration's actions from its own first state (paper VI-A).
-EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads);
+/// Replays every demonstration's actions from its own first state (paper VI-A). Collective over
+/// `cluster`, like evaluate.
+EvalStats evaluate_playback(const std::vector<Episode>& demos, const WorldConfig& world, int threads,
+                            Cluster& cluster = local_cluster());
 
 /// How a policy follows demonstrations when started from each one's first state.
 struct Tracking {
@@ -85,7 +92,8 @@ struct Tracking {
 
 /// Rolls `policy` out from every demonstration's first state (in parallel, one world per
 /// thread; the time limit stretched to cover the longest) and compares with the demonstration.
+/// Collective over `cluster`, like evaluate.
 Tracking track_demos(const PolicyFactory& make_policy, const std::vector<Episode>& demos, const WorldConfig& world,
-                     int threads);
+                     int threads, Cluster& cluster = local_cluster());
 
 }  // namespace dicestack

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/world_config.hpp>
 
 namespace dicestack {
@@ -37,7 +38,20 @@ struct LeaderboardRequest {
   /// they come, so that a rerun with the same settings resumes.
   std::filesystem::path out;
   std::string format = "md";  ///< the table's format at `out`: md, csv, latex or json
+  /// The ranks that share the run (issue 17, docs/scaling.md). Every rank calls run_leaderboard
+  /// with the same request; each training seed of a row (and each baseline) is trained and
+  /// rolled out whole on one rank (dealt by estimated_row_cost, longest first), the root writes
+  /// <out>.partial.json as rows complete, and every rank returns the same table, identical to a
+  /// single process's but for the timings.
+  Cluster* cluster = &local_cluster();
 };
+
+/// A row's estimated cost in seconds on one core (learner "baseline" for a baseline row, with
+/// its name as `regressor`), from measured leaderboards: how rows are dealt among ranks. Only
+/// the ratios matter. `rollouts`: the evaluation rollouts of the work dealt (one training seed of
+/// a learner row; all seeds of a baseline).
+double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
+                          bool paper, int rollouts);
 
 /// One row of the table. Negative errors and times mean "none" (printed "-").
 struct LeaderboardRow {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/world_config.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/regressors/model.hpp>
@@ -55,6 +56,10 @@ struct LearnContext {
   std::function<void(const Progress&)> progress;  ///< may be empty
   std::filesystem::path checkpoint_dir;      ///< empty: no checkpoints
   bool resume = false;                       ///< continue from checkpoint_dir's last iteration
+  /// The ranks that share the work (issue 17): rollouts and corrections are dealt among them,
+  /// the root refits and broadcasts the model, only the root writes checkpoints. Every rank runs
+  /// learn() with the same context; the result is the same on each and for any number of ranks.
+  Cluster* cluster = &local_cluster();
 };
 
 struct LearnResult {
@@ -102,7 +107,8 @@ class LearnerRegistry {
 };
 
 /// Fits `context.regressor` on every step of `data`, each seen through `context.features`:
-/// behaviour cloning's one step.
+/// behaviour cloning's one step. Collective over context.cluster: the root fits, the others
+/// receive its model file's bytes (so every rank acts with the very same model).
 std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed);
 
 }  // namespace dicestack

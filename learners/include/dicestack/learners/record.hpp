@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
@@ -15,8 +16,11 @@ namespace dicestack {
 /// executed actions are perturbed as DART does and the expert's clean actions are recorded.
 /// Returns every episode, successes and failures, each with its outcome; the result does not
 /// depend on the thread count. Throws ConfigError for an unknown expert or a negative noise.
+/// Collective over `cluster`: episodes dealt round-robin among its ranks, every rank gets all of
+/// them in index order, the same for any number of ranks.
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads, const Action& noise = {0.0, 0.0, 0.0});
+                                   int episodes, std::uint64_t seed, int threads, const Action& noise = {0.0, 0.0, 0.0},
+                                   Cluster& cluster = local_cluster());
 
 /// Seed and size of the built-in set.
 inline constexpr std::uint64_t kBuiltinSeed = 2026;

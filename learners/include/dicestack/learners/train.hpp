@@ -36,6 +36,8 @@ struct TrainRequest {
   std::filesystem::path checkpoint_dir;     ///< empty: no checkpoints
   bool resume = false;
   std::function<void(const Progress&)> progress;  ///< may be empty
+  /// The ranks that share the work (LearnContext::cluster); the same model on every rank.
+  Cluster* cluster = &local_cluster();
 };
 
 /// What came out: the model (its record filled in), its learning curve and errors.

@@ -105,6 +105,10 @@ Ownership model_ownership();
 /// existing file there); saving another model over a pickled one removes the old pickle.
 void save_model(const Model& model, const std::filesystem::path& path);
 
+/// The bytes save_model would write for `model` (not pickled: InputError), as one string: how a
+/// model refitted on the root reaches the other ranks of a Cluster (parse_model_file reads it).
+std::string model_to_bytes(const Model& model);
+
 /// Reads a model file (any version up to kModelFormatVersion), checking format, version,
 /// regressor (registered?), parameters, feature map (known, same version, same width as the
 /// regressor's input), dimensions, standardisers, payload size and checksum.

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -51,12 +52,15 @@ class ActionSequenceProblem {
 
 /// The scratch worlds a search evaluates in, and its count of evaluations: one environment
 /// (every evaluation on the calling thread), or a pool whose environments evaluate a CMA-ES
-/// generation in parallel. Results do not depend on which, nor on the thread count.
+/// generation in parallel, dealt among the ranks of `cluster` too (then every rank runs the
+/// same search and calls the same methods in the same order). Results do not depend on which,
+/// nor on the thread or rank count.
 class SequenceEvaluator {
  public:
   explicit SequenceEvaluator(DiceEnv& env) : env_(&env) {}
   /// `threads` as parallel_for takes it; `pool` must hold that many environments.
-  SequenceEvaluator(EnvPool& pool, int threads) : pool_(&pool), threads_(threads) {}
+  SequenceEvaluator(EnvPool& pool, int threads, Cluster& cluster = local_cluster())
+      : pool_(&pool), threads_(threads), cluster_(&cluster) {}
 
   double cost(const ActionSequenceProblem& problem, const double* x);
   /// Every row of `xs` (one candidate per row).
@@ -69,6 +73,7 @@ class SequenceEvaluator {
   DiceEnv* env_ = nullptr;
   EnvPool* pool_ = nullptr;
   int threads_ = 1;
+  Cluster* cluster_ = nullptr;
   int evaluations_ = 0;
 };
 

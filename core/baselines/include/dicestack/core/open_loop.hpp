@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <dicestack/core/action_sequence.hpp>
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -31,8 +32,11 @@ struct OpenLoopSettings {
 /// not depend on the thread count.
 class OpenLoopProblem {
  public:
-  /// Throws ConfigError for a bad world or settings.
-  OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads = 0);
+  /// Throws ConfigError for a bad world or settings. With several ranks in `cluster`, every rank
+  /// makes the same problem and calls the same methods in the same order: cost_batch deals its
+  /// rows among the ranks (docs/scaling.md); cost() runs on each rank.
+  OpenLoopProblem(const WorldConfig& world, const OpenLoopSettings& settings, int threads = 0,
+                  Cluster& cluster = local_cluster());
   OpenLoopProblem(const OpenLoopProblem&) = delete;  // its sequence's cost refers to it
   OpenLoopProblem& operator=(const OpenLoopProblem&) = delete;
 
@@ -41,7 +45,7 @@ class OpenLoopProblem {
   std::vector<Action> actions(const double* x) const;
   /// One evaluation on the calling thread's world 0 (for sequential optimisers).
   double cost(const double* x);
-  /// Every row of `xs` (lambda x dim), in parallel.
+  /// Every row of `xs` (lambda x dim), in parallel (collective over the cluster).
   std::vector<double> cost_batch(const Eigen::MatrixXd& xs);
   int evaluations() const;
   /// The problem as minimise() takes it, and the pool it evaluates in.
