@@ -624,6 +624,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     };
     std::chrono::steady_clock::time_point last_poll{};
     std::atomic<bool> polling{false};
+    const auto plain_report = report;  // restored below: the polling report refers to this block's locals
     if (cluster.is_root()) {
       // While it works on its own jobs, the root looks for other ranks' results at most once a
       // second, from whichever thread reports (one at a time; not from inside a poll).
@@ -666,6 +667,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
       Unpacker u(bytes, "leaderboard results from rank 0");
       for (std::size_t j = 0; j < jobs.size(); ++j) keep(j, u.get_string());
     }
+    report = plain_report;
   }
 
   // The table in its order: learner rows (measured now or read back), then the baselines.

@@ -38,8 +38,11 @@ TEST(Cluster, LongestFirstDealBalancesUnevenCosts) {
   const std::vector<double> cost{1, 1, 100, 1, 1, 1, 1};
   const auto owner = deal_items(cost.size(), 2, cost);
   EXPECT_EQ(owner[2], 0);
-  for (std::size_t i = 0; i < cost.size(); ++i)
-    if (i != 2) EXPECT_EQ(owner[i], 1) << i;
+  for (std::size_t i = 0; i < cost.size(); ++i) {
+    if (i != 2) {
+      EXPECT_EQ(owner[i], 1) << i;
+    }
+  }
   // Greedy LPT on a textbook case: loads 12 and 11 (optimal 11.5 is not reachable).
   const std::vector<double> c2{5, 4, 3, 3, 3, 2, 3};
   const auto o2 = deal_items(c2.size(), 2, c2);
