@@ -41,7 +41,9 @@ int main() {
   return world.state()[0] > 0.0 && none.dims() == 0 ? 0 : 1;
 }
 CPP
-cmake -S "$work/consumer" -B "$work/consumer/build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_BUILD_TYPE=Release > /dev/null
+# DICESTACK_CONSUMER_CXX_FLAGS: set by CTest in the sanitizer build, whose libraries need ASan's runtime.
+cmake -S "$work/consumer" -B "$work/consumer/build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_CXX_FLAGS="${DICESTACK_CONSUMER_CXX_FLAGS:-}" > /dev/null
 cmake --build "$work/consumer/build" > /dev/null
 "$work/consumer/build/consumer" || { echo "FAIL: a program built against the installed targets did not run"; exit 1; }
 cmake -S "$source_dir/examples/ridge_plugin" -B "$work/plugin" -DCMAKE_PREFIX_PATH="$work/prefix" \
