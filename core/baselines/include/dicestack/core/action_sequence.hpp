@@ -79,8 +79,8 @@ class SequenceEvaluator {
 
 struct MinimiseOptions {
   std::string method = "cmaes";  ///< minimiser_names()
-  /// Budget in cost evaluations; 0: `iterations` decides. CMA-ES stops before a generation that
-  /// would exceed it only once it is spent; DE runs whole generations while one fits.
+  /// Budget in cost evaluations; 0: `iterations` decides. CMA-ES stops once it is spent (its
+  /// last generation may pass it); DE runs whole generations while one still fits.
   int evaluations = 0;
   /// Generations of CMA-ES and DE; basin hopping and Bayesian optimisation, which have none,
   /// get iterations x population evaluations. Used when `evaluations` is 0.
