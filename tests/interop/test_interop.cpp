@@ -16,6 +16,7 @@
 #include <dicestack/interop/interop.hpp>
 #include <dicestack/learners/record.hpp>
 
+#include <dicestack/test/episodes.hpp>
 #include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
@@ -67,22 +68,7 @@ void expect_same(const DemoSet& a, const DemoSet& b) {
   EXPECT_EQ(a.provenance, b.provenance);
   ASSERT_EQ(a.episodes.size(), b.episodes.size());
   for (std::size_t i = 0; i < a.episodes.size(); ++i) {
-    const Episode &x = a.episodes[i], &y = b.episodes[i];
-    SCOPED_TRACE(x.name);
-    EXPECT_EQ(x.name, y.name);
-    EXPECT_EQ(x.seed, y.seed);
-    EXPECT_EQ(x.origin, y.origin);
-    EXPECT_EQ(x.states, y.states);
-    EXPECT_EQ(x.actions, y.actions);
-    EXPECT_EQ(x.sources, y.sources);
-    EXPECT_EQ(x.final_state, y.final_state);
-    EXPECT_EQ(x.rewards, y.rewards);
-    EXPECT_EQ(x.terminated, y.terminated);
-    EXPECT_EQ(x.truncated, y.truncated);
-    EXPECT_EQ(x.outcome.steps, y.outcome.steps);
-    EXPECT_EQ(x.outcome.dice_in_cup, y.outcome.dice_in_cup);
-    EXPECT_EQ(x.outcome.stacked, y.outcome.stacked);
-    EXPECT_EQ(x.outcome.wall_contact, y.outcome.wall_contact);
+    test::expect_same_episode(a.episodes[i], b.episodes[i]);
   }
 }
 

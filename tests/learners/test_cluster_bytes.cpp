@@ -5,6 +5,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 #include <dicestack/regressors/model.hpp>
+#include <dicestack/test/episodes.hpp>
 
 namespace dicestack {
 namespace {
@@ -22,21 +23,7 @@ TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
   eps[1].rewards.clear();
   eps[1].name = "episode_0001";
   for (const Episode& e : eps) {
-    const Episode back = episode_from_bytes(episode_to_bytes(e));
-    EXPECT_EQ(back.name, e.name);
-    EXPECT_EQ(back.seed, e.seed);
-    EXPECT_EQ(back.states, e.states);
-    EXPECT_EQ(back.actions, e.actions);
-    EXPECT_EQ(back.sources, e.sources);
-    EXPECT_EQ(back.origin, e.origin);
-    EXPECT_EQ(back.final_state, e.final_state);
-    EXPECT_EQ(back.rewards, e.rewards);
-    EXPECT_EQ(back.terminated, e.terminated);
-    EXPECT_EQ(back.truncated, e.truncated);
-    EXPECT_EQ(back.outcome.steps, e.outcome.steps);
-    EXPECT_EQ(back.outcome.dice_in_cup, e.outcome.dice_in_cup);
-    EXPECT_EQ(back.outcome.stacked, e.outcome.stacked);
-    EXPECT_EQ(back.outcome.wall_contact, e.outcome.wall_contact);
+    test::expect_same_episode(episode_from_bytes(episode_to_bytes(e)), e);
   }
   EXPECT_THROW(episode_from_bytes(episode_to_bytes(eps[0]).substr(0, 100)), Error);
 }

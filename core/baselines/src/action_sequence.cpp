@@ -13,7 +13,6 @@
 
 #include <dicestack/core/cmaes.hpp>
 #include <dicestack/core/error.hpp>
-#include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
 
 namespace dicestack {
@@ -50,23 +49,20 @@ double SequenceEvaluator::cost(const ActionSequenceProblem& problem, const doubl
 }
 
 std::vector<double> SequenceEvaluator::costs(const ActionSequenceProblem& problem, const Eigen::MatrixXd& xs) {
-  std::vector<double> out(static_cast<std::size_t>(xs.rows()));
-  auto one = [&](std::size_t i, DiceEnv& env) {
+  const auto row_cost = [&](std::size_t i, DiceEnv& env) {
     const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
-    out[i] = problem.cost(env, row.data());
+    return problem.cost(env, row.data());
   };
+  const auto n = static_cast<std::size_t>(xs.rows());
+  std::vector<double> out(n);
   if (pool_) {
     out = distributed_map<double>(
-        *cluster_, out.size(), threads_,
-        [&](std::size_t i, int w) {
-          const Eigen::VectorXd row = xs.row(static_cast<Eigen::Index>(i)).transpose();
-          return problem.cost(pool_->at(w), row.data());
-        },
+        *cluster_, n, threads_, [&](std::size_t i, int w) { return row_cost(i, pool_->at(w)); },
         [](const double& v) { return Packer().put(v).take(); }, [](std::string_view b) { return Unpacker(b, "cost").get<double>(); });
   } else {
-    for (std::size_t i = 0; i < out.size(); ++i) one(i, *env_);
+    for (std::size_t i = 0; i < n; ++i) out[i] = row_cost(i, *env_);
   }
-  evaluations_ += static_cast<int>(out.size());
+  evaluations_ += static_cast<int>(n);
   return out;
 }
 
