@@ -2,11 +2,13 @@
 // stepped in C++ on all cores with the GIL released, autoreset on the next step).
 #include <algorithm>
 #include <atomic>
+#include <optional>
 #include <vector>
 
 #include <pybind11/stl.h>
 
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/core/worker_pool.hpp>
 #include <dicestack/core/render.hpp>
 
 #include "bindings.hpp"
@@ -91,17 +93,95 @@ struct SlotResult {
   StepInfo info;
 };
 
+/// The arrays a vector reset or step returns: made on the calling thread (they are Python
+/// objects) while the workers step, filled from the slots afterwards.
+class BatchArrays {
+ public:
+  explicit BatchArrays(std::size_t n)
+      : n_(n),
+        observations_({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(kStateDim)}),
+        rewards_(static_cast<py::ssize_t>(n)),
+        terminated_(static_cast<py::ssize_t>(n)),
+        truncated_(static_cast<py::ssize_t>(n)) {
+    // Gymnasium's vector info: one array per key, and a "_key" mask of the environments that
+    // report it (all of them, always).
+    column("t", columns_.t);
+    column("distance", columns_.distance);
+    column("wall_contact_step", columns_.wall_contact_step);
+    column("dice_in_cup", columns_.dice_in_cup);
+    column("dice_in_cup_now", columns_.dice_in_cup_now);
+    column("stacked", columns_.stacked);
+    column("stacked_steps", columns_.stacked_steps);
+    column("wall_contact", columns_.wall_contact);
+    column("realistic_success", columns_.realistic_success);
+  }
+
+  void fill(const std::vector<SlotResult>& slots) {
+    double* obs = observations_.mutable_data();
+    for (std::size_t i = 0; i < n_; ++i) {
+      const SlotResult& r = slots[i];
+      obs = std::copy(r.observation.begin(), r.observation.end(), obs);
+      rewards_.mutable_data()[i] = r.reward;
+      terminated_.mutable_data()[i] = r.terminated;
+      truncated_.mutable_data()[i] = r.truncated;
+      columns_.t[i] = r.info.t;
+      columns_.distance[i] = r.info.distance;
+      columns_.wall_contact_step[i] = r.info.wall_contact_step;
+      columns_.dice_in_cup[i] = r.info.outcome.dice_in_cup;
+      columns_.dice_in_cup_now[i] = r.info.outcome.dice_in_cup_now;
+      columns_.stacked[i] = r.info.outcome.stacked;
+      columns_.stacked_steps[i] = r.info.outcome.stacked_steps;
+      columns_.wall_contact[i] = r.info.outcome.wall_contact;
+      columns_.realistic_success[i] = r.info.outcome.realistic_success();
+    }
+  }
+
+  py::tuple reset_tuple() const { return py::make_tuple(observations_, infos_); }
+  py::tuple step_tuple() const { return py::make_tuple(observations_, rewards_, terminated_, truncated_, infos_); }
+
+ private:
+  struct Columns {
+    std::int64_t* t = nullptr;
+    double* distance = nullptr;
+    bool* wall_contact_step = nullptr;
+    std::int64_t* dice_in_cup = nullptr;
+    std::int64_t* dice_in_cup_now = nullptr;
+    bool* stacked = nullptr;
+    std::int64_t* stacked_steps = nullptr;
+    bool* wall_contact = nullptr;
+    bool* realistic_success = nullptr;
+  };
+
+  template <class T>
+  void column(const char* key, T*& data) {
+    py::array_t<T> values(static_cast<py::ssize_t>(n_));
+    py::array_t<bool> mask(static_cast<py::ssize_t>(n_));
+    std::fill_n(mask.mutable_data(), n_, true);
+    data = values.mutable_data();
+    infos_[key] = values;
+    infos_[py::str(std::string("_") + key)] = mask;
+  }
+
+  std::size_t n_;
+  py::array_t<double> observations_;
+  py::array_t<double> rewards_;
+  py::array_t<bool> terminated_, truncated_;
+  py::dict infos_;
+  Columns columns_;
+};
+
 /// N environments, autoreset "next-step" (Gymnasium 1.x's default): the step after an episode
 /// ended resets that environment and returns its first observation with reward 0 and
 /// terminated = truncated = False.
 class VectorEnv {
  public:
-  VectorEnv(const WorldConfig& world, int num_envs, int threads) : threads_(threads) {
+  VectorEnv(const WorldConfig& world, int num_envs, int threads)
+      : pool_(std::min(resolve_threads(threads), std::max(num_envs, 1))) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
     envs_.reserve(static_cast<std::size_t>(num_envs));
     for (int i = 0; i < num_envs; ++i) envs_.emplace_back(world);
     done_.assign(envs_.size(), 0);
-    results_.resize(envs_.size());
+    slots_.resize(envs_.size());
   }
 
   std::size_t size() const { return envs_.size(); }
@@ -110,14 +190,14 @@ class VectorEnv {
     if (seeds.size() != envs_.size())
       throw py::value_error("reset needs one seed (or None) per environment: " + std::to_string(envs_.size()) +
                             ", got " + std::to_string(seeds.size()));
-    run([&](std::size_t i) {
-      SlotResult& r = results_[i];
+    const BatchArrays out = run([&](std::size_t i) {
+      SlotResult& r = slots_[i];
       r = SlotResult{};
       r.observation = envs_[i].reset(seeds[i]);
       r.info = envs_[i].info();
       done_[i] = 0;
     });
-    return py::make_tuple(observations(), infos());
+    return out.reset_tuple();
   }
 
   py::tuple step(const py::handle& action_rows) {
@@ -126,8 +206,8 @@ class VectorEnv {
       throw py::value_error("actions must have shape (" + std::to_string(envs_.size()) + ", 3), got " +
                             std::to_string(actions.size()) + " rows");
     for (std::size_t i = 0; i < actions.size(); ++i) require_finite(actions[i], "action of environment " + std::to_string(i));
-    run([&](std::size_t i) {
-      SlotResult& r = results_[i];
+    const BatchArrays out = run([&](std::size_t i) {
+      SlotResult& r = slots_[i];
       if (done_[i]) {
         r = SlotResult{};
         r.observation = envs_[i].reset(std::nullopt);
@@ -139,70 +219,36 @@ class VectorEnv {
       r = {s.observation, s.reward, s.terminated, s.truncated, s.info};
       done_[i] = s.terminated || s.truncated;
     });
-    const auto n = static_cast<py::ssize_t>(envs_.size());
-    py::array_t<double> rewards(n);
-    py::array_t<bool> terminated(n), truncated(n);
-    for (std::size_t i = 0; i < envs_.size(); ++i) {
-      rewards.mutable_data()[i] = results_[i].reward;
-      terminated.mutable_data()[i] = results_[i].terminated;
-      truncated.mutable_data()[i] = results_[i].truncated;
-    }
-    return py::make_tuple(observations(), rewards, terminated, truncated, infos());
+    return out.step_tuple();
   }
 
  private:
-  // Runs fn(i) for every environment on the worker threads, without the GIL; one call at a time.
+  // Runs fn(i) for every environment on the pool's threads, without the GIL, while this thread
+  // makes the arrays to return; one call at a time.
   template <class Fn>
-  void run(Fn&& fn) {
+  BatchArrays run(Fn&& fn) {
     if (busy_.exchange(true)) throw std::logic_error("DiceStackVectorEnv: reset or step called from two threads at once");
     struct Release {
       std::atomic<bool>& flag;
       ~Release() { flag = false; }
     } release{busy_};
-    py::gil_scoped_release nogil;
-    parallel_for(envs_.size(), threads_, [&](std::size_t i, int) { fn(i); });
-  }
-
-  py::array_t<double> observations() const {
-    py::array_t<double> out({static_cast<py::ssize_t>(envs_.size()), static_cast<py::ssize_t>(kStateDim)});
-    double* p = out.mutable_data();
-    for (const auto& r : results_) p = std::copy(r.observation.begin(), r.observation.end(), p);
-    return out;
-  }
-
-  // Gymnasium's vector info: one array per key, and a "_key" mask of the environments that
-  // report it (all of them, always).
-  py::dict infos() const {
-    const auto n = static_cast<py::ssize_t>(envs_.size());
-    py::dict out;
-    auto column = [&](const char* key, auto value_of) {
-      using T = decltype(value_of(results_[0]));
-      py::array_t<T> values(n);
-      py::array_t<bool> mask(n);
-      for (std::size_t i = 0; i < results_.size(); ++i) {
-        values.mutable_data()[i] = value_of(results_[i]);
-        mask.mutable_data()[i] = true;
-      }
-      out[key] = values;
-      out[py::str(std::string("_") + key)] = mask;
-    };
-    column("t", [](const SlotResult& r) { return std::int64_t{r.info.t}; });
-    column("distance", [](const SlotResult& r) { return r.info.distance; });
-    column("wall_contact_step", [](const SlotResult& r) { return r.info.wall_contact_step; });
-    column("dice_in_cup", [](const SlotResult& r) { return std::int64_t{r.info.outcome.dice_in_cup}; });
-    column("dice_in_cup_now", [](const SlotResult& r) { return std::int64_t{r.info.outcome.dice_in_cup_now}; });
-    column("stacked", [](const SlotResult& r) { return r.info.outcome.stacked; });
-    column("stacked_steps", [](const SlotResult& r) { return std::int64_t{r.info.outcome.stacked_steps}; });
-    column("wall_contact", [](const SlotResult& r) { return r.info.outcome.wall_contact; });
-    column("realistic_success", [](const SlotResult& r) { return r.info.outcome.realistic_success(); });
-    return out;
+    std::optional<BatchArrays> out;
+    {
+      std::optional<py::gil_scoped_release> nogil;
+      pool_.run(envs_.size(), [&](std::size_t i, int) { fn(i); }, [&] {
+        out.emplace(envs_.size());
+        nogil.emplace();
+      });
+    }
+    out->fill(slots_);
+    return std::move(*out);
   }
 
   std::vector<EnvCore> envs_;
   std::vector<char> done_;
-  std::vector<SlotResult> results_;
-  int threads_;
+  std::vector<SlotResult> slots_;
   std::atomic<bool> busy_{false};
+  WorkerPool pool_;  // last: its threads stop before the environments go
 };
 
 }  // namespace

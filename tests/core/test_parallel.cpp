@@ -4,10 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
+#include <dicestack/core/worker_pool.hpp>
 
 namespace dicestack {
 namespace {
@@ -92,6 +94,99 @@ TEST(ParallelFor, EmptyAndSingleItemLoops) {
     ++calls;
   });
   EXPECT_EQ(calls, 1);
+}
+
+TEST(WorkerPool, ManyRunsCallEveryIndexOnceWithAWorkerInRange) {
+  for (const int threads : {1, 2, 4}) {
+    WorkerPool pool(threads);
+    EXPECT_EQ(pool.threads(), resolve_threads(threads));
+    for (const std::size_t n : {0u, 1u, 3u, 16u, 1000u}) {
+      for (int run = 0; run < 50; ++run) {
+        std::vector<std::atomic<int>> calls(n);
+        std::atomic<bool> bad_worker{false};
+        pool.run(n, [&](std::size_t i, int worker) {
+          if (worker < 0 || worker >= pool.threads()) bad_worker = true;
+          ++calls[i];
+        });
+        ASSERT_FALSE(bad_worker) << threads << " threads";
+        for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(calls[i], 1) << "index " << i << ", n " << n;
+      }
+    }
+  }
+}
+
+TEST(WorkerPool, NoTwoCallsShareAWorkerAtOnceAndSlotsDoNotDependOnThreads) {
+  auto run = [](int threads) {
+    WorkerPool pool(threads);
+    std::vector<std::atomic<int>> busy(static_cast<std::size_t>(pool.threads()));
+    std::atomic<bool> shared{false};
+    std::vector<double> slots(64);
+    for (int repeat = 0; repeat < 20; ++repeat) {
+      pool.run(slots.size(), [&](std::size_t i, int worker) {
+        auto& flag = busy[static_cast<std::size_t>(worker)];
+        if (flag.fetch_add(1) != 0) shared = true;
+        Rng rng(derive_seed(static_cast<std::uint64_t>(repeat), i));
+        double s = 0.0;
+        for (int k = 0; k < 200; ++k) s += rng.normal();
+        slots[i] += s;
+        flag.fetch_sub(1);
+      });
+    }
+    EXPECT_FALSE(shared) << threads << " threads";
+    return slots;
+  };
+  const auto one = run(1);
+  EXPECT_EQ(run(2), one);
+  EXPECT_EQ(run(4), one);
+}
+
+TEST(WorkerPool, RethrowsTheExceptionOfAnItemAndStaysUsable) {
+  WorkerPool pool(3);
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    try {
+      pool.run(1000, [&](std::size_t i, int) {
+        if (i == 17) throw std::runtime_error("item 17 failed");
+      });
+      FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "item 17 failed");
+    }
+    std::atomic<int> calls{0};
+    pool.run(100, [&](std::size_t, int) { ++calls; });
+    EXPECT_EQ(calls, 100);
+  }
+}
+
+TEST(WorkerPool, RunsFirstOnTheCallingThreadBeforeItTakesItems) {
+  for (const int threads : {1, 2}) {
+    WorkerPool pool(threads);
+    const auto caller = std::this_thread::get_id();
+    std::atomic<bool> first_done{false};
+    std::atomic<bool> caller_item_before_first{false};
+    std::atomic<int> calls{0};
+    pool.run(
+        64,
+        [&](std::size_t, int worker) {
+          if (worker == 0 && !first_done) caller_item_before_first = true;
+          ++calls;
+        },
+        [&] {
+          EXPECT_EQ(std::this_thread::get_id(), caller);
+          first_done = true;
+        });
+    EXPECT_TRUE(first_done);
+    EXPECT_FALSE(caller_item_before_first) << threads << " threads";
+    EXPECT_EQ(calls, 64);
+    try {  // an exception from `first` comes back after the loop, and the pool stays usable
+      pool.run(64, [&](std::size_t, int) {}, [] { throw std::runtime_error("first failed"); });
+      FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "first failed");
+    }
+    calls = 0;
+    pool.run(10, [&](std::size_t, int) { ++calls; });
+    EXPECT_EQ(calls, 10);
+  }
 }
 
 }  // namespace
