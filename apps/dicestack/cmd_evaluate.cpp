@@ -8,6 +8,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/report.hpp>
+#include <dicestack/learners/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -60,8 +61,8 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
   }
-  std::optional<ModelErrors> errors;
-  if (!opt.demos.empty()) errors = model_errors(*model, read_demo_set(opt.demos).episodes);
+  std::optional<Score> errors;
+  if (!opt.demos.empty()) errors = score(*model, DemoSplit(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, "episodes"));
   if (opt.json) {
     print_line(evaluation_json({opt.model.string(), opt.seed, opt.push}, *model, s,
                                errors ? &*errors : nullptr));
@@ -92,7 +93,8 @@ void add_evaluate_command(CLI::App& app, Cluster& cluster) {
   CLI::App* cmd = app.add_subcommand("evaluate", "Roll a trained policy out and report its outcomes");
   opt->world.add_to(*cmd);
   cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--demos", opt->demos, "Also report train and test error (eq. 9) on this set")->check(CLI::ExistingDirectory);
+  cmd->add_option("--demos", opt->demos,
+                  "Also report train and test error (eq. 9) on this set: a folder, `builtin` or `human`");
   cmd->add_option("--episodes", opt->episodes, "Rollouts from random starts")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->check(seed_check())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();

@@ -4,7 +4,9 @@
 // run_leaderboard (learners/leaderboard.hpp), shared with the Python package.
 #include <iostream>
 
+#include <dicestack/learners/baseline.hpp>
 #include <dicestack/learners/leaderboard.hpp>
+#include <dicestack/learners/profile.hpp>
 #include <dicestack/learners/train.hpp>
 
 #include "cli.hpp"
@@ -38,6 +40,26 @@ int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
   return 0;
 }
 
+// The --baselines and --profile help, from the registry and the profiles.
+std::string baselines_help() {
+  std::string names, budgets;
+  for (const auto& b : baselines()) names += b.name + ", ";
+  for (const auto& name : leaderboard_profile_names()) {
+    const Profile& p = leaderboard_profile(name);
+    budgets += (budgets.empty() ? "" : "; ") + name + ": " + std::to_string(p.optimiser_evaluations) + " evaluations (bayes " +
+               std::to_string(p.bayes_evaluations) + "), " + std::to_string(p.reinforce_iterations) + " REINFORCE updates, " +
+               std::to_string(p.rrt_nodes) + " RRT nodes";
+  }
+  return "Baselines without demonstrations as rows of their own: " + names + "or all (" + budgets + ")";
+}
+
+std::string profiles_help() {
+  std::string out;
+  for (const auto& name : leaderboard_profile_names())
+    out += (out.empty() ? "" : ", ") + name + " (" + std::to_string(leaderboard_profile(name).rollouts) + " rollouts)";
+  return out;
+}
+
 }  // namespace
 
 void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
@@ -53,16 +75,14 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
                   "paper profile: state and dart's map for every learner that reads them)")
       ->delimiter(',');
   cmd->add_option("--option", r.options, "key=value learner option (applied to the learners that have it); repeatable");
-  cmd->add_option("--baselines", r.baselines,
-                  "Baselines without demonstrations as rows of their own: cmaes, de, basinhop, bayes, reinforce, rrt "
-                  "or all (quick: 1000 evaluations (bayes 200), 100 REINFORCE updates, 100 RRT nodes; paper: 5000 "
-                  "(bayes 500), 1000, 1000)")
-      ->delimiter(',');
+  cmd->add_option("--baselines", r.baselines, baselines_help())->delimiter(',');
   cmd->add_option("--episodes", r.episodes, "Rollouts per row and training seed (default: 20 quick, 100 paper)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seeds", r.seeds, "Training seeds per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", r.seed, "First seed")->check(seed_check())->capture_default_str();
-  cmd->add_option("--profile", r.profile, "quick or paper")->check(CLI::IsMember({"quick", "paper"}))->capture_default_str();
+  cmd->add_option("--profile", r.profile, profiles_help())
+      ->check(CLI::IsMember(leaderboard_profile_names()))
+      ->capture_default_str();
   cmd->add_option("--split", r.split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25% of rows)")
       ->check(CLI::IsMember({"episodes", "rows"}))
       ->capture_default_str();

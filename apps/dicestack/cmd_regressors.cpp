@@ -10,9 +10,9 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/regressors/model.hpp>
+#include <dicestack/regressors/score.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -125,8 +125,8 @@ int run_bench(const BenchOptions& opt) {
   const WorldConfig world = opt.world.load();
   const auto dir = opt.demos.empty() ? human_demo_set(world) : opt.demos;
   const DemoSet set = read_demo_set(dir);
-  const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
-  const auto sigma = column_sigma(split.train.y);
+  const DemoSplit demo_split(set.episodes, opt.split);
+  const Split& split = demo_split.matrices();
   if (!opt.export_dir.empty()) export_split(split, opt.export_dir);
   auto& reg = RegressorRegistry::global();
   const auto names = opt.regressors.empty() ? reg.names() : opt.regressors;
@@ -157,21 +157,22 @@ int run_bench(const BenchOptions& opt) {
     std::sort(per_call.begin(), per_call.end());
     const double row_us = 1e6 * per_call[per_call.size() / 2];
     t0 = std::chrono::steady_clock::now();
-    const Matrix train_pred = model.predict(split.train.x);
+    model.predict(split.train.x);
     const double batch_rate = static_cast<double>(split.train.rows()) / seconds_since(t0);
-    const double train_error = scaled_l1_error(split.train.y, train_pred, sigma);
-    const double test_error = split.test.rows() ? scaled_l1_error(split.test.y, model.predict(split.test.x), sigma) : 0.0;
-    rows.push_back({{"name", name},
-                    {"fit_s", fit_s},
-                    {"predict_row_us", row_us},
-                    {"batch_rows_per_s", batch_rate},
-                    {"train_error", train_error},
-                    {"test_error", test_error},
-                    {"split", opt.split}});
+    const Score errors = score(model, split);
+    nlohmann::json row{{"name", name},
+                       {"fit_s", fit_s},
+                       {"predict_row_us", row_us},
+                       {"batch_rows_per_s", batch_rate},
+                       {"train_error", errors.train_error},
+                       {"split", opt.split}};
+    if (errors.test_error) row["test_error"] = *errors.test_error;  // none: the split left no test row
+    rows.push_back(row);
     if (!opt.json) {
-      char line[256];
-      std::snprintf(line, sizeof line, "  %-14s %7.2f %16.2f %14.0f %13.3f %12.3f", name.c_str(), fit_s, row_us, batch_rate,
-                    train_error, test_error);
+      char test[32] = "-", line[256];
+      if (errors.test_error) std::snprintf(test, sizeof test, "%.3f", *errors.test_error);
+      std::snprintf(line, sizeof line, "  %-14s %7.2f %16.2f %14.0f %13.3f %12s", name.c_str(), fit_s, row_us, batch_rate,
+                    errors.train_error, test);
       print_line(line);
     }
   }

@@ -59,15 +59,15 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   if (!r.result.curve.empty()) write_curve_csv(r.result.curve, curve_path);
   if (opt.json) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
-                     {"features", r.features},    {"seconds", r.seconds},   {"train_error", r.train_error}};
-    if (r.test_error) j["test_error"] = *r.test_error;
+                     {"features", r.features},    {"seconds", r.seconds},   {"train_error", r.score.train_error}};
+    if (r.score.test_error) j["test_error"] = *r.score.test_error;
     if (!r.result.curve.empty()) j["curve"] = curve_path.string();
     print_line(j.dump());
   } else {
     char line[256];
     std::snprintf(line, sizeof line, "trained %s with %s in %.2f s: train error %.3f%s -> %s", opt.regressor.c_str(),
-                  opt.learner.c_str(), r.seconds, r.train_error,
-                  r.test_error ? (", test error " + std::to_string(*r.test_error).substr(0, 5)).c_str() : "",
+                  opt.learner.c_str(), r.seconds, r.score.train_error,
+                  r.score.test_error ? (", test error " + std::to_string(*r.score.test_error).substr(0, 5)).c_str() : "",
                   opt.out.string().c_str());
     print_line(line);
   }

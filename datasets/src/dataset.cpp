@@ -99,4 +99,48 @@ Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction, 
   return {take_rows(all, train), take_rows(all, test), text};
 }
 
+DemoSplit::DemoSplit(const std::vector<Episode>& episodes, const std::string& rule) : all_(episodes), rule_(rule) {
+  if (rule == "episodes") {
+    for (std::size_t i = 0; i < episodes.size(); ++i) (is_test_episode(i) ? held_out_ : train_).push_back(episodes[i]);
+    if (train_.empty()) throw InputError("episode split: no training episode among " + std::to_string(episodes.size()));
+  } else if (rule == "rows") {
+    const Split& rows = matrices();
+    Episode pseudo;
+    pseudo.name = "training-rows";
+    for (Eigen::Index i = 0; i < rows.train.x.rows(); ++i) {
+      State st;
+      Action a;
+      for (std::size_t j = 0; j < kStateDim; ++j) st[j] = rows.train.x(i, static_cast<Eigen::Index>(j));
+      for (std::size_t j = 0; j < kActionDim; ++j) a[j] = rows.train.y(i, static_cast<Eigen::Index>(j));
+      pseudo.states.push_back(st);
+      pseudo.actions.push_back(a);
+      pseudo.sources.push_back(StepSource::human);
+    }
+    train_.push_back(std::move(pseudo));
+  } else if (rule == "none") {
+    if (episodes.empty()) throw InputError("no demonstration to train on");
+    train_ = episodes;
+  } else {
+    throw ConfigError("split \"" + rule + "\" is not one of episodes, rows, none");
+  }
+}
+
+const Split& DemoSplit::matrices(const FeatureMap& features) const {
+  auto& slot = matrices_[features.name()];
+  if (!slot) {
+    if (rule_ == "rows" && features.name() != state_features().name())
+      throw ConfigError("features \"" + features.name() +
+                        "\" read an episode's history; the row split shuffles the rows: use the episode split");
+    if (rule_ == "episodes") {
+      slot = std::make_unique<Split>(split_by_episode(all_, features));
+    } else if (rule_ == "rows") {
+      slot = std::make_unique<Split>(split_by_rows(all_, 0.25, 42, features));
+    } else {
+      slot = std::make_unique<Split>(Split{make_dataset(all_, features), make_dataset({}, features),
+                                           "none: all " + std::to_string(all_.size()) + " episodes are training"});
+    }
+  }
+  return *slot;
+}
+
 }  // namespace dicestack

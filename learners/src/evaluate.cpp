@@ -225,4 +225,9 @@ Tracking track_demos(const PolicyFactory& make_policy, const std::vector<Episode
   return t;
 }
 
+OutcomeCounts outcome_counts(const EvalStats& s) {
+  auto count = [&](const Rate& r) { return static_cast<int>(std::lround(r.value * s.episodes)); };
+  return {s.episodes, count(s.stacked), count(s.wall_contact), count(s.realistic_success)};
+}
+
 }  // namespace dicestack

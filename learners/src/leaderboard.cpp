@@ -16,14 +16,12 @@
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
-#include <dicestack/core/open_loop.hpp>
-#include <dicestack/core/reinforce.hpp>
-#include <dicestack/core/rrt.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/baseline.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/regressors/score.hpp>
 #include <dicestack/version.hpp>
 
 namespace dicestack {
@@ -44,55 +42,13 @@ json row_json(const LeaderboardRow& r) {
 }
 
 void add_outcomes(LeaderboardRow& row, const EvalStats& st, int seeds) {
-  row.episodes += st.episodes;
-  row.stacked += static_cast<int>(std::lround(st.stacked.value * st.episodes));
-  row.walls += static_cast<int>(std::lround(st.wall_contact.value * st.episodes));
-  row.success += static_cast<int>(std::lround(st.realistic_success.value * st.episodes));
+  const OutcomeCounts n = outcome_counts(st);
+  row.episodes += n.episodes;
+  row.stacked += n.stacked;
+  row.walls += n.wall_contact;
+  row.success += n.realistic_success;
   row.dice_in_cup += st.dice_in_cup_mean / seeds;
   row.us_per_step += st.policy_us_per_step / seeds;
-}
-
-// The network REINFORCE learned, acting on states.
-class NetworkPolicy final : public Policy {
- public:
-  NetworkPolicy(std::shared_ptr<const PolicyNetwork> net, const WorldConfig& world) : net_(std::move(net)), world_(world) {}
-  Action act(const History& h) override { return net_->act(h.current(), world_); }
-  std::string name() const override { return "reinforce"; }
-
- private:
-  std::shared_ptr<const PolicyNetwork> net_;
-  WorldConfig world_;
-};
-
-// Runs a baseline with the profile's budget: an open-loop sequence (optimisers, RRT) played
-// from every start, or REINFORCE's network acting on the states.
-PolicyFactory baseline_policy(const std::string& name, const WorldConfig& world, bool paper, std::uint64_t seed, int threads) {
-  std::vector<Action> actions;
-  if (name == "reinforce") {
-    ReinforceOptions o;
-    o.iterations = paper ? 1000 : 100;
-    o.seed = seed;
-    o.threads = threads;
-    auto net = std::make_shared<const PolicyNetwork>(reinforce(world, o).policy);
-    return [net, world] { return std::make_unique<NetworkPolicy>(net, world); };
-  }
-  if (name == "rrt") {
-    RrtOptions o;
-    o.nodes = paper ? 1000 : 100;
-    o.seed = seed;
-    o.threads = threads;
-    actions = rrt(world, o).actions;
-  } else {
-    OptimiseOptions o;
-    o.method = name;
-    o.evaluations = name == "bayes" ? (paper ? 500 : 200) : (paper ? 5000 : 1000);
-    o.seed = seed;
-    OpenLoopProblem problem(world, {}, threads);
-    actions = problem.actions(optimise(problem, o).best.data());
-  }
-  Episode sequence;
-  sequence.actions = actions;
-  return [sequence] { return std::make_unique<PlaybackPolicy>(sequence); };
 }
 
 LeaderboardRow row_from(const json& j) {
@@ -138,12 +94,14 @@ LeaderboardRow unpack_row(Unpacker& u) {
 }  // namespace
 
 double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
-                          bool paper, int rollouts) {
+                          const Profile& profile, int rollouts) {
   // Seconds on one core, from the measured quick and paper leaderboards (docs/learners.md,
-  // docs/scaling.md). Only the ratios matter: they decide which rank gets which row.
+  // docs/scaling.md). Only the ratios matter: they decide which rank gets which row. A profile
+  // other than "paper" is costed as quick.
+  const bool paper = profile.name == "paper";
   if (learner == "baseline") {
-    const double quick = regressor == "bayes" ? 60.0 : regressor == "reinforce" ? 40.0 : regressor == "rrt" ? 20.0 : 30.0;
-    return (paper ? 5.0 : 1.0) * quick + rollouts * 0.01;
+    const double budget = static_cast<double>(profile.optimiser_evaluations) / leaderboard_profile("quick").optimiser_evaluations;
+    return budget * baseline(regressor).quick_seconds + rollouts * 0.01;
   }
   auto pick = [](const std::map<std::string, double>& table, const std::string& key, double otherwise) {
     const auto it = table.find(key);
@@ -277,7 +235,7 @@ void check_one_of(const std::string& what, const std::string& value, const std::
 
 Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
   LeaderboardRequest opt = request;
-  check_one_of("profile", opt.profile, {"quick", "paper"});
+  const Profile& profile = leaderboard_profile(opt.profile);
   check_one_of("split", opt.split, {"episodes", "rows"});
   check_one_of("format", opt.format, {"md", "csv", "latex", "json"});
   if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
@@ -289,18 +247,15 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
   auto tick = [&](const std::string& text, double fraction) { report(text, fraction, false); };
   const WorldConfig& world = opt.world;
-  const bool paper = opt.profile == "paper";
-  const int episodes = opt.episodes > 0 ? opt.episodes : (paper ? 100 : 20);
+  const int episodes = opt.episodes > 0 ? opt.episodes : profile.rollouts;
   const auto& dir = opt.demos;
   const DemoSet set = read_demo_set(dir);
   const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
   const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger", "dart"} : opt.learners;
   // Learner options: the profile's defaults, then --option (for every learner that has the key).
   auto options_for = [&](const std::string& learner) {
-    std::vector<std::string> out;
-    if (learner == "dagger") out = paper ? std::vector<std::string>{"iterations=5", "rollouts=20"}
-                                         : std::vector<std::string>{"iterations=2", "rollouts=10"};
-    if (learner == "dad" && !paper) out = {"windows=2", "iterations=1", "corrector_iterations=10"};  // paper: its defaults
+    const auto defaults = profile.learner_options.find(learner);
+    std::vector<std::string> out = defaults == profile.learner_options.end() ? std::vector<std::string>{} : defaults->second;
     for (const auto& kv : opt.options) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -312,12 +267,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     return out;
   };
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
-  std::vector<std::string> known_baselines = optimiser_names();
-  known_baselines.insert(known_baselines.end(), {"reinforce", "rrt"});
-  if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = known_baselines;
-  for (const auto& b : opt.baselines)
-    if (std::find(known_baselines.begin(), known_baselines.end(), b) == known_baselines.end())
-      throw ConfigError("unknown baseline \"" + b + "\"; expected cmaes, de, basinhop, bayes, reinforce, rrt or all");
+  if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = baseline_names();
+  for (const auto& b : opt.baselines) baseline(b);  // unknown names fail before any work
   for (const auto& l : learners)
     if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
@@ -329,8 +280,9 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     const LearnerInfo& info = LearnerRegistry::global().info(l);
     // The paper profile's full picture: every learner with the bare state and with dart's map too.
     std::vector<std::string> maps{info.default_features};
-    if (paper && info.default_features != "state") maps.insert(maps.begin(), "state");
-    if (paper && info.default_features == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
+    if (profile.every_feature_map && info.default_features != "state") maps.insert(maps.begin(), "state");
+    if (profile.every_feature_map && info.default_features == "state")
+      maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work
       if (info.state_features_only && f != "state") {
@@ -346,51 +298,34 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
 
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
-  const Split split = opt.split == "rows" ? split_by_rows(set.episodes) : split_by_episode(set.episodes);
-  std::map<std::string, Split> feature_splits;  // the same split seen through each feature map
-  auto split_for = [&](const std::string& f) -> const Split& {
-    if (f == "state") return split;
-    if (!feature_splits.contains(f)) feature_splits.emplace(f, split_by_episode(set.episodes, feature_map(f)));
-    return feature_splits.at(f);
-  };
-  std::vector<Episode> train, held_out;
-  if (opt.split == "rows") {
-    Episode rows;
-    rows.name = "training-rows";
-    for (Eigen::Index i = 0; i < split.train.x.rows(); ++i) {
-      State st;
-      Action a;
-      for (std::size_t j = 0; j < kStateDim; ++j) st[j] = split.train.x(i, static_cast<Eigen::Index>(j));
-      for (std::size_t j = 0; j < kActionDim; ++j) a[j] = split.train.y(i, static_cast<Eigen::Index>(j));
-      rows.states.push_back(st);
-      rows.actions.push_back(a);
-      rows.sources.push_back(StepSource::human);
-    }
-    train.push_back(std::move(rows));
-  } else {
-    for (std::size_t i = 0; i < set.episodes.size(); ++i) (is_test_episode(i) ? held_out : train).push_back(set.episodes[i]);
-  }
-  const auto sigma = column_sigma(split.train.y);
+  const DemoSplit split(set.episodes, opt.split);
+  const std::vector<Episode>& train = split.train();
+  const std::vector<Episode>& held_out = split.held_out();
 
   std::size_t frames = 0;
   for (const auto& e : set.episodes) frames += e.size();
   std::ostringstream header;
   header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << dir.string() << " (" << set.episodes.size()
-         << " episodes, " << frames << " frames); split " << split.description << "; profile " << opt.profile << "; "
+         << " episodes, " << frames << " frames); split " << split.matrices().description << "; profile " << opt.profile << "; "
          << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
          << " training seed(s); rates with 95% Wilson intervals";
   json learner_options = json::object(), row_features = json::array();
   for (const auto& l : learners) learner_options[l] = options_for(l);
   for (const auto& [l, f] : combos) row_features.push_back(l + " " + f);
   header << "; learner options " << learner_options.dump() << "; features " << row_features.dump();
-  if (!paper && opt.regressors.empty() && std::find(learners.begin(), learners.end(), "dart") != learners.end())
-    header << "; rbf_svr under dart left out of the quick profile (200 s to fit 60,000 rows; name it with "
-              "--regressors or use --profile paper)";
+  auto left_out = [&](const std::string& learner, const std::string& regressor) {
+    if (!opt.regressors.empty()) return false;  // named regressors are always run
+    return std::find(profile.left_out.begin(), profile.left_out.end(), std::pair{learner, regressor}) != profile.left_out.end();
+  };
+  if (std::any_of(learners.begin(), learners.end(), [&](const std::string& l) {
+        return std::any_of(regressors.begin(), regressors.end(), [&](const std::string& r) { return left_out(l, r); });
+      }))
+    header << "; " << profile.left_out_note;
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
            << " budgets, then played from the same random starts";
   const json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
-                  {"split", split.description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
+                  {"split", split.matrices().description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
 
   // Resume: rows already measured with the same settings are read back (by the root, which
@@ -413,11 +348,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     return rows_done.dump();
   }));
 
-  // The quick profile leaves out, unless asked for by name, the one row that alone would take
-  // longer than the rest: a kernel SVR fitted on DART's ~60,000 rows (200 s; its rows are O(n^2)).
-  auto skipped = [&](const std::string& learner, const std::string& regressor) {
-    return !paper && opt.regressors.empty() && learner == "dart" && regressor == "rbf_svr";
-  };
+  // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart).
+  const auto& skipped = left_out;
   const std::size_t total = combos.size() * regressors.size();
   // Progress in units of rows: one per (learner, map, regressor) and per baseline.
   const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
@@ -467,7 +399,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     const std::string& name = job.regressor;
     say("baseline " + name, from);
     const auto t0 = std::chrono::steady_clock::now();
-    const PolicyFactory policy = baseline_policy(name, world, paper, opt.seed, opt.threads);
+    const PolicyFactory policy = baseline(name).make(world, profile, opt.seed, opt.threads);
     LeaderboardRow row{name, "baseline"};
     row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     row.train_error = row.test_error = -1;
@@ -483,7 +415,6 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   auto measure_seed = [&](const Job& job, Cluster& inner, double from, double span) {
     const std::string& learner_name = job.learner;
     const std::string& name = job.regressor;
-    const Split& fsplit = split_for(job.features);
     const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(job.seed);
     const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
     // Training is the first half of a seed's share, rollouts the second.
@@ -510,9 +441,10 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     const auto t0 = std::chrono::steady_clock::now();
     const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
     r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    r.train_error = scaled_l1_error(fsplit.train.y, learned.model->predict(fsplit.train.x), sigma);
-    r.has_test = fsplit.test.rows() > 0;
-    if (r.has_test) r.test_error = scaled_l1_error(fsplit.test.y, learned.model->predict(fsplit.test.x), sigma);
+    const Score errors = score(*learned.model, split);
+    r.train_error = errors.train_error;
+    r.has_test = errors.test_error.has_value();
+    r.test_error = errors.test_error.value_or(0.0);
     const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
     say(rollouts_text, at(0.5));
     std::shared_ptr<const Model> model = learned.model;
@@ -590,7 +522,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     std::vector<double> cost(jobs.size());
     for (std::size_t j = 0; j < jobs.size(); ++j)
       cost[j] = estimated_row_cost(jobs[j].index ? jobs[j].learner : "baseline", jobs[j].regressor, jobs[j].features,
-                                   paper, jobs[j].index ? episodes : episodes * opt.seeds);
+                                   profile, jobs[j].index ? episodes : episodes * opt.seeds);
     const std::vector<int> owner = deal_items(jobs.size(), cluster.size(), cost);
     const double job_units = static_cast<double>(jobs.size()) + 0.5;
     {  // the deal, on one line: which rank runs each job, and the estimated load of each rank
@@ -691,11 +623,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads, cluster);
   LeaderboardRow playback{"(demonstrations)", "playback"};
   playback.train_error = playback.test_error = -1;
-  playback.episodes = pb.episodes;
-  playback.stacked = static_cast<int>(std::lround(pb.stacked.value * pb.episodes));
-  playback.walls = static_cast<int>(std::lround(pb.wall_contact.value * pb.episodes));
-  playback.success = static_cast<int>(std::lround(pb.realistic_success.value * pb.episodes));
-  playback.dice_in_cup = pb.dice_in_cup_mean;
+  add_outcomes(playback, pb, 1);
+  playback.us_per_step = 0;  // playback reads recorded actions: no policy time to report
   rows.push_back(playback);
 
   Leaderboard board;

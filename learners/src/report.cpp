@@ -2,8 +2,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <dicestack/datasets/dataset.hpp>
-#include <dicestack/datasets/metrics.hpp>
 
 namespace dicestack {
 namespace {
@@ -12,17 +10,7 @@ nlohmann::json rate_json(const Rate& r) { return {r.value, r.low, r.high}; }
 
 }  // namespace
 
-ModelErrors model_errors(const Model& model, const std::vector<Episode>& episodes) {
-  const Split split = split_by_episode(episodes, model.features());
-  const auto sigma = column_sigma(split.train.y);
-  ModelErrors e;
-  e.train_error = scaled_l1_error(split.train.y, model.predict(split.train.x), sigma);
-  if (split.test.rows() > 0) e.test_error = scaled_l1_error(split.test.y, model.predict(split.test.x), sigma);
-  e.split = split.description;
-  return e;
-}
-
-std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& s, const ModelErrors* errors) {
+std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& s, const Score* errors) {
   nlohmann::json j{{"model", run.model},
                    {"regressor", model.regressor().name()},
                    {"features", model.features().name()},

@@ -5,7 +5,6 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
-#include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/record.hpp>
 
 namespace dicestack {
@@ -23,15 +22,10 @@ TrainReport train_model(const TrainRequest& request) {
       request.features.empty() ? LearnerRegistry::global().info(request.learner).default_features : request.features);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
-  std::vector<Episode> train = request.demos, test;
-  if (request.split == "episodes") {
-    train.clear();
-    for (std::size_t i = 0; i < request.demos.size(); ++i)
-      (is_test_episode(i) ? test : train).push_back(request.demos[i]);
-  }
+  const DemoSplit split(request.demos, request.split);
   LearnContext c;
-  c.demos = train;
-  c.held_out = test;
+  c.demos = split.train();
+  c.held_out = split.held_out();
   c.world = request.world;
   c.regressor = request.regressor;
   c.regressor_sets = request.regressor_sets;
@@ -54,14 +48,7 @@ TrainReport train_model(const TrainRequest& request) {
   model.record["demos"] = request.demos_name;
   model.record["split"] = request.split;
   model.record["seed"] = std::to_string(request.seed);
-
-  const Dataset train_d = make_dataset(train, features);
-  const auto sigma = column_sigma(train_d.y);
-  report.train_error = scaled_l1_error(train_d.y, model.predict(train_d.x), sigma);
-  if (!test.empty()) {
-    const Dataset test_d = make_dataset(test, features);
-    report.test_error = scaled_l1_error(test_d.y, model.predict(test_d.x), sigma);
-  }
+  report.score = score(model, split);
   return report;
 }
 

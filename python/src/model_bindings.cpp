@@ -140,8 +140,8 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
   training["learner"] = learner;
   training["features"] = report->features;
   training["seconds"] = report->seconds;
-  training["train_error"] = report->train_error;
-  if (report->test_error) training["test_error"] = *report->test_error;
+  training["train_error"] = report->score.train_error;
+  if (report->score.test_error) training["test_error"] = *report->score.test_error;
   return {report->result.model, out, training};
 }
 
@@ -161,8 +161,8 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
                                      call.poll(static_cast<double>(finished) / of,
                                                "evaluate: " + std::to_string(finished) + "/" + std::to_string(of) + " rollouts");
                                    });
-  std::optional<ModelErrors> errors;
-  if (demo_episodes) errors = model_errors(*model, *demo_episodes);
+  std::optional<Score> errors;
+  if (demo_episodes) errors = score(*model, DemoSplit(*demo_episodes, "episodes"));
   return evaluation_json(run, *model, stats, errors ? &*errors : nullptr);
 }
 

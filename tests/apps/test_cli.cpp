@@ -18,6 +18,8 @@
 #include <dicestack/core/hash.hpp>
 #include <dicestack/version.hpp>
 
+#include <dicestack/test/helpers.hpp>
+
 namespace dicestack {
 namespace {
 
@@ -95,12 +97,11 @@ TEST(Cli, StateHashIsIdenticalAcrossProcessesAndMatchesThisOne) {
 }
 
 TEST(Cli, BadWorldConfigIsReportedWithTheField) {
-  const auto dir = std::filesystem::temp_directory_path();
-  const auto good = dir / "dicestack_cli_world.json";
+  const auto good = test::scratch_path("dicestack_cli_world.json");
   ASSERT_EQ(run("config --out " + good.string()).status, 0);
   auto j = nlohmann::json::parse(std::ifstream(good));
   j["physics"]["substeps"] = -2;
-  const auto bad = dir / "dicestack_cli_world_bad.json";
+  const auto bad = test::scratch_path("dicestack_cli_world_bad.json");
   std::ofstream(bad) << j.dump();
   const Process r = run("rollout --world " + bad.string());
   EXPECT_EQ(r.status, 1);
@@ -114,7 +115,7 @@ TEST(Cli, BadWorldConfigIsReportedWithTheField) {
 }
 
 TEST(Cli, RolloutWritesAPng) {
-  const auto png = std::filesystem::temp_directory_path() / "dicestack_cli_rollout.png";
+  const auto png = test::scratch_path("dicestack_cli_rollout.png");
   std::filesystem::remove(png);
   const Process r = run("rollout --seed 1 --steps 20 --png " + png.string());
   EXPECT_EQ(r.status, 0) << r.output;
@@ -131,7 +132,7 @@ namespace {
 const std::string kTinyDemos = std::string(DICESTACK_SOURCE_DIR) + "/tests/datasets/data/good";
 
 TEST(CliLearning, TrainThenEvaluateEndToEnd) {
-  const auto model = std::filesystem::temp_directory_path() / "dicestack_cli_knn.dsm";
+  const auto model = test::scratch_path("dicestack_cli_knn.dsm");
   const Process t = run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + model.string());
   ASSERT_EQ(t.status, 0) << t.output;
   const Process e = run("evaluate --model " + model.string() + " --episodes 3 --seed 2 --json --demos " + kTinyDemos);
@@ -143,6 +144,24 @@ TEST(CliLearning, TrainThenEvaluateEndToEnd) {
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["episodes"], 3);
   std::filesystem::remove(model);
+}
+
+TEST(CliLearning, WithoutATestEpisodeEveryCommandReportsNoTestErrorRatherThanZero) {
+  // The two-episode set leaves the episode split no test episode.
+  const Process bench = run("bench regressors --demos " + kTinyDemos + " --regressors linear_svr --calls 50 --json");
+  ASSERT_EQ(bench.status, 0) << bench.output;
+  const auto rows = nlohmann::json::parse(bench.output);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(rows[0].contains("train_error"));
+  EXPECT_FALSE(rows[0].contains("test_error")) << bench.output;
+  const Process table = run("bench regressors --demos " + kTinyDemos + " --regressors linear_svr --calls 50");
+  ASSERT_EQ(table.status, 0) << table.output;
+  EXPECT_THAT(table.output, ::testing::ContainsRegex("linear_svr .* -\n"));
+  const Process train = run("train --demos " + kTinyDemos + " --regressor linear_svr --json --out " +
+                            (test::scratch_path("dicestack_cli_no_test.dsm")).string());
+  ASSERT_EQ(train.status, 0) << train.output;
+  EXPECT_EQ(train.output.find("test_error"), std::string::npos) << train.output;
+  std::filesystem::remove(test::scratch_path("dicestack_cli_no_test.dsm"));
 }
 
 TEST(CliLearning, BadArgumentsGiveAClearMessage) {
@@ -163,7 +182,7 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
 }
 
 TEST(CliLearning, DadTrainsWithACurveAndRefusesTheRowSplit) {
-  const auto model = std::filesystem::temp_directory_path() / "dicestack_cli_dad.dsm";
+  const auto model = test::scratch_path("dicestack_cli_dad.dsm");
   const Process t = run("train --demos " + kTinyDemos + " --regressor knn --learner dad --split none --option windows=1 "
                         "--option corrector_iterations=1 --option demos=1 --json --out " + model.string(), false);
   ASSERT_EQ(t.status, 0) << t.output;
@@ -198,7 +217,7 @@ std::pair<int, int> csv_shape(const std::filesystem::path& path) {
 }
 
 TEST(CliLearning, BenchRegressorsExportsTheSplitItMeasured) {
-  const auto dir = std::filesystem::temp_directory_path() / "dicestack_cli_export";
+  const auto dir = test::scratch_path("dicestack_cli_export");
   std::filesystem::remove_all(dir);
   const Process p = run("bench regressors --demos " + kTinyDemos + " --regressors linear_svr --split rows --calls 50 --json "
                         "--export " + dir.string(), false);
@@ -220,7 +239,7 @@ TEST(CliLearning, BenchRegressorsExportsTheSplitItMeasured) {
 }
 
 TEST(CliBaselines, OptimiseWritesTheBestSequenceAndItsOutcome) {
-  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_optimise";
+  const auto out = test::scratch_path("dicestack_cli_optimise");
   std::filesystem::remove_all(out);
   const Process o = run("optimise --method cmaes --steps 5 --evaluations 40 --seed 3 --json --out " + out.string(), false);
   ASSERT_EQ(o.status, 0) << o.output;
@@ -238,7 +257,7 @@ TEST(CliBaselines, OptimiseWritesTheBestSequenceAndItsOutcome) {
 }
 
 TEST(CliBaselines, RrtWritesItsResult) {
-  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_rrt";
+  const auto out = test::scratch_path("dicestack_cli_rrt");
   std::filesystem::remove_all(out);
   const Process r = run("rrt --nodes 5 --extend-steps 2 --extend-iterations 2 --seed 1 --json --out " + out.string(), false);
   ASSERT_EQ(r.status, 0) << r.output;
@@ -250,7 +269,7 @@ TEST(CliBaselines, RrtWritesItsResult) {
 }
 
 TEST(CliBaselines, ReinforceWritesTheGreedyEpisodeAndItsCurve) {
-  const auto out = std::filesystem::temp_directory_path() / "dicestack_cli_reinforce";
+  const auto out = test::scratch_path("dicestack_cli_reinforce");
   std::filesystem::remove_all(out);
   const Process r = run("reinforce --iterations 3 --batch 2 --steps 6 --seed 1 --json --out " + out.string(), false);
   ASSERT_EQ(r.status, 0) << r.output;
@@ -391,7 +410,7 @@ namespace dicestack {
 namespace {
 
 TEST(CliRender, VideoFramesAndPlotOfARecordedEpisode) {
-  const auto dir = std::filesystem::temp_directory_path() / "dicestack_cli_render";
+  const auto dir = test::scratch_path("dicestack_cli_render");
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string episode = std::string(DICESTACK_SOURCE_DIR) + "/tests/datasets/data/good/episode_0000.csv";  // 4 steps

@@ -27,7 +27,7 @@ fs::path unique_dir(const std::string& name) {
 }
 
 TEST(AtomicFile, NothingAppearsWithoutCommit) {
-  const fs::path path = fs::temp_directory_path() / "dicestack_atomic_a.txt";
+  const fs::path path = test::scratch_path("dicestack_atomic_a.txt");
   fs::remove(path);
   {
     AtomicFile f(path, kText);
@@ -39,7 +39,7 @@ TEST(AtomicFile, NothingAppearsWithoutCommit) {
 }
 
 TEST(AtomicFile, CommitReplacesTheOldFileWhole) {
-  const fs::path path = fs::temp_directory_path() / "dicestack_atomic_b.txt";
+  const fs::path path = test::scratch_path("dicestack_atomic_b.txt");
   { std::ofstream(path) << "old"; }
   {
     AtomicFile f(path, kText);

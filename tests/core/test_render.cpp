@@ -6,6 +6,8 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/render.hpp>
 
+#include <dicestack/test/helpers.hpp>
+
 namespace dicestack {
 namespace {
 
@@ -24,7 +26,7 @@ TEST(Render, DrawsTheOriginalWindowWithShapes) {
 
 TEST(Render, WritesAPngAtomically) {
   const WorldConfig c;
-  const auto path = std::filesystem::temp_directory_path() / "dicestack_render_test.png";
+  const auto path = test::scratch_path("dicestack_render_test.png");
   std::filesystem::remove(path);
   write_png(render_state(paper_start_state(c), c, {}), path);
   ASSERT_TRUE(std::filesystem::exists(path));

@@ -124,7 +124,7 @@ TEST(CupdiceImport, ReplayedActionsMoveTheCupAsRecorded) {
 }
 
 TEST(CupdiceImport, MalformedRecordingsAreRejected) {
-  const fs::path dir = fs::temp_directory_path() / "dicestack_cupdice_bad";
+  const fs::path dir = test::scratch_path("dicestack_cupdice_bad");
   fs::create_directories(dir);
   std::ofstream(dir / "short.csv") << "1,2,3\n";
   EXPECT_THAT(test::error_of([&] { import_cupdice_file(dir / "short.csv", WorldConfig{}); }),

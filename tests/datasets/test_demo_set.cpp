@@ -76,7 +76,7 @@ TEST(DemoSet, WriteThenReadIsExact) {
   set.episodes[0].states[1][5] = 0.1 + 0.2;  // not exactly representable in short decimal
   set.episodes[0].outcome.stacked = true;
   set.episodes[0].origin = "unit test";
-  const fs::path dir = fs::temp_directory_path() / "dicestack_demo_roundtrip";
+  const fs::path dir = test::scratch_path("dicestack_demo_roundtrip");
   fs::remove_all(dir);
   write_demo_set(set, dir);
   const DemoSet back = read_demo_set(dir);
@@ -155,7 +155,7 @@ TEST(DemoSet, VersionTwoKeepsTransitionsAndVersionOneReadsWithoutThem) {
 }
 
 TEST(DemoSet, AppendAddsEpisodesAndKeepsTheOldOnes) {
-  const fs::path dir = fs::temp_directory_path() / "dicestack_demo_append";
+  const fs::path dir = test::scratch_path("dicestack_demo_append");
   fs::remove_all(dir);
   const DemoSet good = read_demo_set(kData / "good");
   auto names = append_to_demo_set(dir, {good.episodes[0]}, good.world, "appended");
@@ -171,7 +171,7 @@ TEST(DemoSet, AppendAddsEpisodesAndKeepsTheOldOnes) {
 TEST(DemoSet, WriterRejectsMalformedEpisodes) {
   DemoSet set = read_demo_set(kData / "good");
   set.episodes[1].actions.pop_back();
-  const fs::path dir = fs::temp_directory_path() / "dicestack_demo_bad_write";
+  const fs::path dir = test::scratch_path("dicestack_demo_bad_write");
   fs::remove_all(dir);
   EXPECT_THAT(test::error_of([&] { write_demo_set(set, dir); }), HasSubstr("3 states, 2 actions"));
   EXPECT_FALSE(fs::exists(dir)) << "a failed write leaves nothing behind";

@@ -120,7 +120,7 @@ TEST(Dad, KeepsThePolicyThatFollowsTheDemonstrationsBest) {
 }
 
 TEST(Dad, ResumeEqualsUninterrupted) {
-  const auto dir = std::filesystem::temp_directory_path() / "dicestack_dad_resume";
+  const auto dir = test::scratch_path("dicestack_dad_resume");
   std::filesystem::remove_all(dir);
   LearnContext c = dad_context(2);
   const LearnResult whole = LearnerRegistry::global().create("dad", kSmall)->learn(c);

@@ -154,7 +154,7 @@ TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {
   LearnContext c = small_context(2);
   const auto learner = LearnerRegistry::global().create(
       "dagger", {"iterations=1", "rollouts=3", "beta=1", "include_demos=false", "expert=scripted"});
-  c.checkpoint_dir = std::filesystem::temp_directory_path() / "dicestack_dagger_beta1";
+  c.checkpoint_dir = test::scratch_path("dicestack_dagger_beta1");
   std::filesystem::remove_all(c.checkpoint_dir);
   const LearnResult r = learner->learn(c);
   const DemoSet data = read_demo_set(c.checkpoint_dir / "data-1");
@@ -190,7 +190,7 @@ TEST(Dagger, ResumeEqualsUninterrupted) {
   const DemoSet demos = read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good");
   LearnContext c = small_context(2);
   c.demos = demos.episodes;
-  const auto dir = std::filesystem::temp_directory_path() / "dicestack_dagger_resume";
+  const auto dir = test::scratch_path("dicestack_dagger_resume");
   std::filesystem::remove_all(dir);
   const LearnResult whole = LearnerRegistry::global().create("dagger", {"iterations=3", "rollouts=2", "expert=scripted"})->learn(c);
   // Run two rounds (as if killed after round 2), then resume to three.

@@ -98,7 +98,7 @@ TEST_P(Conformance, SaveThenLoadPredictsIdentically) {
   EXPECT_EQ(back->predict(probe), r->predict(probe));
   // Through a model file, with standardisers and checksum.
   Model model = Model::train(make(), x, target(x, false), 6);
-  const fs::path path = fs::temp_directory_path() / ("dicestack_conformance_" + GetParam() + ".dsm");
+  const fs::path path = test::scratch_path("dicestack_conformance_" + GetParam() + ".dsm");
   save_model(model, path);
   const Model loaded = load_model(path);
   EXPECT_EQ(loaded.predict(probe), model.predict(probe));
@@ -215,7 +215,7 @@ TEST(Registry, PluginHandshakeRefusesWhatItCannotUse) {
               HasSubstr("its plugin record has a null field"));
   EXPECT_THAT(test::error_of([&] { reg.load_plugin(DICESTACK_DUPLICATE_PLUGIN); }),
               HasSubstr("regressor \"knn\" registered twice (built-in, and plugin "));
-  const fs::path junk = fs::temp_directory_path() / "dicestack_not_a_library.so";
+  const fs::path junk = test::scratch_path("dicestack_not_a_library.so");
   std::ofstream(junk) << "not an ELF file";
   EXPECT_THAT(test::error_of([&] { reg.load_plugin(junk); }), HasSubstr("cannot load:"));
   EXPECT_THAT(test::error_of([&] { reg.load_plugin("/nonexistent/libx.so"); }), HasSubstr("no such file"));
@@ -225,7 +225,7 @@ TEST(Registry, PluginHandshakeRefusesWhatItCannotUse) {
 TEST(ModelFile, TruncatedCorruptedOrForeignFilesAreRejected) {
   const Matrix x = inputs(100, 24, 13);
   const Model model = Model::train(RegressorRegistry::global().create("knn"), x, target(x, true), 1);
-  const fs::path path = fs::temp_directory_path() / "dicestack_model_file.dsm";
+  const fs::path path = test::scratch_path("dicestack_model_file.dsm");
   save_model(model, path);
   std::string bytes;
   {

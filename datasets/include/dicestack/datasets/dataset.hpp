@@ -2,6 +2,8 @@
 // Demonstrations as matrices a regressor can fit: X (N x a feature map's width; the 24 state
 // numbers by default), Y (N x 3 actions), with episode boundaries, and the train/test splits of DESIGN.
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,31 @@ Split split_by_episode(const std::vector<Episode>& episodes, const FeatureMap& f
 /// Twister permutation), so neighbouring frames of one episode can sit on both sides.
 Split split_by_rows(const std::vector<Episode>& episodes, double test_fraction = 0.25, std::uint32_t seed = 42,
                     const FeatureMap& features = state_features());
+
+/// A demonstration set split for an experiment, seen both ways: the episodes a learner trains
+/// on (and those it may hold out), and the same split as matrices for eq. 9's errors.
+class DemoSplit {
+ public:
+  /// `rule`: "episodes" (i % 5 == 4 is test), "rows" (the paper's random 25 % of rows; a learner
+  /// gets the training rows as one pseudo-episode, as the paper fitted on shuffled rows) or
+  /// "none" (everything is training). Throws ConfigError for another rule, InputError when the
+  /// split leaves nothing to train on.
+  DemoSplit(const std::vector<Episode>& episodes, const std::string& rule);
+
+  const std::string& rule() const { return rule_; }
+  /// What a learner trains on: the training episodes, or (rows) one pseudo-episode of the rows.
+  const std::vector<Episode>& train() const { return train_; }
+  /// The test episodes under "episodes"; empty under "rows" and "none".
+  const std::vector<Episode>& held_out() const { return held_out_; }
+  /// The split's matrices through `features`, made once per map (not thread-safe). Under "rows"
+  /// only the state map: ConfigError for a map that reads an episode's history.
+  const Split& matrices(const FeatureMap& features = state_features()) const;
+
+ private:
+  std::vector<Episode> all_, train_, held_out_;
+  std::string rule_;
+  mutable std::map<std::string, std::unique_ptr<Split>> matrices_;
+};
 
 /// numpy.random.RandomState(seed).permutation(n), reproduced exactly.
 std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t seed);

@@ -62,6 +62,12 @@ struct EvalStats {
   double seconds = 0.0;           ///< wall time of the whole evaluation
 };
 
+/// Rollout outcomes as counts (k of n), as tables and Wilson intervals take them.
+struct OutcomeCounts {
+  int episodes = 0, stacked = 0, wall_contact = 0, realistic_success = 0;
+};
+OutcomeCounts outcome_counts(const EvalStats& stats);
+
 /// Makes one policy per worker thread (policies may keep per-episode state).
 using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
 

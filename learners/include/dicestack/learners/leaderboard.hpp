@@ -12,6 +12,7 @@
 
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/world_config.hpp>
+#include <dicestack/learners/profile.hpp>
 
 namespace dicestack {
 
@@ -27,7 +28,7 @@ struct LeaderboardRequest {
   /// Feature maps: a row per learner and map it can read; empty: each learner's own (the paper
   /// profile adds "state" and dart's map for every learner that reads them).
   std::vector<std::string> features;
-  std::string profile = "quick";  ///< "quick" or "paper": learner options, budgets, rollouts
+  std::string profile = "quick";  ///< leaderboard_profile(): learner options, budgets, rollouts
   std::string split = "episodes";  ///< "episodes" (i % 5 == 4 is test) or "rows" (the paper's 25 % of rows)
   int episodes = 0;               ///< rollouts per row and training seed; 0: 20 (quick) or 100 (paper)
   int seeds = 1;                  ///< training seeds per row, >= 1
@@ -51,7 +52,7 @@ struct LeaderboardRequest {
 /// the ratios matter. `rollouts`: the evaluation rollouts of the work dealt (one training seed of
 /// a learner row; all seeds of a baseline).
 double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
-                          bool paper, int rollouts);
+                          const Profile& profile, int rollouts);
 
 /// One row of the table. Negative errors and times mean "none" (printed "-").
 struct LeaderboardRow {

@@ -10,18 +10,9 @@
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/regressors/model.hpp>
+#include <dicestack/regressors/score.hpp>
 
 namespace dicestack {
-
-/// A model's eq. 9 errors on a demonstration set under the default episode split.
-struct ModelErrors {
-  double train_error = 0.0;
-  std::optional<double> test_error;  ///< when the split has test episodes
-  std::string split;                 ///< the split's description
-};
-
-/// Throws InputError if the split leaves no training episode.
-ModelErrors model_errors(const Model& model, const std::vector<Episode>& episodes);
 
 /// How the rollouts were asked for.
 struct EvaluationRun {
@@ -36,6 +27,6 @@ struct EvaluationRun {
 /// mean_episode_length, us_per_step, seconds, and train_error, test_error, split when `errors`
 /// is given.
 std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& stats,
-                            const ModelErrors* errors = nullptr);
+                            const Score* errors = nullptr);
 
 }  // namespace dicestack

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/regressors/score.hpp>
 
 namespace dicestack {
 
@@ -45,8 +46,7 @@ struct TrainReport {
   LearnResult result;
   std::string features;              ///< the feature map used
   double seconds = 0.0;              ///< the learner's wall time
-  double train_error = 0.0;          ///< eq. 9 on the training episodes
-  std::optional<double> test_error;  ///< eq. 9 on the held-out episodes, when there are any
+  Score score;                       ///< eq. 9 on the training and held-out episodes
 };
 
 /// Checks the learner, its options, the regressor and the feature map before any work

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ inline Matrix random_matrix(Eigen::Index n, Eigen::Index d, std::uint64_t seed) 
   Matrix m(n, d);
   for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = rng.uniform(-1.0, 1.0);
   return m;
+}
+
+/// A path in the temporary folder named for this process, so that two test runs can share a
+/// machine: temp/<name> becomes temp/<stem>-<pid><extension>.
+inline std::filesystem::path scratch_path(const std::string& name) {
+  const std::filesystem::path n(name);
+  return std::filesystem::temp_directory_path() /
+         (n.stem().string() + "-" + std::to_string(getpid()) + n.extension().string());
 }
 
 /// What a callable throws, as text; empty if it does not throw.

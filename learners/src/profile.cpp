@@ -1,0 +1,53 @@
+#include <dicestack/learners/profile.hpp>
+
+#include <dicestack/core/error.hpp>
+
+namespace dicestack {
+namespace {
+
+std::vector<Profile> make_profiles() {
+  Profile quick;
+  quick.name = "quick";
+  quick.rollouts = 20;
+  quick.learner_options = {{"dagger", {"iterations=2", "rollouts=10"}},
+                           {"dad", {"windows=2", "iterations=1", "corrector_iterations=10"}}};
+  // A kernel SVR fitted on DART's ~60,000 rows alone would take longer than the rest (its rows are O(n^2)).
+  quick.left_out = {{"dart", "rbf_svr"}};
+  quick.left_out_note =
+      "rbf_svr under dart left out of the quick profile (200 s to fit 60,000 rows; name it with --regressors or use "
+      "--profile paper)";
+
+  Profile paper;
+  paper.name = "paper";
+  paper.rollouts = 100;
+  paper.learner_options = {{"dagger", {"iterations=5", "rollouts=20"}}};  // dad: its defaults
+  paper.every_feature_map = true;
+  paper.optimiser_evaluations = 5000;
+  paper.bayes_evaluations = 500;
+  paper.reinforce_iterations = 1000;
+  paper.rrt_nodes = 1000;
+  return {quick, paper};
+}
+
+const std::vector<Profile>& profiles() {
+  static const std::vector<Profile> all = make_profiles();
+  return all;
+}
+
+}  // namespace
+
+const Profile& leaderboard_profile(const std::string& name) {
+  for (const auto& p : profiles())
+    if (p.name == name) return p;
+  std::string list;
+  for (const auto& p : profiles()) list += (list.empty() ? "" : ", ") + p.name;
+  throw ConfigError("leaderboard: profile \"" + name + "\" is not one of " + list);
+}
+
+std::vector<std::string> leaderboard_profile_names() {
+  std::vector<std::string> out;
+  for (const auto& p : profiles()) out.push_back(p.name);
+  return out;
+}
+
+}  // namespace dicestack

@@ -1,0 +1,113 @@
+// The experiment layer under the leaderboard and the commands: score, profiles, the baseline
+// registry and outcome counts.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/datasets/metrics.hpp>
+#include <dicestack/learners/baseline.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/leaderboard.hpp>
+#include <dicestack/learners/profile.hpp>
+#include <dicestack/regressors/registry.hpp>
+#include <dicestack/regressors/score.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::vector<Episode> good_episodes() {
+  return read_demo_set(std::filesystem::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good").episodes;
+}
+
+TEST(Score, IsEquationNineWithSigmaFromTheTrainingLabelsAndNoTestErrorWithoutTestRows) {
+  std::vector<Episode> eps = good_episodes();
+  while (eps.size() < 5) {  // a fifth episode makes a test side
+    const Episode copy = eps[eps.size() % 2];
+    eps.push_back(copy);
+  }
+  const DemoSplit split(eps, "episodes");
+  const Split& m = split.matrices();
+  const Model model = Model::train(RegressorRegistry::global().create("linear_svr"), m.train.x, m.train.y, 1);
+  const Score s = score(model, split);
+  const auto sigma = column_sigma(m.train.y);
+  EXPECT_EQ(s.train_error, scaled_l1_error(m.train.y, model.predict(m.train.x), sigma));
+  ASSERT_TRUE(s.test_error.has_value());
+  EXPECT_EQ(*s.test_error, scaled_l1_error(m.test.y, model.predict(m.test.x), sigma));
+  EXPECT_EQ(s.split, m.description);
+
+  const Score all = score(model, DemoSplit(eps, "none"));  // no test rows: none, not 0
+  EXPECT_FALSE(all.test_error.has_value());
+  EXPECT_THAT(all.split, HasSubstr("none"));
+}
+
+TEST(Profile, QuickAndPaperAreDataAndOtherNamesAreRefused) {
+  EXPECT_EQ(leaderboard_profile_names(), (std::vector<std::string>{"quick", "paper"}));
+  const Profile& quick = leaderboard_profile("quick");
+  const Profile& paper = leaderboard_profile("paper");
+  EXPECT_EQ(quick.rollouts, 20);
+  EXPECT_EQ(paper.rollouts, 100);
+  EXPECT_FALSE(quick.every_feature_map);
+  EXPECT_TRUE(paper.every_feature_map);
+  EXPECT_EQ(quick.left_out, (std::vector<std::pair<std::string, std::string>>{{"dart", "rbf_svr"}}));
+  EXPECT_TRUE(paper.left_out.empty());
+  EXPECT_EQ(quick.learner_options.at("dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}));
+  EXPECT_GT(paper.optimiser_evaluations, quick.optimiser_evaluations);
+  try {
+    leaderboard_profile("huge");
+    FAIL() << "no exception";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("profile \"huge\" is not one of quick, paper"));
+  }
+}
+
+TEST(Baselines, RegistryListsEveryOptimiserThenReinforceAndRrt) {
+  EXPECT_EQ(baseline_names(), (std::vector<std::string>{"cmaes", "de", "basinhop", "bayes", "reinforce", "rrt"}));
+  try {
+    baseline("annealing");
+    FAIL() << "no exception";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("unknown baseline \"annealing\"; expected cmaes, de, basinhop, bayes, reinforce, rrt or all"));
+  }
+  // The paper profile's budgets cost more than the quick one's, whatever the baseline.
+  for (const auto& name : baseline_names())
+    EXPECT_GT(estimated_row_cost("baseline", name, "-", leaderboard_profile("paper"), 100),
+              estimated_row_cost("baseline", name, "-", leaderboard_profile("quick"), 100))
+        << name;
+}
+
+TEST(Baselines, APolicyMadeWithATinyBudgetIsSeededAndPlaysTheWorld) {
+  WorldConfig world;
+  world.episode.max_steps = 30;
+  Profile tiny = leaderboard_profile("quick");
+  tiny.rrt_nodes = 4;
+  tiny.reinforce_iterations = 1;
+  for (const std::string name : {"rrt", "reinforce"}) {
+    const PolicyFactory a = baseline(name).make(world, tiny, 3, 1);
+    const PolicyFactory b = baseline(name).make(world, tiny, 3, 2);
+    const EvalStats sa = evaluate(a, world, 2, 0, 1), sb = evaluate(b, world, 2, 0, 1);
+    EXPECT_EQ(sa.episodes, 2) << name;
+    EXPECT_EQ(sa.mean_length, sb.mean_length) << name;
+    EXPECT_EQ(sa.dice_in_cup_mean, sb.dice_in_cup_mean) << name;
+  }
+}
+
+TEST(OutcomeCounts, AreTheRatesTimesTheEpisodes) {
+  EvalStats s;
+  s.episodes = 7;
+  s.stacked = wilson(3, 7);
+  s.wall_contact = wilson(7, 7);
+  s.realistic_success = wilson(0, 7);
+  const OutcomeCounts n = outcome_counts(s);
+  EXPECT_EQ(n.episodes, 7);
+  EXPECT_EQ(n.stacked, 3);
+  EXPECT_EQ(n.wall_contact, 7);
+  EXPECT_EQ(n.realistic_success, 0);
+}
+
+}  // namespace
+}  // namespace dicestack
