@@ -34,8 +34,8 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   add_leaderboard_command(app, cluster);
   add_learners_command(app);
   add_optimise_command(app, cluster);
-  add_reinforce_command(app);
-  add_rrt_command(app);
+  add_reinforce_command(app, cluster);
+  add_rrt_command(app, cluster);
   add_play_command(app);
   add_train_command(app, cluster);
   add_record_command(app, cluster);
@@ -45,7 +45,8 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   if (cluster.size() > 1)
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
       const std::string name = sub->get_name();
-      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard" && name != "optimise")
+      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard" && name != "optimise" &&
+          name != "reinforce" && name != "rrt")
         sub->preparse_callback([&cluster](std::size_t) {
           if (!cluster.is_root()) throw RootOnly{};
         });

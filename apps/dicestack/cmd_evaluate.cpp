@@ -33,6 +33,9 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
   if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))
     throw InputError(opt.video_dir.string() + ": --video-dir exists and is not a folder");
+  std::optional<Score> errors;  // before the rollouts, so that a bad set fails at once; the root prints them
+  if (!opt.demos.empty() && cluster.is_root())
+    errors = score(*model, DemoSplit(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, "episodes"));
   const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
   std::vector<Episode> rollouts;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,
@@ -61,8 +64,6 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
   }
-  std::optional<Score> errors;
-  if (!opt.demos.empty()) errors = score(*model, DemoSplit(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, "episodes"));
   if (opt.json) {
     print_line(evaluation_json({opt.model.string(), opt.seed, opt.push}, *model, s,
                                errors ? &*errors : nullptr));

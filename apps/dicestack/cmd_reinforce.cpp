@@ -17,17 +17,20 @@ struct ReinforceCommandOptions {
   bool json = false;
 };
 
-int run_reinforce(const ReinforceCommandOptions& opt) {
+int run_reinforce(const ReinforceCommandOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);
   const WorldConfig world = opt.world.load();
+  ReinforceOptions options = opt.reinforce;
+  options.cluster = &cluster;  // the ranks share each batch's episodes
   ProgressBar bar;
-  const ReinforceResult r = reinforce(world, opt.reinforce, [&](const ReinforcePoint& p) {
+  const ReinforceResult r = reinforce(world, options, [&](const ReinforcePoint& p) {
     char text[160];
     std::snprintf(text, sizeof text, "reinforce: iteration %d/%d, mean return %.3g, greedy cost %.4g", p.iteration,
                   opt.reinforce.iterations, p.mean_return, p.greedy_cost);
     bar.update(static_cast<double>(p.iteration) / opt.reinforce.iterations, text);
   });
   bar.finish();
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   WorldConfig played = world;
   played.episode.max_steps = std::max(played.episode.max_steps, opt.reinforce.steps);
   const Episode greedy = replay(played, r.greedy_actions, 0, "dicestack reinforce");
@@ -52,7 +55,7 @@ int run_reinforce(const ReinforceCommandOptions& opt) {
 
 }  // namespace
 
-void add_reinforce_command(CLI::App& app) {
+void add_reinforce_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<ReinforceCommandOptions>();
   auto& r = opt->reinforce;
   CLI::App* cmd = app.add_subcommand("reinforce", "REINFORCE from the paper's start (paper V-C): a Gaussian policy on a 3-layer network");
@@ -71,7 +74,7 @@ void add_reinforce_command(CLI::App& app) {
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the greedy episode (a demonstration set) and reinforce.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] { run_reinforce(*opt); });
+  cmd->callback([opt, &cluster] { run_reinforce(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

@@ -17,16 +17,23 @@ struct RrtCommandOptions {
   bool json = false;
 };
 
-int run_rrt(const RrtCommandOptions& opt) {
+int run_rrt(const RrtCommandOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);
   const WorldConfig world = opt.world.load();
+  // With CMA-ES an extension's generation is one batch, which the ranks share; the other
+  // methods evaluate one point at a time and run on the root alone.
+  const bool shared = opt.rrt.method == "cmaes";
+  if (!shared && !cluster.is_root()) return 0;
+  RrtOptions options = opt.rrt;
+  options.cluster = shared ? &cluster : &local_cluster();
   ProgressBar bar;
-  const RrtResult r = rrt(world, opt.rrt, [&](int nodes, double best) {
+  const RrtResult r = rrt(world, options, [&](int nodes, double best) {
     char text[160];
     std::snprintf(text, sizeof text, "rrt: %d/%d nodes, nearest to the goal %.4g", nodes, opt.rrt.nodes, best);
     bar.update(static_cast<double>(nodes) / std::max(1, opt.rrt.nodes), text);
   });
   bar.finish();
+  if (!cluster.is_root()) return 0;  // the root writes and prints
   WorldConfig played = world;
   played.episode.max_steps = std::max(played.episode.max_steps, static_cast<int>(r.actions.size()));
   // When no node got nearer the goal than the start, there is no path: only rrt.json is written.
@@ -52,7 +59,7 @@ int run_rrt(const RrtCommandOptions& opt) {
 
 }  // namespace
 
-void add_rrt_command(CLI::App& app) {
+void add_rrt_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<RrtCommandOptions>();
   auto& r = opt->rrt;
   CLI::App* cmd = app.add_subcommand("rrt", "RRT from the paper's start (paper V-D): extensions optimise a few steps of actions");
@@ -66,7 +73,7 @@ void add_rrt_command(CLI::App& app) {
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the best path (a demonstration set) and rrt.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt] { run_rrt(*opt); });
+  cmd->callback([opt, &cluster] { run_rrt(*opt, cluster); });
 }
 
 }  // namespace dicestack::cli

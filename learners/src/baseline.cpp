@@ -59,11 +59,14 @@ std::vector<BaselineInfo> make_baselines() {
   std::vector<BaselineInfo> all;
   for (const auto& method : optimiser_names())  // every open-loop optimiser is a baseline
     all.push_back({method, "open-loop action sequence optimised by " + method, method == "bayes" ? 60.0 : 30.0,
+                   [method](const Profile& p) { return method == "bayes" ? p.bayes_evaluations : p.optimiser_evaluations; },
                    [method](const WorldConfig& w, const Profile& p, std::uint64_t seed, int threads) {
                      return open_loop(method, w, p, seed, threads);
                    }});
-  all.push_back({"reinforce", "REINFORCE policy network, from rewards alone", 40.0, &reinforce_baseline});
-  all.push_back({"rrt", "RRT over world snapshots, its best branch played open loop", 20.0, &rrt_baseline});
+  all.push_back({"reinforce", "REINFORCE policy network, from rewards alone", 40.0,
+                 [](const Profile& p) { return p.reinforce_iterations; }, &reinforce_baseline});
+  all.push_back({"rrt", "RRT over world snapshots, its best branch played open loop", 20.0,
+                 [](const Profile& p) { return p.rrt_nodes; }, &rrt_baseline});
   return all;
 }
 

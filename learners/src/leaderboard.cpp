@@ -100,8 +100,9 @@ double estimated_row_cost(const std::string& learner, const std::string& regress
   // other than "paper" is costed as quick.
   const bool paper = profile.name == "paper";
   if (learner == "baseline") {
-    const double budget = static_cast<double>(profile.optimiser_evaluations) / leaderboard_profile("quick").optimiser_evaluations;
-    return budget * baseline(regressor).quick_seconds + rollouts * 0.01;
+    const BaselineInfo& b = baseline(regressor);
+    const double budget = static_cast<double>(b.budget(profile)) / b.budget(leaderboard_profile("quick"));
+    return budget * b.quick_seconds + rollouts * 0.01;
   }
   auto pick = [](const std::map<std::string, double>& table, const std::string& key, double otherwise) {
     const auto it = table.find(key);

@@ -3,7 +3,7 @@
 # under mpirun -np 2 and -np 3 (with 1 and 2 threads per rank), outputs compared byte for byte
 # (timing fields removed from JSON). `failure` checks that a rank that fails or dies ends the
 # whole run quickly with a clear message.
-#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | evaluate | dagger | dad | dart | leaderboard | optimise | failure
+#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | evaluate | dagger | dad | dart | leaderboard | optimise | reinforce | rrt | failure
 set -euo pipefail
 exe="$1"
 mpirun="$2"
@@ -22,13 +22,14 @@ fail() { echo "FAIL: $*"; exit 1; }
 same() {  # same A B: byte-identical files or folders
   diff -r "$1" "$2" > "$work/diff.txt" || { head -20 "$work/diff.txt"; fail "$1 and $2 differ"; }
 }
-# JSON without its timing fields (seconds, fit_s, us_per_step, seconds_per_episode), keys sorted.
+# JSON without its timing fields (seconds, fit_s, us_per_step, seconds_per_episode, the rates), keys sorted.
 untimed() {
   python3 - "$1" <<'PY'
 import json, sys
 def strip(v):
     if isinstance(v, dict):
-        return {k: strip(x) for k, x in v.items() if k not in ("seconds", "fit_s", "us_per_step", "seconds_per_episode", "evaluations_per_second")}
+        return {k: strip(x) for k, x in v.items() if k not in ("seconds", "fit_s", "us_per_step", "seconds_per_episode", "evaluations_per_second",
+                                                        "steps_per_second")}
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v
@@ -136,6 +137,23 @@ PY
     same "$work/opt-1.txt" "$work/opt-3.txt"
     same "$work/opt-1" "$work/opt-2"
     same "$work/opt-1" "$work/opt-3"
+    ;;
+  reinforce|rrt)  # REINFORCE's batches and the RRT's CMA-ES generations shared among the ranks
+    if [ "$mode" = reinforce ]; then
+      opts=(--iterations 4 --batch 5 --steps 20 --seed 6)
+    else
+      opts=(--nodes 6 --extend-steps 5 --seed 6)
+    fi
+    for run in "1 2" "2 1" "3 2"; do
+      set -- $run
+      ranks "$1" "$mode" "${opts[@]}" --threads "$2" --out "$work/$mode-$1" "${world[@]}" > /dev/null
+      untimed "$work/$mode-$1/$mode.json" | grep -v '"out":' > "$work/$mode-$1.txt"  # its own folder
+      rm "$work/$mode-$1/$mode.json"
+    done
+    same "$work/$mode-1.txt" "$work/$mode-2.txt"
+    same "$work/$mode-1.txt" "$work/$mode-3.txt"
+    same "$work/$mode-1" "$work/$mode-2"
+    same "$work/$mode-1" "$work/$mode-3"
     ;;
   failure)
     "$exe" train --regressor knn --demos "$work/demos" --out "$work/knn.dsm" "${world[@]}" > /dev/null

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
 #include <stdexcept>
@@ -177,16 +181,39 @@ TEST(WorkerPool, RunsFirstOnTheCallingThreadBeforeItTakesItems) {
     EXPECT_TRUE(first_done);
     EXPECT_FALSE(caller_item_before_first) << threads << " threads";
     EXPECT_EQ(calls, 64);
-    try {  // an exception from `first` comes back after the loop, and the pool stays usable
-      pool.run(64, [&](std::size_t, int) {}, [] { throw std::runtime_error("first failed"); });
+    calls = 0;
+    try {  // an exception from `first` comes back after every item ran, and the pool stays usable
+      pool.run(64, [&](std::size_t, int) { ++calls; }, [] { throw std::runtime_error("first failed"); });
       FAIL() << "no exception";
     } catch (const std::runtime_error& e) {
       EXPECT_EQ(std::string(e.what()), "first failed");
     }
+    EXPECT_EQ(calls, 64) << threads << " threads";
     calls = 0;
     pool.run(10, [&](std::size_t, int) { ++calls; });
     EXPECT_EQ(calls, 10);
   }
+}
+
+TEST(WorkerPool, AForkedChildRunsSequentiallyAndEndsWithoutItsParentsThreads) {
+  WorkerPool pool(2);
+  pool.run(8, [](std::size_t, int) {});  // the threads exist and have run
+  const pid_t child = fork();
+  ASSERT_NE(child, -1);
+  if (child == 0) {
+    int calls = 0;
+    pool.run(8, [&](std::size_t, int worker) { calls += worker == 0; });
+    pool.~WorkerPool();  // must not wait for threads the child does not have (_exit runs no destructor)
+    _exit(calls == 8 ? 0 : 1);
+  }
+  int status = 0;
+  for (int waited = 0; waited < 100 && waitpid(child, &status, WNOHANG) == 0; ++waited) usleep(100000);
+  if (waitpid(child, &status, WNOHANG) == 0) {
+    kill(child, SIGKILL);
+    waitpid(child, &status, 0);
+    FAIL() << "the forked child hung";
+  }
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
 }  // namespace

@@ -99,6 +99,36 @@ struct EpisodeTrace {
   std::vector<State> states;  // after each step
 };
 
+// An episode as bytes for the ranks (every double kept bit for bit).
+std::string pack_trace(const EpisodeTrace& e) {
+  Packer p;
+  p.put<std::uint64_t>(e.rewards.size());
+  for (std::size_t t = 0; t < e.rewards.size(); ++t) {
+    p.put<std::uint64_t>(static_cast<std::uint64_t>(e.inputs[t].size()));
+    for (Eigen::Index j = 0; j < e.inputs[t].size(); ++j) p.put(e.inputs[t][j]);
+    for (Eigen::Index j = 0; j < 3; ++j) p.put(e.actions[t][j]);
+    p.put(e.rewards[t]).put(e.states[t]);
+  }
+  return p.take();
+}
+
+EpisodeTrace unpack_trace(std::string_view bytes) {
+  Unpacker u(bytes, "REINFORCE episode");
+  EpisodeTrace e;
+  const auto steps = static_cast<std::size_t>(u.get<std::uint64_t>());
+  for (std::size_t t = 0; t < steps; ++t) {
+    Eigen::VectorXd x(static_cast<Eigen::Index>(u.get<std::uint64_t>()));
+    for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = u.get<double>();
+    Eigen::Vector3d a;
+    for (Eigen::Index j = 0; j < 3; ++j) a[j] = u.get<double>();
+    e.inputs.push_back(std::move(x));
+    e.actions.push_back(a);
+    e.rewards.push_back(u.get<double>());
+    e.states.push_back(u.get<State>());
+  }
+  return e;
+}
+
 Eigen::VectorXd scaled_input(const State& s, const CostConfig& cost) {
   Eigen::VectorXd x(kStateDim);
   for (std::size_t j = 0; j < kStateDim; ++j) x[static_cast<Eigen::Index>(j)] = s[j] / cost.sigma[j];
@@ -155,11 +185,13 @@ ReinforceResult reinforce(const WorldConfig& config, const ReinforceOptions& o,
   EnvPool envs(world, o.threads);
   auto env_of = [&](int w) -> DiceEnv& { return envs.at(w); };
   for (int it = 1; it <= o.iterations; ++it) {
-    std::vector<EpisodeTrace> traces(static_cast<std::size_t>(o.batch));
-    parallel_for(traces.size(), o.threads, [&](std::size_t k, int w) {
-      Rng rng(derive_seed(derive_seed(o.seed, static_cast<std::uint64_t>(it)), k));
-      traces[k] = run_episode(env_of(w), net, start, goal, o.steps, o.sigma, &rng);
-    });
+    const std::vector<EpisodeTrace> traces = distributed_map<EpisodeTrace>(
+        *o.cluster, static_cast<std::size_t>(o.batch), o.threads,
+        [&](std::size_t k, int w) {
+          Rng rng(derive_seed(derive_seed(o.seed, static_cast<std::uint64_t>(it)), k));
+          return run_episode(env_of(w), net, start, goal, o.steps, o.sigma, &rng);
+        },
+        pack_trace, unpack_trace);
     // Returns G_t = sum_{u >= t} discount^(u - t) r_u, per episode.
     std::vector<Eigen::VectorXd> returns;
     double mean_return = 0.0;

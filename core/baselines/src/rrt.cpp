@@ -88,7 +88,7 @@ RrtResult rrt(const WorldConfig& config, const RrtOptions& o, const std::functio
     mo.sigma0 = 0.5;
     mo.iterations = o.extend_iterations;
     mo.seed = derive_seed(o.seed, static_cast<std::uint64_t>(k));
-    SequenceEvaluator evaluator(envs, o.threads);
+    SequenceEvaluator evaluator(envs, o.threads, *o.cluster);
     const MinimiseResult found = minimise(extension, evaluator, mo);
     result.simulated_steps += static_cast<long long>(found.evaluations) * o.extend_steps;
     DiceEnv& env = env_of(0);

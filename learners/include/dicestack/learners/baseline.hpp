@@ -17,6 +17,8 @@ struct BaselineInfo {
   std::string name;
   std::string description;
   double quick_seconds = 30.0;  ///< estimated cost on one core under the quick profile (for dealing rows)
+  /// Its budget under a profile (evaluations, updates or nodes); its cost grows in proportion.
+  std::function<int(const Profile&)> budget;
   /// Optimises (or learns) from the world's start with the profile's budget and returns the
   /// policy that plays the result: an open-loop action sequence, or REINFORCE's network.
   std::function<PolicyFactory(const WorldConfig& world, const Profile& profile, std::uint64_t seed, int threads)> make;

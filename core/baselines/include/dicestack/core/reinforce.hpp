@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -23,6 +24,9 @@ struct ReinforceOptions {
   double learning_rate = 1e-3; ///< Adam
   std::uint64_t seed = 0;
   int threads = 0;
+  /// The ranks that share each batch's episodes (dealt round-robin, gathered in index order):
+  /// every rank computes the same update (docs/scaling.md).
+  Cluster* cluster = &local_cluster();
 };
 
 /// The policy network: state / cost.sigma -> LeakyReLU -> LeakyReLU -> tanh, times the action scale.

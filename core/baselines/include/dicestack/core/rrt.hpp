@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 
 namespace dicestack {
@@ -21,6 +22,8 @@ struct RrtOptions {
   int max_depth_steps = 400;   ///< a node this many steps from the root is not extended
   std::uint64_t seed = 0;
   int threads = 0;             ///< an extension's CMA-ES generation is evaluated in parallel
+  /// The ranks that share each CMA-ES generation (docs/scaling.md); the same tree on every rank.
+  Cluster* cluster = &local_cluster();
 };
 
 struct RrtResult {

@@ -14,7 +14,8 @@ namespace dicestack {
 
 /// parallel_for's contract (fn(i, worker) for every i, worker in [0, threads()), no two calls on
 /// one worker at once, the first exception rethrown) over threads started once. The calling
-/// thread is worker 0 and works too; idle workers spin briefly, then sleep. One run at a time.
+/// thread is worker 0 and works too; idle workers poll for 50 µs, then sleep. One run at a time.
+/// In a child forked from the creating process the threads are gone: runs there are sequential.
 class WorkerPool {
  public:
   /// `threads` as in parallel_for (0 = all cores); threads() - 1 threads are started.
@@ -27,15 +28,17 @@ class WorkerPool {
 
   /// Calls fn(i, worker) for every i in [0, n). `first`, if given, runs on the calling thread
   /// after the workers start and before it takes items: work that must stay on this thread
-  /// (making Python objects) overlaps the loop. Its exception is rethrown after the loop stops.
+  /// (making Python objects) overlaps the loop. Its exception does not stop the loop: it is
+  /// rethrown after every item ran (an item's exception, which does stop it, comes first).
   void run(std::size_t n, const std::function<void(std::size_t i, int worker)>& fn,
            const std::function<void()>& first = {});
 
  private:
   void serve(int worker);
   void take_items(int worker);
-  void record_error();
+  void stop_workers();
 
+  int owner_;  // the process that started the threads
   std::vector<std::thread> workers_;
   std::atomic<std::uint64_t> generation_{0};  // bumped to start a run (or to stop, with stop_)
   std::atomic<int> running_{0};               // background workers not yet done with this run
