@@ -21,8 +21,9 @@
 #include <dicestack/learners/baseline.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
-#include <dicestack/regressors/score.hpp>
 #include <dicestack/version.hpp>
+
+#include "leaderboard_rows.hpp"
 
 namespace dicestack {
 namespace {
@@ -41,16 +42,6 @@ json row_json(const LeaderboardRow& r) {
           {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
 }
 
-void add_outcomes(LeaderboardRow& row, const EvalStats& st, int seeds) {
-  const OutcomeCounts n = outcome_counts(st);
-  row.episodes += n.episodes;
-  row.stacked += n.stacked;
-  row.walls += n.wall_contact;
-  row.success += n.realistic_success;
-  row.dice_in_cup += st.dice_in_cup_mean / seeds;
-  row.us_per_step += st.policy_us_per_step / seeds;
-}
-
 LeaderboardRow row_from(const json& j) {
   LeaderboardRow r;
   r.regressor = j.at("regressor");
@@ -65,29 +56,6 @@ LeaderboardRow row_from(const json& j) {
   r.success = j.at("realistic_success");
   r.fit_s = j.at("fit_s");
   r.us_per_step = j.at("us_per_step");
-  return r;
-}
-
-void pack_row(Packer& p, const LeaderboardRow& r) {
-  p.put_string(r.regressor).put_string(r.learner).put_string(r.features);
-  p.put(r.train_error).put(r.test_error).put(r.fit_s).put(r.us_per_step).put(r.dice_in_cup);
-  p.put(r.episodes).put(r.stacked).put(r.walls).put(r.success);
-}
-
-LeaderboardRow unpack_row(Unpacker& u) {
-  LeaderboardRow r;
-  r.regressor = u.get_string();
-  r.learner = u.get_string();
-  r.features = u.get_string();
-  r.train_error = u.get<double>();
-  r.test_error = u.get<double>();
-  r.fit_s = u.get<double>();
-  r.us_per_step = u.get<double>();
-  r.dice_in_cup = u.get<double>();
-  r.episodes = u.get<int>();
-  r.stacked = u.get<int>();
-  r.walls = u.get<int>();
-  r.success = u.get<int>();
   return r;
 }
 
@@ -246,7 +214,6 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
   };
   auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
-  auto tick = [&](const std::string& text, double fraction) { report(text, fraction, false); };
   const WorldConfig& world = opt.world;
   const int episodes = opt.episodes > 0 ? opt.episodes : profile.rollouts;
   const auto& dir = opt.demos;
@@ -300,8 +267,6 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
   const DemoSplit split(set.episodes, opt.split);
-  const std::vector<Episode>& train = split.train();
-  const std::vector<Episode>& held_out = split.held_out();
 
   std::size_t frames = 0;
   for (const auto& e : set.episodes) frames += e.size();
@@ -374,101 +339,17 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     }
   for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", 0, b});
 
-  // A learner row's measurements for one training seed; rows add their seeds up in seed order.
-  struct SeedResult {
-    double fit_s = 0.0, train_error = 0.0, test_error = 0.0;
-    bool has_test = false;
-    EvalStats stats;
-  };
-  auto pack_seed = [](const SeedResult& r) {
-    return Packer().put(r.fit_s).put(r.train_error).put(r.test_error).put<std::uint8_t>(r.has_test).put(r.stats).take();
-  };
-  auto unpack_seed = [](std::string_view bytes) {
-    Unpacker u(bytes, "leaderboard seed result");
-    SeedResult r;
-    r.fit_s = u.get<double>();
-    r.train_error = u.get<double>();
-    r.test_error = u.get<double>();
-    r.has_test = u.get<std::uint8_t>() != 0;
-    r.stats = u.get<EvalStats>();
-    return r;
-  };
-
-  // One baseline row, or one seed of a learner row, on this rank alone when several share the
-  // run (`inner` is then the single process); its progress fraction runs from `from` to `from + span`.
-  auto measure_baseline = [&](const Job& job, Cluster& inner, double from, double span) {
-    const std::string& name = job.regressor;
-    say("baseline " + name, from);
-    const auto t0 = std::chrono::steady_clock::now();
-    const PolicyFactory policy = baseline(name).make(world, profile, opt.seed, opt.threads);
-    LeaderboardRow row{name, "baseline"};
-    row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    row.train_error = row.test_error = -1;
-    for (int s = 0; s < opt.seeds; ++s) {
-      const EvalStats st = evaluate(policy, world, episodes, opt.seed + static_cast<std::uint64_t>(s), opt.threads,
-                                    InitialPush::none, nullptr, [&](int finished, int of) {
-                                      tick("baseline " + name, from + span * (s + static_cast<double>(finished) / of) / opt.seeds);
-                                    }, inner);
-      add_outcomes(row, st, opt.seeds);
-    }
-    return row;
-  };
-  auto measure_seed = [&](const Job& job, Cluster& inner, double from, double span) {
-    const std::string& learner_name = job.learner;
-    const std::string& name = job.regressor;
-    const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(job.seed);
-    const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + learner_name + " " + name;
-    // Training is the first half of a seed's share, rollouts the second.
-    auto at = [&](double part) { return from + span * part; };
-    say(row_text + ": training (seed " + std::to_string(seed) + ")", at(0.0));
-    LearnContext c;
-    c.world = world;
-    c.regressor = name;
-    c.features = job.features;
-    c.seed = seed;
-    c.threads = opt.threads;
-    c.demos = train;
-    c.held_out = held_out;
-    c.cluster = &inner;
-    std::string last_phase;
-    c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
-      const std::string phase = std::to_string(p.iteration) + p.phase;
-      const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
-                               std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
-      report(text, at(0.5 * p.fraction), phase != last_phase);
-      last_phase = phase;
-    };
-    SeedResult r;
-    const auto t0 = std::chrono::steady_clock::now();
-    const LearnResult learned = LearnerRegistry::global().create(learner_name, options_for(learner_name))->learn(c);
-    r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const Score errors = score(*learned.model, split);
-    r.train_error = errors.train_error;
-    r.has_test = errors.test_error.has_value();
-    r.test_error = errors.test_error.value_or(0.0);
-    const std::string rollouts_text = row_text + ": " + std::to_string(episodes) + " rollouts";
-    say(rollouts_text, at(0.5));
-    std::shared_ptr<const Model> model = learned.model;
-    r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, seed, opt.threads,
-                       InitialPush::none, nullptr, [&](int finished, int of) {
-                         tick(rollouts_text, at(0.5 + 0.5 * finished / of));
-                       }, inner);
-    return r;
-  };
-  // A learner row from its seeds, added up in seed order (the same sums for any deal).
-  auto combine = [&](const Job& job, const std::vector<SeedResult>& seeds) {
-    LeaderboardRow row{job.regressor, job.learner, job.features};
-    for (const SeedResult& r : seeds) {
-      row.fit_s += r.fit_s / opt.seeds;
-      row.train_error += r.train_error / opt.seeds;
-      if (!r.has_test)
-        row.test_error = -1;  // no test episode: printed "-"
-      else
-        row.test_error += r.test_error / opt.seeds;
-      add_outcomes(row, r.stats, opt.seeds);
-    }
-    return row;
-  };
+  // Each job's work (learner_seed, baseline_row) and how a row adds its seeds up (combine).
+  RowSettings settings;
+  settings.world = world;
+  settings.profile = &profile;
+  settings.split = &split;
+  settings.episodes = episodes;
+  settings.seeds = opt.seeds;
+  settings.seed = opt.seed;
+  settings.threads = opt.threads;
+  settings.learner_options = options_for;
+  const RowRunner runner(settings, report);
 
   // Finished rows by their first job; a learner row goes to <out>.partial.json as soon as the
   // root has all its seeds.
@@ -492,22 +373,27 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
       keep_row(j, unpack_row(u));
       return;
     }
-    seed_results[j] = unpack_seed(bytes);
+    seed_results[j] = unpack_seed_result(bytes);
     const std::size_t first = j - static_cast<std::size_t>(jobs[j].seed);
     std::vector<SeedResult> seeds;
     for (std::size_t k = first; k < first + static_cast<std::size_t>(opt.seeds); ++k) {
       if (!seed_results[k]) return;  // more seeds to come
       seeds.push_back(*seed_results[k]);
     }
-    keep_row(first, combine(jobs[first], seeds));
+    keep_row(first, runner.combine(jobs[first].learner, jobs[first].features, jobs[first].regressor, seeds));
   };
+  // One job (a baseline, or one seed of a learner row) on `inner` (the single process when
+  // several ranks share the run); its progress fraction runs from `from` to `from + span`.
   auto run_job = [&](std::size_t j, Cluster& inner, double from, double span) {
-    if (jobs[j].index == 0) {
+    const Job& job = jobs[j];
+    if (job.index == 0) {
       Packer p;
-      pack_row(p, measure_baseline(jobs[j], inner, from, span));
+      pack_row(p, runner.baseline_row(job.regressor, inner, from, span));
       return p.take();
     }
-    return pack_seed(measure_seed(jobs[j], inner, from, span));
+    const std::string row_text =
+        "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + job.learner + " " + job.regressor;
+    return pack_seed_result(runner.learner_seed(job.learner, job.features, job.regressor, job.seed, row_text, inner, from, span));
   };
   if (cluster.size() == 1) {
     for (std::size_t j = 0; j < jobs.size(); ++j) {
