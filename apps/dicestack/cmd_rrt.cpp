@@ -20,12 +20,8 @@ struct RrtCommandOptions {
 int run_rrt(const RrtCommandOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);
   const WorldConfig world = opt.world.load();
-  // With CMA-ES an extension's generation is one batch, which the ranks share; the other
-  // methods evaluate one point at a time and run on the root alone.
-  const bool shared = opt.rrt.method == "cmaes";
-  if (!shared && !cluster.is_root()) return 0;
   RrtOptions options = opt.rrt;
-  options.cluster = shared ? &cluster : &local_cluster();
+  options.cluster = &cluster;  // the ranks share each extension's CMA-ES generations (the command's method)
   ProgressBar bar;
   const RrtResult r = rrt(world, options, [&](int nodes, double best) {
     char text[160];

@@ -279,6 +279,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   for (const auto& l : learners) learner_options[l] = options_for(l);
   for (const auto& [l, f] : combos) row_features.push_back(l + " " + f);
   header << "; learner options " << learner_options.dump() << "; features " << row_features.dump();
+  // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart).
   auto left_out = [&](const std::string& learner, const std::string& regressor) {
     if (!opt.regressors.empty()) return false;  // named regressors are always run
     return std::find(profile.left_out.begin(), profile.left_out.end(), std::pair{learner, regressor}) != profile.left_out.end();
@@ -314,8 +315,6 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     return rows_done.dump();
   }));
 
-  // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart).
-  const auto& skipped = left_out;
   const std::size_t total = combos.size() * regressors.size();
   // Progress in units of rows: one per (learner, map, regressor) and per baseline.
   const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
@@ -334,7 +333,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     for (const auto& name : regressors) {
       ++index;
       const std::string key = learner_name + "/" + features + "/" + name;
-      if (!skipped(learner_name, name) && !done.contains(key))
+      if (!left_out(learner_name, name) && !done.contains(key))
         for (int s = 0; s < opt.seeds; ++s) jobs.push_back({index, learner_name, features, name, key, s, 0});
     }
   for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", 0, b});
@@ -496,7 +495,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   for (const auto& [learner_name, features] : combos)
     for (const auto& name : regressors) {
       ++index;
-      if (skipped(learner_name, name)) continue;
+      if (left_out(learner_name, name)) continue;
       if (next < jobs.size() && jobs[next].index == index) {
         rows.push_back(*measured[next]);
         next += static_cast<std::size_t>(opt.seeds);

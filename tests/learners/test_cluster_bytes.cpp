@@ -6,19 +6,14 @@
 #include <dicestack/learners/record.hpp>
 #include <dicestack/regressors/model.hpp>
 #include <dicestack/test/episodes.hpp>
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {
 
-WorldConfig short_world() {
-  WorldConfig w;
-  w.episode.max_steps = 40;
-  return w;
-}
-
 // What travels between ranks must come back bit for bit, or results would change with the rank count.
 TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
-  auto eps = record_expert("scripted", {}, short_world(), 2, 11, 1);
+  auto eps = record_expert("scripted", {}, test::short_world(40), 2, 11, 1);
   eps[1].final_state.reset();
   eps[1].rewards.clear();
   eps[1].name = "episode_0001";
@@ -32,7 +27,7 @@ TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
 // exactly as the original and writes the same bytes again.
 TEST(ClusterBytes, ModelBytesRoundTripForEveryRegressor) {
   LearnContext c;
-  c.world = short_world();
+  c.world = test::short_world(40);
   c.demos = record_expert("scripted", {}, c.world, 2, 3, 1);
   for (const std::string& name : RegressorRegistry::global().names()) {
     c.regressor = name;

@@ -17,15 +17,9 @@
 namespace dicestack {
 namespace {
 
-WorldConfig short_world() {
-  WorldConfig w;
-  w.episode.max_steps = 60;
-  return w;
-}
-
 // Scripted-expert episodes of 60 steps: demonstrations the world replays bit for bit.
 const std::vector<Episode>& demos() {
-  static const std::vector<Episode> d = record_expert("scripted", {}, short_world(), 3, 5, 1);
+  static const std::vector<Episode> d = record_expert("scripted", {}, test::short_world(), 3, 5, 1);
   return d;
 }
 
@@ -44,7 +38,7 @@ CorrectionProblem window_of(DiceEnv& env, const Episode& demo, std::size_t t, st
 class CorrectorTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CorrectorTest, CorrectionsReduceTheDeviationFromTheDemonstration) {
-  DiceEnv env(short_world());
+  DiceEnv env(test::short_world());
   const Episode& demo = demos()[0];
   CorrectionProblem p = window_of(env, demo, 10, 8);
   for (auto& a : p.warm) a[0] += 0.6, a[1] -= 0.05;  // a policy that drifts
@@ -66,7 +60,7 @@ TEST_P(CorrectorTest, LabelsAreInTheDemonstrationsUnits) {
   // corrector must hand back exactly those actions, in the units they were recorded in. A
   // corrector that returned its search variables (action / scale) would fail here: the scales
   // are 1, 0.1 and 0.5.
-  DiceEnv env(short_world());
+  DiceEnv env(test::short_world());
   const Episode& demo = demos()[0];
   const CorrectionProblem p = window_of(env, demo, 20, 6);
   const Correction fix = make_corrector(GetParam(), {5, 0.25, 0})->correct(env, p, 4);
@@ -85,7 +79,7 @@ TEST(Dad, UnknownCorrectorIsRejected) {
 
 LearnContext dad_context(int threads) {
   LearnContext c;
-  c.world = short_world();
+  c.world = test::short_world();
   c.regressor = "knn";
   c.seed = 21;
   c.threads = threads;

@@ -20,12 +20,6 @@ namespace {
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 
-WorldConfig short_world() {
-  WorldConfig w;
-  w.episode.max_steps = 60;
-  return w;
-}
-
 TEST(Starts, TrainingAndEvaluationStreamsShareNoStart) {
   // Every seed a user is likely to type, on both sides: no start seed (hence no start) in common.
   std::set<std::uint64_t> evaluation;
@@ -34,7 +28,7 @@ TEST(Starts, TrainingAndEvaluationStreamsShareNoStart) {
   for (std::uint64_t s = 0; s < 20; ++s)
     for (std::uint64_t i = 0; i < 500; ++i) ASSERT_FALSE(evaluation.contains(training_start_seed(s, i))) << s << " " << i;
   // And the starts themselves: record --seed 0 against evaluate --seed 0.
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   const auto recorded = record_expert("scripted", {}, w, 5, 0, 1);
   std::vector<Episode> evaluated;
   evaluate([] { return std::make_unique<PlaybackPolicy>(Episode{}); }, w, 5, 0, 1, InitialPush::none, &evaluated);
@@ -57,7 +51,7 @@ class Probe final : public Policy {
 };
 
 TEST(Rollout, PoliciesSeeTheirHistoryAndTheActionsTheWorldApplied) {
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   DiceEnv env(w);
   Probe p;
   const State start = random_start_state(w, 3);
@@ -72,7 +66,7 @@ TEST(Rollout, PoliciesSeeTheirHistoryAndTheActionsTheWorldApplied) {
 }
 
 TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   DiceEnv a(w), b(w);
   auto expert = make_expert("scripted");
   ExpertPolicy pa(*expert, a);
@@ -96,7 +90,7 @@ TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
 TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
   const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2", "successes_only=false"});
   LearnContext c;
-  c.world = short_world();
+  c.world = test::short_world();
   c.regressor = "knn";
   c.features = "state+clock+start";
   c.seed = 5;
@@ -120,7 +114,7 @@ TEST(Dart, AModelFileAloneRollsOut) {
   // At evaluation only the regressor acts: the model is read back from its file, and the
   // rollout gets no expert, no simulation ahead and no snapshot (ModelPolicy sees a History).
   LearnContext c;
-  c.world = short_world();
+  c.world = test::short_world();
   c.regressor = "linear_svr";
   c.features = "state+clock+start";
   c.seed = 2;
@@ -138,7 +132,7 @@ TEST(Dart, AModelFileAloneRollsOut) {
 
 TEST(Dad, RefusesAFeatureMapBeyondTheState) {
   LearnContext c;
-  c.world = short_world();
+  c.world = test::short_world();
   c.demos = record_expert("scripted", {}, c.world, 2, 1, 1);
   c.features = "state+clock";
   const std::string error =

@@ -7,18 +7,13 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/replay.hpp>
 #include <dicestack/learners/record.hpp>
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {
 
-WorldConfig short_world() {
-  WorldConfig w;
-  w.episode.max_steps = 60;
-  return w;
-}
-
 TEST(Transitions, RolloutsRecordTheFinalStateRewardsAndEnd) {
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   const State goal = goal_state(w);
   for (const Episode& e : record_expert("scripted", {}, w, 3, 4, 1)) {
     ASSERT_TRUE(e.has_transitions()) << e.name;
@@ -33,7 +28,7 @@ TEST(Transitions, RolloutsRecordTheFinalStateRewardsAndEnd) {
 }
 
 TEST(Transitions, VersionOneEpisodesAreRecoveredExactlyByReplay) {
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   const auto recorded = record_expert("scripted", {}, w, 3, 9, 1);
   std::vector<Episode> v1 = recorded;
   for (auto& e : v1) e.clear_transitions();
@@ -47,7 +42,7 @@ TEST(Transitions, VersionOneEpisodesAreRecoveredExactlyByReplay) {
 }
 
 TEST(Transitions, EpisodesThatDoNotReplayAreNamedAndLeftAlone) {
-  const WorldConfig w = short_world();
+  const WorldConfig w = test::short_world();
   // DART: the world executed noisy actions, the file holds the clean labels.
   auto noisy = record_expert("scripted", {}, w, 2, 1, 1, Action{0.3, 0.3, 0.3});
   noisy[0].name = "noisy_0";

@@ -23,6 +23,7 @@ struct RrtOptions {
   std::uint64_t seed = 0;
   int threads = 0;             ///< an extension's CMA-ES generation is evaluated in parallel
   /// The ranks that share each CMA-ES generation (docs/scaling.md); the same tree on every rank.
+  /// The other methods evaluate one point at a time: every rank then repeats the whole search.
   Cluster* cluster = &local_cluster();
 };
 

@@ -18,6 +18,13 @@ namespace dicestack::test {
 
 inline bool bit_equal(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
 
+/// The default world with a short time limit, for tests that roll out or learn.
+inline WorldConfig short_world(int max_steps = 60) {
+  WorldConfig w;
+  w.episode.max_steps = max_steps;
+  return w;
+}
+
 /// `n` actions uniform in the optimisers' scale, from `seed`.
 inline std::vector<Action> random_actions(const WorldConfig& c, std::uint64_t seed, int n) {
   Rng rng(seed);
