@@ -5,6 +5,7 @@
 #include <cstring>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
@@ -212,6 +213,40 @@ class MpcExpert final : public Expert {
   std::optional<DiceEnv> sim_;
 };
 
+// Follows one recorded cup path chosen once per episode, at its first query, by simulating the
+// recordings from that state (choose_path); afterwards only tracks it. Its actions are then a
+// function of the start, the step and the state: consistent labels, as DART needs.
+class TrackerExpert final : public Expert {
+ public:
+  explicit TrackerExpert(const ExpertConfig& config) : recordings_(config.recordings) {}
+  std::string name() const override { return "tracker"; }
+
+ private:
+  void do_reset(std::uint64_t seed) override {
+    seed_ = seed;
+    follower_ = PathFollower();
+  }
+
+  Action do_act(const DiceEnv& env) override {
+    const int t = env.t();
+    if (!follower_.valid() || t < start_step_) {
+      if (!sim_) sim_.emplace(env.config());
+      choice_ = choose_path(*recordings_, env, *sim_, seed_);
+      start_step_ = t;
+      follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, env.get_state(), t,
+                               recordings_->config().gain);
+    }
+    return follower_.act(env.get_state(), t);
+  }
+
+  std::shared_ptr<const Recordings> recordings_;
+  std::uint64_t seed_ = 0;
+  PathFollower follower_;
+  TrackerChoice choice_;
+  int start_step_ = 0;
+  std::optional<DiceEnv> sim_;
+};
+
 }  // namespace
 
 void Expert::reset(std::uint64_t seed) { do_reset(seed); }
@@ -225,18 +260,57 @@ Action Expert::act(const DiceEnv& env) {
   return a;
 }
 
-std::vector<ExpertInfo> expert_list() {
-  return {{"scripted", "the tuned swing plan (scoop, swing, stop) tracked by feedback; no simulation"},
-          {"mpc", "searches swing plans in the simulator from the current state; replans when off its prediction"}};
+ExpertRegistry& ExpertRegistry::global() {
+  static ExpertRegistry* registry = [] {
+    auto* r = new ExpertRegistry;
+    r->add({"scripted", "the tuned swing plan (scoop, swing, stop) tracked by feedback; no simulation"},
+           [](const ExpertConfig& c) { return std::make_unique<ScriptedExpert>(c); });
+    r->add({"mpc", "searches swing plans in the simulator from the current state; replans when off its prediction"},
+           [](const ExpertConfig& c) { return std::make_unique<MpcExpert>(c); });
+    r->add({"tracker", "follows the recorded cup path (of --demos) that succeeds when simulated from the start"},
+           [](const ExpertConfig& c) -> std::unique_ptr<Expert> {
+             if (!c.recordings)
+               throw ConfigError("expert \"tracker\" needs recordings to follow (a demonstration set: --demos)");
+             return std::make_unique<TrackerExpert>(c);
+           });
+    return r;
+  }();
+  return *registry;
 }
 
-std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config) {
-  validate(config);
-  if (name == "scripted") return std::make_unique<ScriptedExpert>(config);
-  if (name == "mpc") return std::make_unique<MpcExpert>(config);
+void ExpertRegistry::add(ExpertInfo info, Factory factory) {
+  for (const auto& e : entries_)
+    if (e.info.name == info.name) throw ConfigError("expert \"" + info.name + "\" registered twice");
+  entries_.push_back({std::move(info), std::move(factory)});
+}
+
+ExpertRegistry::Factory ExpertRegistry::replace(std::string_view name, Factory factory) {
+  for (auto& e : entries_)
+    if (e.info.name == name) return std::exchange(e.factory, std::move(factory));
+  throw ConfigError("expert \"" + std::string(name) + "\" is not registered");
+}
+
+std::unique_ptr<Expert> ExpertRegistry::create(std::string_view name, const ExpertConfig& config) const {
+  for (const auto& e : entries_)
+    if (e.info.name == name) {
+      validate(config);
+      return e.factory(config);
+    }
   std::string known;
-  for (const auto& e : expert_list()) known += (known.empty() ? "" : ", ") + e.name;
+  for (const auto& e : entries_) known += (known.empty() ? "" : ", ") + e.info.name;
   throw ConfigError("unknown expert \"" + std::string(name) + "\"; known: " + known);
+}
+
+std::vector<ExpertInfo> ExpertRegistry::list() const {
+  std::vector<ExpertInfo> out;
+  for (const auto& e : entries_) out.push_back(e.info);
+  return out;
+}
+
+std::vector<ExpertInfo> expert_list() { return ExpertRegistry::global().list(); }
+
+std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config) {
+  return ExpertRegistry::global().create(name, config);
 }
 
 ExpertEpisode run_expert_episode(Expert& expert, DiceEnv& env, bool keep_trajectory) {

@@ -62,12 +62,7 @@ double SwingPlan::lowest(double angle) const {
   return -m;
 }
 
-double SwingPlan::reach(double angle, double side) const {
-  double m = -1e9;
-  for (const auto& seg : cup_.segments)
-    for (const Vec2 q : {seg.a, seg.b}) m = std::max(m, side * to_world({0.0, 0.0}, angle, q).x + seg.radius);
-  return m;
-}
+double SwingPlan::reach(double angle, double side) const { return cup_reach(cup_, angle, side); }
 
 double SwingPlan::safe_x(double x) const {
   // The reach depends on the tilt, which depends on x: a few fixed-point passes settle it.

@@ -1,5 +1,6 @@
 #include <dicestack/core/geometry.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace dicestack {
@@ -51,6 +52,13 @@ double die_inertia(const DiceConfig& dice) {
 Vec2 to_world(Vec2 origin, double angle, Vec2 p) {
   const double c = std::cos(angle), s = std::sin(angle);
   return {origin.x + c * p.x - s * p.y, origin.y + s * p.x + c * p.y};
+}
+
+double cup_reach(const CupGeometry& cup, double angle, double side) {
+  double m = -1e300;
+  for (const auto& seg : cup.segments)
+    for (const Vec2 q : {seg.a, seg.b}) m = std::max(m, side * to_world({0.0, 0.0}, angle, q).x + seg.radius);
+  return m;
 }
 
 Vec2 to_local(Vec2 origin, double angle, Vec2 p) {

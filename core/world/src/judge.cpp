@@ -61,6 +61,25 @@ bool is_stacked(const State& s, const WorldConfig& config) {
   return true;
 }
 
+double stack_shortfall(const State& s, const WorldConfig& config) {
+  const auto& j = config.judge;
+  std::array<std::size_t, kDiceCount> order{0, 1, 2};
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return s[si::die(a) + 1] < s[si::die(b) + 1]; });
+  const double side = 2.0 * config.dice.half_size;
+  const double bottom = table_height(config.walls) + config.dice.half_size;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < kDiceCount; ++k) {
+    const std::size_t d = si::die(order[k]);
+    const double expected_y = bottom + side * static_cast<double>(k);
+    sum += std::abs(s[d + 1] - expected_y) / (j.gap_tolerance * static_cast<double>(k + 1));
+    if (k > 0) sum += std::abs(s[d] - s[si::die(order[k - 1])]) / j.column_tolerance;
+    sum += off_quarter_turn(s[d + 2]) / j.angle_tolerance;
+    sum += std::hypot(s[d + 3], s[d + 4]) / j.rest_speed + std::abs(s[d + 5]) / j.rest_angular_speed;
+  }
+  return sum;
+}
+
 Settled settle(const State& state, const WorldConfig& config, int max_steps) {
   World world(config, state);
   Settled r;

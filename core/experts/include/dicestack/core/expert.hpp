@@ -13,12 +13,14 @@
 // Policy is expected (rollouts, DAgger, DART), an expert is wrapped in ExpertPolicy
 // (learners/policy.hpp); docs/architecture.md says why the adapter lives there.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/tracker.hpp>
 
 namespace dicestack {
 
@@ -57,6 +59,9 @@ struct ExpertConfig {
   /// its actions are then a function of the start, the step and the state (DART's labels).
   bool replan = true;
   double search_spread = 0.03;    ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
+  /// "tracker": the recordings it follows (required; built once and shared by every copy). Its
+  /// TrackerConfig is the one the Recordings were built with.
+  std::shared_ptr<const Recordings> recordings;
 };
 
 /// A policy that may use the simulator. act() works from any state of an episode, not only
@@ -87,11 +92,37 @@ struct ExpertInfo {
 };
 std::vector<ExpertInfo> expert_list();
 
+/// Experts by name, in the order registered: the built-ins ("scripted", "mpc", "tracker") on
+/// first use. make_expert() creates through the global one; docs/architecture.md says how to
+/// add an expert.
+class ExpertRegistry {
+ public:
+  using Factory = std::function<std::unique_ptr<Expert>(const ExpertConfig&)>;
+  static ExpertRegistry& global();
+  /// Throws ConfigError if the name is taken.
+  void add(ExpertInfo info, Factory factory);
+  /// Swaps `name`'s factory for `factory` and returns the old one (tests prove that learning from
+  /// recordings builds no mpc or scripted expert). Not thread-safe against create().
+  Factory replace(std::string_view name, Factory factory);
+  /// Throws ConfigError for an unknown name, listing the known ones.
+  std::unique_ptr<Expert> create(std::string_view name, const ExpertConfig& config) const;
+  std::vector<ExpertInfo> list() const;
+
+ private:
+  struct Entry {
+    ExpertInfo info;
+    Factory factory;
+  };
+  std::vector<Entry> entries_;
+};
+
 /// Creates an expert by its command-line name: "scripted" (the swing plan, fixed parameters,
-/// feedback only) or "mpc" (searches swing plans in the simulator from the current state and
-/// replans when the world leaves its prediction). An "mpc" expert simulates with the WorldConfig
-/// of the first environment it is given; use one expert per world. Throws ConfigError for an
-/// unknown name or a bad config field.
+/// feedback only), "mpc" (searches swing plans in the simulator from the current state and
+/// replans when the world leaves its prediction) or "tracker" (follows the recorded cup path of
+/// config.recordings that its simulation from the episode's start shows to succeed; chosen
+/// once per episode, tracked by feedback on the cup). "mpc" and "tracker" simulate with the
+/// WorldConfig of the first environment they are given; use one expert per world. Throws
+/// ConfigError for an unknown name, a bad config field, or "tracker" without recordings.
 std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config = {});
 
 /// What one expert episode did.

@@ -32,6 +32,10 @@ std::array<Vec2, 8> die_vertices(const DiceConfig& dice);
 /// Moment of inertia of a uniform die about its centre, kg m^2.
 double die_inertia(const DiceConfig& dice);
 
+/// How far the cup at `angle` reaches from its centre of mass towards `side` (+1 right, -1
+/// left), rims included, m: a side wall touches it when its centre is this close.
+double cup_reach(const CupGeometry& cup, double angle, double side);
+
 /// Rotates p by `angle` and adds `origin`.
 Vec2 to_world(Vec2 origin, double angle, Vec2 p);
 

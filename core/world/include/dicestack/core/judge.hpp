@@ -17,6 +17,11 @@ int count_dice_in_cup(const State& state, const WorldConfig& config);
 /// side by side, a leaning or offset column, or a moving one are not stacked.
 bool is_stacked(const State& state, const WorldConfig& config);
 
+/// How far `state` is from is_stacked: the sum over is_stacked's tests of each deviation in
+/// units of its tolerance (a state is stacked when every term is at most 1). For searches that
+/// must rank near misses (the tracker's choice) without a cost of their own.
+double stack_shortfall(const State& state, const WorldConfig& config);
+
 /// What happened in an episode so far.
 struct Outcome {
   int steps = 0;             ///< control steps taken

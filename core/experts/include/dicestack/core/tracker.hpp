@@ -1,0 +1,116 @@
+#pragma once
+// The demonstrator made of demonstrations (issue 24): recorded cup paths, moved into a start's
+// frame and followed by feedback on the cup alone, chosen by simulating them from the start.
+// It reads nothing but the recordings, the world and the simulator: no swing plan, no mpc.
+//
+// Why the cup's path and not the actions: the task is open-loop in the cup's path, not in the
+// actions. A recording's actions replayed in another world (or from a start 1 cm away) lose the
+// dice at the first contact; its cup path, tracked, scoops them again (docs/learners.md).
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/cluster.hpp>
+#include <dicestack/core/env.hpp>
+
+namespace dicestack {
+
+/// One recording, as the tracker uses it: the states before each action and the actions.
+struct CupPath {
+  std::string name;
+  std::vector<State> states;
+  std::vector<Action> actions;  ///< same length as states
+};
+
+/// How a recorded path is fitted to a start beyond the move into its frame: the spirit of the
+/// paper's eq. 11, corrections that make a recording play back in this world.
+struct PathWarp {
+  double time_scale = 1.0;  ///< recorded steps per control step (> 1 plays it faster)
+  double offset = 0.0;      ///< extra shift in x, m
+  double amplitude = 1.0;   ///< the path's x about its dice' mean x is scaled by this
+};
+
+/// Settings of the tracker. The warp bounds say how far a correction may go, they are not tuned
+/// gains (docs/learners.md, "The tracker").
+struct TrackerConfig {
+  double gain = 10.0;        ///< feedback gain on the cup's pose, 1/s (the issue's k)
+  int probes = 16;           ///< training starts that rank the recordings (most successes first), >= 0
+  bool optimise = true;      ///< when no recording succeeds as recorded, search warps
+  int optimise_paths = 4;    ///< the warp search tries the recordings that came closest, >= 1
+  int optimise_evaluations = 60;   ///< simulated warps per recording (CMA-ES), >= 1
+  double time_scale_range = 0.15;  ///< warps keep |log time_scale| <= log(1 + this), in [0, 1)
+  double offset_range = 0.3;       ///< |offset| <= this, m
+  double amplitude_range = 0.15;   ///< |amplitude - 1| <= this, in [0, 1)
+  int hold_steps = 60;       ///< a simulation ends this many steps after the path's end, >= 0
+};
+
+/// Throws ConfigError naming the first field of `config` out of its range.
+void validate(const TrackerConfig& config);
+
+/// Follows one recorded path moved into a start's frame (x shifted by the difference of the
+/// dice' mean x), then warped: dv = v_ref + gain (p_ref - p) - v on the cup's x, y and angle,
+/// with v_ref the recorded velocity after the recorded action. After the path's end it holds the
+/// last pose. act() is a pure function of the state and the step.
+class PathFollower {
+ public:
+  PathFollower() = default;
+  /// `path` must outlive the follower.
+  PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain);
+
+  Action act(const State& s, int step) const;
+  /// Control steps from the start step to the path's end.
+  int length() const { return length_; }
+  bool valid() const { return path_ != nullptr; }
+
+ private:
+  const CupPath* path_ = nullptr;
+  PathWarp warp_;
+  int start_step_ = 0, length_ = 0;
+  double centre_ = 0.0, shift_ = 0.0, gain_ = 10.0;
+};
+
+/// Recordings prepared for the tracker: each path, and their order of trial. Built once (the
+/// ranking simulates every path from `config.probes` training starts) and shared, read-only, by
+/// every tracker expert on every thread. The order is a deterministic function of the paths,
+/// the world, the config and the seed: the same on any number of threads or ranks.
+class Recordings {
+ public:
+  /// Throws InputError if `paths` is empty, or a path is empty, has states and actions of
+  /// different lengths or a value that is not finite (naming the path and step); ConfigError
+  /// for a bad config. Collective over `cluster`: the probe simulations are dealt among its ranks.
+  Recordings(std::vector<CupPath> paths, const WorldConfig& world, const TrackerConfig& config, std::uint64_t seed,
+             int threads = 0, Cluster& cluster = local_cluster());
+
+  const std::vector<CupPath>& paths() const { return paths_; }
+  /// Path indices in the order the tracker tries them: most probe successes first, then by index.
+  const std::vector<std::size_t>& order() const { return order_; }
+  /// Probe successes per path (index as in paths()).
+  const std::vector<int>& probe_successes() const { return probe_successes_; }
+  const TrackerConfig& config() const { return config_; }
+  std::uint64_t seed() const { return seed_; }
+
+ private:
+  std::vector<CupPath> paths_;
+  TrackerConfig config_;
+  std::uint64_t seed_ = 0;
+  std::vector<std::size_t> order_;
+  std::vector<int> probe_successes_;
+};
+
+/// What the tracker's search chose for one start.
+struct TrackerChoice {
+  std::size_t path = 0;  ///< index into Recordings::paths()
+  PathWarp warp;
+  bool success = false;  ///< its simulated episode ended in a realistic success
+  int simulations = 0;   ///< episodes simulated to choose it
+};
+
+/// Searches `recordings` from env's current state, simulating in `sim` (an environment of the
+/// same world): the first path in order() whose simulated episode is a realistic success; if
+/// none and config.optimise, warps (CMA-ES, seeded by `seed`) of the paths that came closest;
+/// failing all, the closest (fewest judge tolerances from a stack, no wall). Deterministic in
+/// the state, the recordings and `seed`.
+TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed);
+
+}  // namespace dicestack

@@ -1,0 +1,154 @@
+// The tracker (issue 24): recorded cup paths followed by feedback on the cup, chosen by
+// simulation; and the expert registry it is built through.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/tracker.hpp>
+
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+namespace si = state_index;
+
+// An episode of the scripted expert from random start `seed`, as a recorded cup path.
+CupPath scripted_path(std::uint64_t seed, const WorldConfig& world = {}) {
+  DiceEnv env(world);
+  env.reset(seed);
+  auto expert = make_expert("scripted");
+  expert->reset(seed);
+  const ExpertEpisode e = run_expert_episode(*expert, env, true);
+  return {"scripted_" + std::to_string(seed), e.states, e.actions};
+}
+
+double mean_dice_x(const State& s) { return (s[si::die(0)] + s[si::die(1)] + s[si::die(2)]) / 3.0; }
+
+// Follows `follower` from `start` for the path's length; the largest |cup x - (recorded x + shift)|.
+double largest_x_error(const CupPath& path, const State& start, double shift, const WorldConfig& world) {
+  DiceEnv env(world);
+  env.reset_to(start);
+  const PathFollower follower(path, {}, start, 0, TrackerConfig{}.gain);
+  double worst = 0.0;
+  for (std::size_t t = 0; t + 1 < path.states.size(); ++t) {
+    env.step(follower.act(env.get_state(), env.t()));
+    worst = std::max(worst, std::abs(env.get_state()[si::kCupX] - (path.states[t + 1][si::kCupX] + shift)));
+  }
+  return worst;
+}
+
+TEST(PathFollower, FollowsARecordingFromItsOwnStart) {
+  const CupPath path = scripted_path(4);
+  EXPECT_LT(largest_x_error(path, path.states.front(), 0.0, {}), 0.01);
+}
+
+TEST(PathFollower, MovesThePathWithTheDice) {
+  // The same recording from a start whose whole scene is 0.3 m to the left: the cup follows the
+  // recorded x shifted by the dice' mean x.
+  const CupPath path = scripted_path(4);
+  State start = path.states.front();
+  start[si::kCupX] -= 0.3;
+  for (std::size_t i = 0; i < kDiceCount; ++i) start[si::die(i)] -= 0.3;
+  EXPECT_NEAR(mean_dice_x(start) - mean_dice_x(path.states.front()), -0.3, 1e-12);
+  EXPECT_LT(largest_x_error(path, start, -0.3, {}), 0.01);
+}
+
+TEST(PathFollower, HoldsTheLastPoseAfterThePathEnds) {
+  const CupPath path = scripted_path(4);
+  const PathFollower follower(path, {}, path.states.front(), 0, 10.0);
+  // At rest on the last recorded pose, past the end, the feedback asks for nothing.
+  State at_end = path.states.back();
+  at_end[si::kCupVx] = at_end[si::kCupVy] = at_end[si::kCupW] = 0.0;
+  const Action a = follower.act(at_end, static_cast<int>(path.states.size()) + 20);
+  for (double v : a) EXPECT_NEAR(v, 0.0, 1e-9);
+}
+
+TEST(Recordings, RefuseBadRecordingsNamingThem) {
+  const WorldConfig w;
+  EXPECT_THROW(Recordings({}, w, {}, 0), InputError);
+  CupPath p = scripted_path(4);
+  p.actions.pop_back();
+  EXPECT_NE(test::error_of([&] { Recordings({p}, w, {}, 0); }).find(p.name), std::string::npos);
+  p = scripted_path(4);
+  p.states[7][5] = std::nan("");
+  const std::string e = test::error_of([&] { Recordings({p}, w, {}, 0); });
+  EXPECT_NE(e.find("\"scripted_4\" state 7"), std::string::npos) << e;
+  TrackerConfig bad;
+  bad.time_scale_range = 1.5;
+  EXPECT_NE(test::error_of([&] { Recordings({scripted_path(4)}, w, bad, 0); }).find("time_scale_range"), std::string::npos);
+}
+
+TEST(Recordings, RankingDoesNotDependOnThreads) {
+  const WorldConfig w = test::short_world(200);
+  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  TrackerConfig c;
+  c.probes = 4;
+  const Recordings one(paths, w, c, 7, 1), two(paths, w, c, 7, 2);
+  EXPECT_EQ(one.order(), two.order());
+  EXPECT_EQ(one.probe_successes(), two.probe_successes());
+}
+
+TEST(ChoosePath, FindsARecordingThatSucceedsAndIsDeterministic) {
+  const WorldConfig w;
+  // Paths of successful scripted episodes; a start of one of them is a start some path succeeds from.
+  std::vector<CupPath> paths;
+  for (std::uint64_t s = 0; paths.size() < 3; ++s) {
+    DiceEnv env(w);
+    env.reset(s);
+    auto expert = make_expert("scripted");
+    expert->reset(s);
+    const ExpertEpisode e = run_expert_episode(*expert, env, true);
+    if (e.outcome.realistic_success()) paths.push_back({"p" + std::to_string(s), e.states, e.actions});
+  }
+  TrackerConfig c;
+  c.probes = 0;
+  c.optimise = false;
+  const Recordings r(paths, w, c, 0);
+  DiceEnv env(w), sim(w);
+  env.reset_to(paths[1].states.front());
+  const TrackerChoice a = choose_path(r, env, sim, 3), b = choose_path(r, env, sim, 3);
+  EXPECT_TRUE(a.success);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.simulations, b.simulations);
+  EXPECT_TRUE(test::bit_equal(env.get_state(), paths[1].states.front()));  // the environment is not touched
+}
+
+TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
+  EXPECT_NE(test::error_of([] { make_expert("tracker"); }).find("needs recordings"), std::string::npos);
+  EXPECT_NE(test::error_of([] { make_expert("trackr"); }).find("scripted, mpc, tracker"), std::string::npos);
+  EXPECT_THROW(ExpertRegistry::global().add({"mpc", "again"}, nullptr), ConfigError);
+}
+
+TEST(ExpertRegistry, AReplacedFactoryIsUsedAndCanBePutBack) {
+  auto old = ExpertRegistry::global().replace(
+      "scripted", [](const ExpertConfig&) -> std::unique_ptr<Expert> { throw std::logic_error("no scripted here"); });
+  EXPECT_EQ(test::error_of([] { make_expert("scripted"); }), "no scripted here");
+  ExpertRegistry::global().replace("scripted", std::move(old));
+  EXPECT_EQ(make_expert("scripted")->name(), "scripted");
+}
+
+TEST(TrackerExpert, ChoosesOnceAndFollows) {
+  const WorldConfig w;
+  std::vector<CupPath> paths{scripted_path(5)};
+  TrackerConfig c;
+  c.probes = 0;
+  c.optimise = false;
+  ExpertConfig config;
+  config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
+  auto tracker = make_expert("tracker", config);
+  EXPECT_EQ(tracker->name(), "tracker");
+  // From the recording's own start the tracker reproduces its cup path.
+  DiceEnv env(w);
+  env.reset_to(paths[0].states.front());
+  tracker->reset(0);
+  const ExpertEpisode e = run_expert_episode(*tracker, env, true);
+  ASSERT_GE(e.states.size(), 50u);
+  for (std::size_t t = 0; t < 50; ++t) EXPECT_NEAR(e.states[t][si::kCupX], paths[0].states[t][si::kCupX], 0.01) << t;
+}
+
+}  // namespace
+}  // namespace dicestack
