@@ -4,12 +4,14 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <map>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
 
 namespace dicestack {
 
@@ -19,8 +21,9 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "dicestack-checkpoint";
-// 1: the same fields without "version" (and, before the marker, without "format"); 2: adds "version".
-constexpr int kVersion = 2;
+// 1: the same fields without "version" (and, before the marker, without "format"); 2: adds
+// "version"; 3: "run"'s learner options as an object of key -> value, not one "k=v, k=v" text.
+constexpr int kVersion = 3;
 
 // "data-<digits>" or "best-<digits>.model" (suffix empty or ".model").
 bool numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
@@ -29,6 +32,36 @@ bool numbered(const std::string& name, const std::string& prefix, const std::str
   for (std::size_t i = prefix.size(); i < name.size() - suffix.size(); ++i)
     if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
   return true;
+}
+
+// A checkpoint's learner options as key -> value: an object (version 3) or, before, the text
+// "k=v, k=v" (values never hold ", ": they are numbers, booleans and choice names).
+std::map<std::string, std::string> saved_options(const json& saved) {
+  std::map<std::string, std::string> out;
+  if (saved.is_object()) {
+    for (const auto& [k, v] : saved.items()) out[k] = v.is_string() ? v.get<std::string>() : v.dump();
+  } else if (saved.is_string()) {
+    const std::string text = saved.get<std::string>();
+    for (std::size_t at = 0; at < text.size();) {
+      std::size_t end = text.find(", ", at);
+      if (end == std::string::npos) end = text.size();
+      const std::string kv = text.substr(at, end - at);
+      const std::size_t eq = kv.find('=');
+      if (eq != std::string::npos) out[kv.substr(0, eq)] = kv.substr(eq + 1);
+      at = end + 2;
+    }
+  }
+  return out;
+}
+
+// What a learner's option meant in checkpoints written before the option existed: the behaviour
+// then, which is its default unless listed here (DaD corrected towards whole states before it
+// had "target").
+std::string value_before(const std::string& learner, const std::string& key) {
+  if (learner == "dad" && key == "target") return "state";
+  for (const auto& p : LearnerRegistry::global().info(learner).params)
+    if (p.name == key) return p.default_value;
+  return "";
 }
 
 std::string excerpt(const json& j) {
@@ -80,11 +113,11 @@ void remove_old_best_models(const fs::path& dir, const std::string& keep) {
 }
 
 json run_settings(const LearnContext& c, const Params& learner_params, const std::vector<std::string>& extendable) {
-  std::string sets, options;
+  std::string sets;
+  json options = json::object();
   for (const auto& s : c.regressor_sets) sets += (sets.empty() ? "" : " ") + s;
   for (const auto& [key, value] : learner_params.as_text())
-    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end())
-      options += (options.empty() ? "" : ", ") + key + "=" + value;
+    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end()) options[key] = value;
   return {{"regressor", c.regressor},
           {"regressor_sets", sets},
           {"features", c.features},
@@ -167,11 +200,26 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
     throw InputError(path.string() + ": field \"run\" must be an object");
   if (state.contains("run")) {  // states written before runs were recorded have none to compare
     std::string differences;
+    auto differ = [&](const std::string& what, const json& saved, const json& now) {
+      differences += (differences.empty() ? "" : "; ") + what + " " + excerpt(saved) + " in the checkpoint, " +
+                     now.dump() + " in this run";
+    };
     for (const auto& [key, value] : run.items()) {
       const json saved = state["run"].value(key, json());
-      if (saved != value)
-        differences += (differences.empty() ? "" : "; ") + key + " " + excerpt(saved) + " in the checkpoint, " +
-                       value.dump() + " in this run";
+      if (key != "learner_options") {
+        if (saved != value) differ(key, saved, value);
+        continue;
+      }
+      // Option by option, parsed: an option added since the checkpoint was written matches when
+      // this run gives it the value its absence meant.
+      const auto before = saved_options(saved);
+      const std::string learner = fs::path(state_file).stem().string();
+      for (const auto& [k, v] : value.items()) {
+        const std::string now = v.get<std::string>();
+        const auto it = before.find(k);
+        const std::string then = it != before.end() ? it->second : value_before(learner, k);
+        if (then != now) differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
+      }
     }
     if (!differences.empty())
       throw InputError(path.string() + ": cannot resume a run made with other settings: " + differences +

@@ -6,6 +6,7 @@
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/rng.hpp>
+#include <dicestack/core/tracker.hpp>
 
 namespace dicestack {
 
@@ -18,7 +19,8 @@ double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::ve
   for (std::size_t j = 0; j < problem.target.size(); ++j) {
     if (states) states->push_back(env.get_state());
     env.step(actions[j]);
-    cost += tracking_distance_sq(env.get_state(), problem.target[j], c);
+    cost += problem.aim == CorrectionTarget::cup ? cup_distance_sq(env.get_state(), problem.target[j], c)
+                                                 : tracking_distance_sq(env.get_state(), problem.target[j], c);
   }
   return cost;
 }
@@ -59,14 +61,52 @@ class SequenceCorrector final : public Corrector {
   CorrectorOptions options_;
 };
 
+// The tracker's feedback law (core/tracker.hpp) along the demonstration's own path: from the
+// drifted world the cup is steered back onto the recorded cup path; nothing is searched. The
+// warm start (the policy's own actions) stays the answer if it follows the path better.
+class TrackCorrector final : public Corrector {
+ public:
+  explicit TrackCorrector(double gain) : gain_(gain) {}
+
+  Correction correct(DiceEnv& env, const CorrectionProblem& p, std::uint64_t) const override {
+    if (p.reference.size() != p.target.size() || p.reference_actions.size() != p.target.size())
+      throw InputError("track corrector: the window needs the demonstration's states and actions at its steps");
+    Correction c;
+    c.warm_cost = window_cost(env, p, p.warm);
+    const CupPath path{"window", p.reference, p.reference_actions};
+    env.restore(p.start);
+    const PathFollower follower(path, {}, p.reference.front(), env.t(), gain_);
+    std::vector<Action> actions;
+    for (std::size_t j = 0; j < p.target.size(); ++j) {
+      actions.push_back(env.step(follower.act(env.get_state(), env.t())).applied);
+    }
+    const double cost = window_cost(env, p, actions);
+    c.actions = cost < c.warm_cost ? actions : p.warm;
+    c.cost = window_cost(env, p, c.actions, &c.states);
+    c.evaluations = 3;
+    return c;
+  }
+
+ private:
+  double gain_;
+};
+
 }  // namespace
 
-std::vector<std::string> corrector_names() { return minimiser_names(); }
+std::vector<std::string> corrector_names() {
+  auto names = minimiser_names();
+  names.push_back("track");
+  return names;
+}
 
 std::unique_ptr<Corrector> make_corrector(std::string_view name, const CorrectorOptions& options) {
-  const auto names = corrector_names();
-  if (std::find(names.begin(), names.end(), name) == names.end())
-    throw ConfigError("unknown corrector \"" + std::string(name) + "\"; expected cmaes, de, basinhop or bayes");
+  if (name == "track") return std::make_unique<TrackCorrector>(options.gain);
+  const auto names = minimiser_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string list;
+    for (const auto& n : corrector_names()) list += (list.empty() ? "" : ", ") + n;
+    throw ConfigError("unknown corrector \"" + std::string(name) + "\"; expected one of " + list);
+  }
   return std::make_unique<SequenceCorrector>(std::string(name), options);
 }
 

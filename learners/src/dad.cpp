@@ -6,6 +6,7 @@
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/core/tracker.hpp>
 #include <dicestack/learners/corrector.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
@@ -26,7 +27,8 @@ struct Task {
 
 // DaD with windowed annealing (paper VI-E, DESIGN "Learners"): roll the policy out from each
 // demonstration's first state; at every w-th step, from the policy's own drifted world, find
-// the next w actions that bring the simulated states back onto the demonstration's (eq. 11);
+// the next w actions that bring the simulated cup back onto the demonstration's cup path (or,
+// with target=state, all simulated states onto the demonstration's: eq. 11 as written);
 // add those (state, action) pairs to the data once (eq. 10); refit. Windows grow from 1/10 of
 // the demonstration to all of it, with a few iterations each.
 class Dad final : public Learner {
@@ -73,7 +75,7 @@ class Dad final : public Learner {
     EnvPool envs(world, c.threads);
     const auto corrector = make_corrector(params().choice("corrector"),
                                           {static_cast<int>(params().integer("corrector_iterations")), params().real("sigma0"),
-                                           static_cast<int>(params().integer("population"))});
+                                           static_cast<int>(params().integer("population")), TrackerConfig{}.gain});
     for (int k = first; k <= total; ++k) {
       const int window = (k - 1) / per_window + 1;
       auto report = [&](const char* phase, int done, int of) {
@@ -81,7 +83,7 @@ class Dad final : public Learner {
           c.progress({phase, k, total, window, windows, done, of, (k - 1 + (of ? static_cast<double>(done) / of : 0.0)) / total});
       };
       report("rollouts", 0, 0);
-      const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, envs, c.threads);
+      const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, aim(), envs, c.threads);
 
       // Every rank cut the same windows (the rollouts are deterministic); the corrections, the
       // heavy part, are dealt among the ranks by window length and gathered in index order.
@@ -145,7 +147,12 @@ class Dad final : public Learner {
   static std::vector<ParamSpec> schema() {
     return {{"windows", ParamType::integer, "10", 1, 1000, "window sizes: k/windows of each demonstration, k = 1..windows", {}},
             {"iterations", ParamType::integer, "3", 1, 1000, "iterations per window", {}},
-            {"corrector", ParamType::choice, "cmaes", 0, 0, "optimiser of each window's actions", {"cmaes", "de", "basinhop", "bayes"}},
+            {"corrector", ParamType::choice, "cmaes", 0, 0,
+             "how each window's actions are found: an optimiser, or track (the tracker's feedback law, no search)",
+             corrector_names()},
+            {"target", ParamType::choice, "cup", 0, 0,
+             "what corrections steer back to: cup (the recording's cup path) or state (all its recorded states, eq. 11 "
+             "as the paper wrote it)", {"cup", "state"}},
             {"corrector_iterations", ParamType::integer, "50", 1, 100000, "generations per correction", {}},
             {"sigma0", ParamType::real, "0.25", 1e-6, 100, "initial spread around the policy's actions, scaled action units", {}},
             {"population", ParamType::integer, "0", 0, 100000, "candidates per generation; 0: 4 + floor(3 ln n)", {}},
@@ -184,8 +191,10 @@ class Dad final : public Learner {
 
   // Rolls the policy out from every target's first state and cuts its trajectory into windows
   // of w steps: each starts from the policy's world at that step, aims at the target's states.
+  CorrectionTarget aim() const { return params().choice("target") == "cup" ? CorrectionTarget::cup : CorrectionTarget::state; }
+
   static std::vector<Task> policy_windows(const Model& model, const std::vector<Episode>& targets, int window, int windows,
-                                          EnvPool& envs, int threads) {
+                                          CorrectionTarget aim, EnvPool& envs, int threads) {
     std::vector<std::vector<Task>> per_demo(targets.size());
     parallel_for(targets.size(), threads, [&](std::size_t d, int w) {
       DiceEnv& env = envs.at(w);
@@ -196,8 +205,12 @@ class Dad final : public Learner {
       options.max_steps = len - 1;
       options.before_step = [&](const DiceEnv& at, std::size_t t) {
         if (t % width != 0) return;
-        Task task{d, t, {at.snapshot(), {}, {}}};
-        for (std::size_t j = t + 1; j < len && j <= t + width; ++j) task.problem.target.push_back(demo.states[j]);
+        Task task{d, t, {at.snapshot(), {}, {}, aim, {}, {}}};
+        for (std::size_t j = t + 1; j < len && j <= t + width; ++j) {
+          task.problem.target.push_back(demo.states[j]);
+          task.problem.reference.push_back(demo.states[j - 1]);
+          task.problem.reference_actions.push_back(demo.actions[j - 1]);
+        }
         per_demo[d].push_back(std::move(task));
       };
       ModelPolicy policy(std::shared_ptr<const Model>(&model, [](const Model*) {}));  // borrowed for this rollout

@@ -9,6 +9,7 @@
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/episode_bytes.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/policy.hpp>
 
@@ -27,7 +28,7 @@ class Dagger final : public Learner {
     const int iterations = static_cast<int>(params().integer("iterations"));
     const int rollouts = static_cast<int>(params().integer("rollouts"));
     const std::string expert_name = params().choice("expert");
-    ExpertConfig expert_config;
+    ExpertConfig expert_config = learner_expert_config(expert_name, params(), c);
     // Without replanning, mpc's labels are a function of the start, the step and the state: the
     // same on and off its own path (docs/learners.md).
     expert_config.replan = params().boolean("replan");
@@ -76,6 +77,7 @@ class Dagger final : public Learner {
     }
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";
+    model->record["expert"] = expert_name;
     result.model = model;
     return result;
   }
@@ -83,13 +85,15 @@ class Dagger final : public Learner {
   static std::vector<ParamSpec> schema() {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
-    return {{"iterations", ParamType::integer, "5", 0, 1000, "DAgger rounds", {}},
+    std::vector<ParamSpec> specs{{"iterations", ParamType::integer, "5", 0, 1000, "DAgger rounds", {}},
             {"rollouts", ParamType::integer, "20", 1, 100000, "mixture rollouts per round, from random starts", {}},
             {"beta", ParamType::real, "0.5", 0, 1, "p of the exponential schedule beta_i = p^(i-1)", {}},
             {"schedule", ParamType::choice, "exponential", 0, 0, "exponential (p^(i-1)) or linear (1 down to 0)", {"exponential", "linear"}},
-            {"expert", ParamType::choice, "mpc", 0, 0, "the expert that acts and labels", names},
+            {"expert", ParamType::choice, "mpc", 0, 0, "the expert that acts and labels (tracker: follows the recordings of --demos)", names},
             {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the world leaves its prediction", {}},
             {"include_demos", ParamType::boolean, "true", 0, 1, "start the aggregate from the demonstrations", {}}};
+    for (auto& p : tracker_param_specs()) specs.push_back(std::move(p));
+    return specs;
   }
 
  private:

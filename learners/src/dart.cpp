@@ -1,5 +1,6 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 
@@ -22,7 +23,7 @@ class Dart final : public Learner {
       if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
     if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
     std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
-    ExpertConfig expert;
+    ExpertConfig expert = learner_expert_config(params().choice("expert"), params(), c);
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
@@ -41,6 +42,7 @@ class Dart final : public Learner {
     LearnResult r;
     r.model = fit_model(c, data, c.seed);
     r.model->record["learner"] = "dart";
+    r.model->record["expert"] = params().choice("expert");
     r.model->record["dart_episodes"] = std::to_string(episodes);
     r.model->record["dart_expert_successes"] = std::to_string(successes);
     if (c.progress) c.progress({"fit", 1, 1, 0, 0, 1, 1, 1.0});
@@ -50,7 +52,7 @@ class Dart final : public Learner {
   static std::vector<ParamSpec> schema() {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
-    return {{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels", names},
+    const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos)", names},
             {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
@@ -61,6 +63,9 @@ class Dart final : public Learner {
              "mpc: replan when the noise pushes the world off its prediction (its labels then depend on the noise so far)", {}},
             {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
+    std::vector<ParamSpec> out = specs;
+    for (auto& p : tracker_param_specs()) out.push_back(std::move(p));
+    return out;
   }
 };
 

@@ -219,33 +219,41 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   const auto& dir = opt.demos;
   const DemoSet set = read_demo_set(dir);
   const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
-  const auto learners = opt.learners.empty() ? std::vector<std::string>{"bc", "dagger", "dart"} : opt.learners;
-  // Learner options: the profile's defaults, then --option (for every learner that has the key).
-  auto options_for = [&](const std::string& learner) {
+  // Learner rows by spec ("dart" or "dart:expert=tracker"), each with its registered learner.
+  std::map<std::string, LearnerSpec> specs;
+  const auto learners = opt.learners.empty() ? profile.learners : opt.learners;
+  for (const auto& l : learners) specs.emplace(l, parse_learner_spec(l));  // unknown names fail before any work
+  auto base = [&](const std::string& spec) { return specs.at(spec).name; };
+  // Learner options: the profile's defaults, then the spec's, then --option (for every learner
+  // that has the key).
+  auto options_for = [&](const std::string& spec) {
+    const std::string learner = base(spec);
     const auto defaults = profile.learner_options.find(learner);
     std::vector<std::string> out = defaults == profile.learner_options.end() ? std::vector<std::string>{} : defaults->second;
-    for (const auto& kv : opt.options) {
+    auto put = [&](const std::string& kv) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
         if (p.name == key) {
           std::erase_if(out, [&](const std::string& o) { return o.substr(0, o.find('=')) == key; });
           out.push_back(kv);
         }
-    }
+    };
+    for (const auto& kv : specs.at(spec).options) put(kv);
+    for (const auto& kv : opt.options) put(kv);
     return out;
   };
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = baseline_names();
   for (const auto& b : opt.baselines) baseline(b);  // unknown names fail before any work
   for (const auto& l : learners)
-    if (LearnerRegistry::global().info(l).needs_trajectories && opt.split == "rows")
+    if (LearnerRegistry::global().info(base(l)).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
 
   // (learner, feature map) rows: each learner with every map of --features it can read, or with
   // its own default map.
   std::vector<std::pair<std::string, std::string>> combos;
   for (const auto& l : learners) {
-    const LearnerInfo& info = LearnerRegistry::global().info(l);
+    const LearnerInfo& info = LearnerRegistry::global().info(base(l));
     // The paper profile's full picture: every learner with the bare state and with dart's map too.
     std::vector<std::string> maps{info.default_features};
     if (profile.every_feature_map && info.default_features != "state") maps.insert(maps.begin(), "state");
@@ -282,7 +290,10 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart).
   auto left_out = [&](const std::string& learner, const std::string& regressor) {
     if (!opt.regressors.empty()) return false;  // named regressors are always run
-    return std::find(profile.left_out.begin(), profile.left_out.end(), std::pair{learner, regressor}) != profile.left_out.end();
+    // A pair names a learner row by its spec ("dart:expert=tracker") or every row of a learner ("dart").
+    return std::any_of(profile.left_out.begin(), profile.left_out.end(), [&](const auto& pair) {
+      return pair.second == regressor && (pair.first == learner || pair.first == base(learner));
+    });
   };
   if (std::any_of(learners.begin(), learners.end(), [&](const std::string& l) {
         return std::any_of(regressors.begin(), regressors.end(), [&](const std::string& r) { return left_out(l, r); });
@@ -407,7 +418,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     // own jobs, writes the progress file, and at the end waits for the rest and broadcasts them.
     std::vector<double> cost(jobs.size());
     for (std::size_t j = 0; j < jobs.size(); ++j)
-      cost[j] = estimated_row_cost(jobs[j].index ? jobs[j].learner : "baseline", jobs[j].regressor, jobs[j].features,
+      cost[j] = estimated_row_cost(jobs[j].index ? base(jobs[j].learner) : "baseline", jobs[j].regressor, jobs[j].features,
                                    profile, jobs[j].index ? episodes : episodes * opt.seeds);
     const std::vector<int> owner = deal_items(jobs.size(), cluster.size(), cost);
     const double job_units = static_cast<double>(jobs.size()) + 0.5;

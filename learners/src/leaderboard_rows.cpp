@@ -84,7 +84,8 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   };
   SeedResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  const LearnResult learned = LearnerRegistry::global().create(learner, s_.learner_options(learner))->learn(c);
+  const LearnResult learned =
+      LearnerRegistry::global().create(parse_learner_spec(learner).name, s_.learner_options(learner))->learn(c);
   r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Score errors = score(*learned.model, *s_.split);
   r.train_error = errors.train_error;

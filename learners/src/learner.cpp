@@ -1,6 +1,5 @@
 #include <dicestack/learners/learner.hpp>
 
-
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/registry_lookup.hpp>
@@ -40,6 +39,24 @@ std::unique_ptr<Learner> LearnerRegistry::create(std::string_view name, const st
 }
 
 std::vector<std::string> LearnerRegistry::names() const { return registered_names(entries_); }
+
+LearnerSpec parse_learner_spec(std::string_view text, const LearnerRegistry& registry) {
+  LearnerSpec spec;
+  spec.text = std::string(text);
+  std::size_t colon = text.find(':');
+  spec.name = std::string(text.substr(0, colon));
+  while (colon != std::string_view::npos) {
+    const std::size_t next = text.find(':', colon + 1);
+    spec.options.emplace_back(text.substr(colon + 1, next == std::string_view::npos ? next : next - colon - 1));
+    colon = next;
+  }
+  try {
+    registry.create(spec.name, spec.options);  // unknown names, keys and values fail here
+  } catch (const ConfigError& e) {
+    throw ConfigError("learner \"" + spec.text + "\": " + e.what());
+  }
+  return spec;
+}
 
 namespace {
 

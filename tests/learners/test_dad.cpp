@@ -27,10 +27,12 @@ const std::vector<Episode>& demos() {
 CorrectionProblem window_of(DiceEnv& env, const Episode& demo, std::size_t t, std::size_t w) {
   env.reset_to(demo.states[0], demo.seed);
   for (std::size_t k = 0; k < t; ++k) env.step(demo.actions[k]);
-  CorrectionProblem p{env.snapshot(), {}, {}};
+  CorrectionProblem p{env.snapshot(), {}, {}, CorrectionTarget::state, {}, {}};
   for (std::size_t k = t; k < t + w; ++k) {
     p.target.push_back(demo.states[k + 1]);
     p.warm.push_back(demo.actions[k]);
+    p.reference.push_back(demo.states[k]);
+    p.reference_actions.push_back(demo.actions[k]);
   }
   return p;
 }
@@ -42,7 +44,7 @@ TEST_P(CorrectorTest, CorrectionsReduceTheDeviationFromTheDemonstration) {
   const Episode& demo = demos()[0];
   CorrectionProblem p = window_of(env, demo, 10, 8);
   for (auto& a : p.warm) a[0] += 0.6, a[1] -= 0.05;  // a policy that drifts
-  const Correction fix = make_corrector(GetParam(), {20, 0.25, 0})->correct(env, p, 3);
+  const Correction fix = make_corrector(GetParam(), {20, 0.25, 0, 10.0})->correct(env, p, 3);
   EXPECT_GT(fix.warm_cost, 0.0);
   EXPECT_LT(fix.cost, 0.5 * fix.warm_cost) << GetParam();
   // The labels are what the world applies: replaying them gives the recorded trajectory.
@@ -63,7 +65,7 @@ TEST_P(CorrectorTest, LabelsAreInTheDemonstrationsUnits) {
   DiceEnv env(test::short_world());
   const Episode& demo = demos()[0];
   const CorrectionProblem p = window_of(env, demo, 20, 6);
-  const Correction fix = make_corrector(GetParam(), {5, 0.25, 0})->correct(env, p, 4);
+  const Correction fix = make_corrector(GetParam(), {5, 0.25, 0, 10.0})->correct(env, p, 4);
   EXPECT_EQ(fix.warm_cost, 0.0);
   EXPECT_EQ(fix.cost, 0.0);
   ASSERT_EQ(fix.actions.size(), 6u);

@@ -1,8 +1,10 @@
 #pragma once
 // DaD's corrector (paper eq. 11): from the world a policy drifted into, find the next w actions
-// whose simulated states follow the demonstration's next w states. Any method of
-// core/action_sequence.hpp: CMA-ES (ours) by default, pagmo's differential evolution, basin
-// hopping, Bayesian optimisation.
+// whose simulated states follow the demonstration's next w states (all 24 numbers, as the paper)
+// or its cup path alone (issue 24: no cup motion brings bounced dice back onto their recorded
+// states). Any method of core/action_sequence.hpp: CMA-ES (ours), pagmo's differential
+// evolution, basin hopping, Bayesian optimisation; or "track": the tracker's feedback law
+// steering the cup back onto the recorded path, no search.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -13,11 +15,22 @@
 
 namespace dicestack {
 
+/// What a window's corrections aim at.
+enum class CorrectionTarget {
+  state,  ///< the demonstration's whole states (eq. 11 as the paper wrote it)
+  cup,    ///< the demonstration's cup pose (x, y, angle) alone
+};
+
 /// One window to correct.
 struct CorrectionProblem {
   EnvSnapshot start;           ///< the world where the window begins (the policy's, drifted)
   std::vector<State> target;   ///< the demonstration's states after each of the w steps
   std::vector<Action> warm;    ///< the policy's own w actions from `start`: the search starts here
+  CorrectionTarget aim = CorrectionTarget::state;
+  /// "track": the demonstration's states and actions at the window's own steps (the state each
+  /// action was taken in), which the feedback law follows.
+  std::vector<State> reference;
+  std::vector<Action> reference_actions;
 };
 
 /// The best actions found and the trajectory they produce.
@@ -29,8 +42,9 @@ struct Correction {
   int evaluations = 0;          ///< window simulations spent
 };
 
-/// Squared scaled distance (all 24 dimensions) summed over the window when `actions` are
-/// applied from `problem.start`; fills `states` (may be null) with the states before each action.
+/// Squared scaled distance (all 24 dimensions, or the cup's 3 for CorrectionTarget::cup) summed
+/// over the window when `actions` are applied from `problem.start`; fills `states` (may be null)
+/// with the states before each action.
 double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
                    std::vector<State>* states = nullptr);
 
@@ -47,9 +61,10 @@ struct CorrectorOptions {
   int iterations = 50;   ///< generations (basinhop, bayes: iterations x population evaluations)
   double sigma0 = 0.25;  ///< initial spread in scaled action units
   int population = 0;    ///< 0: pycma's 4 + floor(3 ln n)
+  double gain = 10.0;    ///< "track": feedback gain on the cup's pose, 1/s
 };
 
-/// The correctors' names: cmaes, de, basinhop, bayes.
+/// The correctors' names: cmaes, de, basinhop, bayes, track.
 std::vector<std::string> corrector_names();
 
 /// One of corrector_names(); throws ConfigError for another name.

@@ -106,6 +106,18 @@ class LearnerRegistry {
   std::map<std::string, LearnerInfo, std::less<>> entries_;
 };
 
+/// A learner with options of its own, as a leaderboard row names it: "NAME" or
+/// "NAME:key=value[:key=value...]", e.g. "dart:expert=tracker" (DART from the recordings alone).
+struct LearnerSpec {
+  std::string text;                  ///< as given: the row's name
+  std::string name;                  ///< the registered learner
+  std::vector<std::string> options;  ///< "key=value", checked against the learner's schema
+};
+
+/// Parses and checks a spec against the registry (unknown learner, option or value: ConfigError,
+/// naming the spec).
+LearnerSpec parse_learner_spec(std::string_view text, const LearnerRegistry& registry = LearnerRegistry::global());
+
 /// Fits `context.regressor` on every step of `data`, each seen through `context.features`:
 /// behaviour cloning's one step. Collective over context.cluster: the root fits, the others
 /// receive its model file's bytes (so every rank acts with the very same model).

@@ -1,0 +1,38 @@
+#pragma once
+// The demonstrator made of demonstrations (issue 24): a demonstration set turned into the
+// tracker expert's Recordings (core/tracker.hpp), for record, DART, DAgger, the leaderboard and
+// Python.
+#include <memory>
+#include <vector>
+
+#include <string>
+
+#include <dicestack/core/cluster.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/tracker.hpp>
+#include <dicestack/datasets/episode.hpp>
+#include <dicestack/learners/learner.hpp>
+
+namespace dicestack {
+
+/// Each episode's states and actions as a cup path named after the episode.
+std::vector<CupPath> cup_paths(const std::vector<Episode>& episodes);
+
+/// The tracker's recordings from `demos` (ranked by simulation from config.probes training
+/// starts of `seed`: see Recordings). Throws InputError if `demos` is empty. Collective over
+/// `cluster`.
+std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& demos, const WorldConfig& world,
+                                                  const TrackerConfig& config, std::uint64_t seed, int threads = 0,
+                                                  Cluster& cluster = local_cluster());
+
+/// The options of a learner whose expert may be the tracker (DART, DAgger): tracker_probes,
+/// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations).
+std::vector<ParamSpec> tracker_param_specs();
+
+/// The ExpertConfig of a learner's expert `name` (DART, DAgger): for "tracker", its recordings
+/// made from the context's training demonstrations with the learner's tracker_* options (ranked
+/// with the context's seed, over its cluster); for the others, the defaults. Throws InputError
+/// for "tracker" without demonstrations.
+ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& context);
+
+}  // namespace dicestack

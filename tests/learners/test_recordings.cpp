@@ -1,0 +1,135 @@
+// Learning from recordings alone (issue 24): the tracker as the expert of DART and DAgger, with
+// the hand-made experts impossible to build, and a model that then acts on its own.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <unistd.h>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/datasets/data_paths.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/record.hpp>
+
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+// Six of the paper's human recordings (made in Chipmunk, imported once into the cache).
+const std::vector<Episode>& human_six() {
+  static const std::vector<Episode> six = [] {
+    auto all = read_demo_set(human_demo_set(WorldConfig{})).episodes;
+    all.resize(6);
+    return all;
+  }();
+  return six;
+}
+
+// While alive, the named experts cannot be built: make_expert throws naming them.
+class Forbidden {
+ public:
+  explicit Forbidden(std::vector<std::string> names) : names_(std::move(names)) {
+    for (const auto& n : names_)
+      saved_.push_back(ExpertRegistry::global().replace(n, [n](const ExpertConfig&) -> std::unique_ptr<Expert> {
+        throw std::logic_error("expert " + n + " was built");
+      }));
+  }
+  ~Forbidden() {
+    for (std::size_t i = 0; i < names_.size(); ++i) ExpertRegistry::global().replace(names_[i], std::move(saved_[i]));
+  }
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<ExpertRegistry::Factory> saved_;
+};
+
+LearnContext recordings_context() {
+  LearnContext c;
+  c.world = WorldConfig{};
+  c.demos = human_six();
+  c.regressor = "linear_svr";
+  c.features = "state+clock+start_state";
+  c.seed = 3;
+  c.threads = 2;
+  return c;
+}
+
+TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
+  const Forbidden no({"mpc", "scripted"});
+  EXPECT_THAT(test::error_of([] { make_expert("mpc"); }), HasSubstr("expert mpc was built"));
+  const LearnContext c = recordings_context();
+  const auto learned = LearnerRegistry::global()
+                           .create("dart", {"expert=tracker", "episodes=3", "successes_only=false", "tracker_probes=1",
+                                            "tracker_optimise=false"})
+                           ->learn(c);
+  EXPECT_EQ(learned.model->record.at("expert"), "tracker");
+  EXPECT_EQ(learned.model->record.at("learner"), "dart");
+}
+
+TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
+  const Forbidden no({"mpc", "scripted"});
+  const LearnContext c = recordings_context();
+  const auto learned = LearnerRegistry::global()
+                           .create("dagger", {"expert=tracker", "iterations=1", "rollouts=2", "tracker_probes=0",
+                                              "tracker_optimise=false"})
+                           ->learn(c);
+  EXPECT_EQ(learned.model->record.at("expert"), "tracker");
+}
+
+TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
+  const LearnContext c = recordings_context();
+  const auto learned = LearnerRegistry::global()
+                           .create("dart", {"expert=tracker", "episodes=2", "successes_only=false", "tracker_probes=0",
+                                            "tracker_optimise=false"})
+                           ->learn(c);
+  const fs::path path = test::scratch_path("dicestack_tracker_model.dsm");
+  save_model(*learned.model, path);
+  auto model = std::make_shared<const Model>(load_model(path));
+  fs::remove(path);
+  const Forbidden none({"mpc", "scripted", "tracker"});
+  const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, test::short_world(), 3, 0, 2);
+  EXPECT_EQ(s.episodes, 3);
+}
+
+TEST(HonestLearning, TheTrackerNeedsDemonstrations) {
+  LearnContext c = recordings_context();
+  c.demos.clear();
+  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", {"expert=tracker"})->learn(c); }),
+              HasSubstr("expert tracker: no demonstrations to follow"));
+}
+
+TEST(Tracker, RecordingThroughItDoesNotDependOnThreadsAndNamesItsExpert) {
+  TrackerConfig t;
+  t.probes = 1;
+  t.optimise = false;
+  ExpertConfig config;
+  config.recordings = make_recordings(human_six(), WorldConfig{}, t, 0, 2);
+  const auto one = record_expert("tracker", config, WorldConfig{}, 2, 4, 1);
+  const auto two = record_expert("tracker", config, WorldConfig{}, 2, 4, 2);
+  ASSERT_EQ(one.size(), 2u);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states);
+    EXPECT_EQ(one[i].origin, "expert tracker");
+  }
+}
+
+TEST(LearnerSpec, ParsesOptionsAndRefusesUnknownOnes) {
+  const LearnerSpec s = parse_learner_spec("dart:expert=tracker:episodes=10");
+  EXPECT_EQ(s.name, "dart");
+  EXPECT_EQ(s.options, (std::vector<std::string>{"expert=tracker", "episodes=10"}));
+  EXPECT_EQ(parse_learner_spec("bc").options.size(), 0u);
+  EXPECT_THAT(test::error_of([] { parse_learner_spec("dart:expert=oracle"); }), HasSubstr("learner \"dart:expert=oracle\""));
+  EXPECT_THROW(parse_learner_spec("dartt"), ConfigError);
+  EXPECT_THROW(parse_learner_spec("dart:noise"), ConfigError);
+}
+
+}  // namespace
+}  // namespace dicestack
