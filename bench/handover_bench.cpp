@@ -2,7 +2,9 @@
 // steps while the expert watches (it is asked every step, so its plan and latches follow the
 // episode, as DAgger asks it), then the expert takes over. Prints, per k, the realistic success
 // from evaluation starts and how far the policy's actions were from the expert's labels.
-//   dicestack_handover_bench MODEL [--expert mpc|scripted] [--replan] [--episodes N] [--seed S]
+//   dicestack_handover_bench MODEL [--expert mpc|scripted|tracker] [--demos builtin|human|DIR] [--replan]
+//                            [--episodes N] [--seed S]
+// The tracker follows the recordings of --demos (default: the human recordings).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,16 +16,20 @@
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/policy.hpp>
+#include <dicestack/learners/train.hpp>
 
 using namespace dicestack;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: dicestack_handover_bench MODEL [--expert NAME] [--replan] [--episodes N] [--seed S]\n");
+    std::fprintf(stderr, "usage: dicestack_handover_bench MODEL [--expert NAME] [--demos SET] [--replan] [--episodes N] "
+                         "[--seed S]\n");
     return 2;
   }
-  std::string expert_name = "mpc";
+  std::string expert_name = "mpc", demos = "human";
   bool replan = false;
   int episodes = 100;
   std::uint64_t seed = 1000;
@@ -36,6 +42,7 @@ int main(int argc, char** argv) {
     for (int i = 2; i < argc; ++i) {
       const std::string a = argv[i];
       if (a == "--expert" && i + 1 < argc) expert_name = argv[++i];
+      else if (a == "--demos" && i + 1 < argc) demos = argv[++i];
       else if (a == "--replan") replan = true;
       else if (a == "--episodes" && i + 1 < argc) episodes = static_cast<int>(std::min(number(argv[++i]), 1000000ULL));
       else if (a == "--seed" && i + 1 < argc) seed = number(argv[++i]);
@@ -45,6 +52,8 @@ int main(int argc, char** argv) {
     const WorldConfig world;
     ExpertConfig config;
     config.replan = replan;
+    if (expert_name == "tracker")
+      config.recordings = make_recordings(read_demo_set(resolve_demo_set(demos, world)).episodes, world, {}, seed);
     std::printf("model %s, expert %s (%s), %d evaluation starts from seed %llu\n", argv[1], expert_name.c_str(),
                 replan ? "replanning" : "planning once", episodes, static_cast<unsigned long long>(seed));
     std::printf("%12s %10s %8s %24s\n", "policy steps", "success", "walls", "|policy - label| / scale");

@@ -3,8 +3,11 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/record.hpp>
+#include <dicestack/learners/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -18,6 +21,7 @@ struct RecordOptions {
   int episodes = 100;
   std::uint64_t seed = 0;
   std::filesystem::path out;
+  std::filesystem::path demos;  // the tracker's recordings
   int threads = 0;
   double noise = 0.0;
   bool successes_only = false, no_replan = false;
@@ -30,6 +34,17 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
+  std::string recordings;  // for the provenance
+  if (opt.expert == "tracker") {
+    if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
+    const auto dir = resolve_demo_set(opt.demos, world);
+    const DemoSet demos = read_demo_set(dir);
+    expert.recordings = make_recordings(demos.episodes, world, {}, opt.seed, opt.threads, cluster);
+    recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
+                 " (" + (demos.description.empty() ? "no description" : demos.description) + ")";
+  } else if (!opt.demos.empty()) {
+    throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
+  }
   std::vector<Episode> eps = record_expert(opt.expert, expert, world, opt.episodes, opt.seed, opt.threads,
                                          {opt.noise, opt.noise, opt.noise}, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
@@ -44,11 +59,12 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   }
   DemoSet set;
   set.world = world;
-  set.description = "dicestack record --expert " + opt.expert;
+  set.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string());
   set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
                    std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
                    (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
-                   "; episode i starts from random_start_state(world, training_start_seed(seed, i))" +
+                   (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
+                   "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
                    (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
                                           std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
                                           "actions recorded"
@@ -94,6 +110,8 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--episodes", opt->episodes, "Episodes from random starts")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->check(seed_check())->capture_default_str();
   cmd->add_option("--out", opt->out, "Demonstration folder to write (missing, empty, or a dicestack set, which is replaced whole)")->required();
+  cmd->add_option("--demos", opt->demos,
+                  "tracker: the recordings it follows (a demonstration folder, builtin or human)");
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--noise", opt->noise,
                   "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "

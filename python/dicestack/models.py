@@ -29,11 +29,19 @@ def load_model(path, allow_pickle=False):
     return _dicestack.load_model(os.fspath(path), allow_pickle)
 
 
-def expert(name):
-    """An automatic expert, "scripted" or "mpc": `expert(env)` (or `.act(env)`) gives the action
-    for a DiceStackEnv's current state. It restarts by itself at each new episode; use one expert
-    per world."""
-    return _dicestack.Expert(name)
+def expert(name, demos=None, *, world=None, seed=0):
+    """An automatic expert, "scripted", "mpc" or "tracker": `expert(env)` (or `.act(env)`) gives
+    the action for a DiceStackEnv's current state. It restarts by itself at each new episode; use
+    one expert per world.
+
+    "tracker" is the demonstrator made of demonstrations: it follows the recorded cup path of
+    `demos` ("builtin", "human", a folder or a list of Episodes) that succeeds when simulated
+    from the episode's start, chosen once per episode. Its recordings are ranked in `world` with
+    `seed` when it is made (a few seconds). The other experts read no demonstrations."""
+    if name == "tracker" and demos is None:
+        raise ValueError('expert "tracker" follows recordings: give them with demos= ("builtin", "human", a folder '
+                         "or a list of Episodes)")
+    return _dicestack.Expert(name, None if demos is None else _demos_argument(demos), resolve_world(world), seed)
 
 
 def _assignments(values, what):

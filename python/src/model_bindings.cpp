@@ -8,6 +8,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <dicestack/core/expert.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/leaderboard.hpp>
@@ -49,11 +50,39 @@ class PyPolicy {
   std::vector<State> states_;
 };
 
+/// Demonstrations given as a name or folder ("builtin", "human", a path) or as episodes.
+std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& world, std::string* name) {
+  if (py::isinstance<py::str>(demos)) {
+    const std::string spec = demos.cast<std::string>();
+    std::filesystem::path dir;
+    {
+      py::gil_scoped_release nogil;
+      dir = resolve_demo_set(spec, world);
+    }
+    if (name) *name = dir.string();
+    return reading(dir, [&] { return read_demo_set(dir).episodes; });
+  }
+  if (name) *name = "<episodes from Python>";
+  return episodes_from(demos.cast<py::iterable>());
+}
+
 /// An automatic expert acting on a Python environment; restarts (seeded with the episode's seed)
 /// whenever it meets a new episode.
 class PyExpert {
  public:
-  explicit PyExpert(const std::string& name) : expert_(make_expert(name)) {}
+  /// `demos` (None, or as demos_from takes them) are the recordings "tracker" follows, ranked in
+  /// `world` with `seed`; other experts read none.
+  PyExpert(const std::string& name, const py::handle& demos, const WorldConfig& world, std::uint64_t seed) {
+    ExpertConfig config;
+    if (!demos.is_none()) {
+      if (name != "tracker")
+        throw py::value_error("expert \"" + name + "\" reads no demonstrations (demos= is the recordings of \"tracker\")");
+      const std::vector<Episode> episodes = demos_from(demos, world, nullptr);
+      py::gil_scoped_release nogil;
+      config.recordings = make_recordings(episodes, world, {}, seed);
+    }
+    expert_ = make_expert(name, config);
+  }
   Action act(EnvCore& core) {
     if (world_hash_ && *world_hash_ != core.world_hash())
       throw py::value_error("expert \"" + expert_->name() +
@@ -79,22 +108,6 @@ py::dict string_map(const std::map<std::string, std::string>& values) {
   py::dict d;
   for (const auto& [k, v] : values) d[py::str(k)] = v;
   return d;
-}
-
-/// Demonstrations given as a name or folder ("builtin", "human", a path) or as episodes.
-std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& world, std::string* name) {
-  if (py::isinstance<py::str>(demos)) {
-    const std::string spec = demos.cast<std::string>();
-    std::filesystem::path dir;
-    {
-      py::gil_scoped_release nogil;
-      dir = resolve_demo_set(spec, world);
-    }
-    if (name) *name = dir.string();
-    return reading(dir, [&] { return read_demo_set(dir).episodes; });
-  }
-  if (name) *name = "<episodes from Python>";
-  return episodes_from(demos.cast<py::iterable>());
 }
 
 /// Refuses a user's file at a model's path, and at its pickle's when the regressor pickles, before any work.
@@ -244,8 +257,9 @@ void bind_models(py::module_& m) {
           return PyModel{std::make_shared<Model>(std::move(model)), path.string(), std::nullopt};
         }, py::arg("path"), py::arg("allow_pickle"));
 
-  py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\" or \"mpc\") acting on an environment")
-      .def(py::init<const std::string&>(), py::arg("name"))
+  py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\", \"mpc\" or \"tracker\") acting on an environment")
+      .def(py::init<const std::string&, const py::handle&, const WorldConfig&, std::uint64_t>(), py::arg("name"),
+           py::arg("demos"), py::arg("world"), py::arg("seed"))
       .def("act", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def("__call__", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def_property_readonly("name", &PyExpert::name);

@@ -3,7 +3,7 @@
 # under mpirun -np 2 and -np 3 (with 1 and 2 threads per rank), outputs compared byte for byte
 # (timing fields removed from JSON). `failure` checks that a rank that fails or dies ends the
 # whole run quickly with a clear message.
-#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | evaluate | dagger | dad | dart | leaderboard | optimise | reinforce | rrt | failure
+#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | tracker | evaluate | dagger | dad | dart | leaderboard | optimise | reinforce | rrt | failure
 set -euo pipefail
 exe="$1"
 mpirun="$2"
@@ -54,6 +54,21 @@ case "$mode" in
     done
     same "$work/rec-1" "$work/rec-2"
     same "$work/rec-1" "$work/rec-3"
+    ;;
+  tracker)  # the demonstrator made of recordings: its ranking and its episodes, then DART through it
+    for run in "1 2" "2 1" "3 2"; do
+      set -- $run
+      ranks "$1" record --expert tracker --demos "$work/demos" --episodes 5 --seed 3 --noise 0.1 --threads "$2" \
+        --out "$work/rec-$1" "${world[@]}" > /dev/null
+      ranks "$1" train --regressor knn --learner dart --option expert=tracker --option episodes=5 \
+        --option successes_only=false --option tracker_probes=2 --demos "$work/demos" --seed 4 --threads "$2" \
+        --out "$work/dart-$1.dsm" "${world[@]}" > /dev/null
+    done
+    grep -q 'expert tracker' "$work/rec-1/meta.json" || fail "the set does not name its expert"
+    same "$work/rec-1" "$work/rec-2"
+    same "$work/rec-1" "$work/rec-3"
+    same "$work/dart-1.dsm" "$work/dart-2.dsm"
+    same "$work/dart-1.dsm" "$work/dart-3.dsm"
     ;;
   evaluate)
     "$exe" train --regressor knn --demos "$work/demos" --out "$work/knn.dsm" "${world[@]}" > /dev/null

@@ -387,6 +387,41 @@ TEST(CliLearning, RecordWithNoiseRecordsTheCleanActionsAndSaysSo) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
+  const auto dir = test::scratch_path("dicestack_cli_tracker");
+  const Process p = run("record --expert tracker --demos " + kTinyDemos + " --episodes 2 --out " + dir.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  std::ifstream meta(dir / "meta.json");
+  const auto j = nlohmann::json::parse(meta);
+  EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("--expert tracker "));
+  EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("--demos " + kTinyDemos));
+  EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("recordings followed: the "));
+  EXPECT_EQ(j["episodes"][0]["origin"], "expert tracker");
+  std::filesystem::remove_all(dir);
+  // The tracker without recordings, and recordings for an expert that reads none, are refused
+  // before anything is written.
+  Process bad = run("record --expert tracker --episodes 1 --out " + dir.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("--expert tracker follows recordings: give them with --demos"));
+  bad = run("record --expert mpc --demos " + kTinyDemos + " --episodes 1 --out " + dir.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("expert mpc reads none"));
+  EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
+TEST(CliLearning, LeaderboardRowsCanBeLearnersWithOptions) {
+  const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr "
+                        "--learners bc,dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1 "
+                        "--episodes 1 --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  const auto rows = nlohmann::json::parse(p.output)["rows"];
+  ASSERT_EQ(rows.size(), 3u);  // bc, dart through the tracker, playback
+  EXPECT_EQ(rows[1]["learner"], "dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1");
+  const Process bad = run("leaderboard --demos " + kTinyDemos + " --learners dart:expert=oracle --episodes 1");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("learner \"dart:expert=oracle\""));
+}
+
 TEST(CliBaselines, LeaderboardAddsBaselineRowsFromTheSameStarts) {
   const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 2 --seed 4 "
                         "--baselines de,rrt --format json", false);

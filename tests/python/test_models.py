@@ -100,3 +100,22 @@ def test_expert_refuses_an_env_of_another_world():
     other.reset(seed=0)
     with pytest.raises(ValueError, match="one expert per world"):
         expert(other)
+
+
+def test_tracker_follows_the_builtin_recordings_to_a_stack():
+    expert = dicestack.expert("tracker", demos="builtin")
+    assert expert.name == "tracker"
+    env = dicestack.DiceStackEnv()
+    env.reset(seed=3)
+    for _ in range(env.world["episode"]["max_steps"]):
+        _, _, terminated, truncated, info = env.step(expert(env))
+        if terminated or truncated:
+            break
+    assert terminated and info["realistic_success"] and not info["wall_contact"]
+
+
+def test_tracker_needs_recordings_and_the_others_read_none():
+    with pytest.raises(ValueError, match="give them with demos="):
+        dicestack.expert("tracker")
+    with pytest.raises(ValueError, match="reads no demonstrations|no recordings|demos"):
+        dicestack.expert("mpc", demos="builtin")

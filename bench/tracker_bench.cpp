@@ -1,0 +1,187 @@
+// Measures the tracker, the demonstrator made of demonstrations (issue 24; docs/learners.md):
+// realistic success, wall contact, which recordings it chose and how many simulations its
+// search took, over random starts (evaluation_start_seed(seed, i)). Usage:
+//   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
+//       [--recordings K [--subset-seed S]] [--probes P] [--no-optimise]
+//       [--noise F [--noise-window FROM,TO]] [--per-path] [--json]
+// --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
+// --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
+// the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
+// choices are to a learner's errors. --per-path follows every recording as recorded (no search)
+// from each start instead, with and without that noise, and lists them by successes.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/parallel.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
+#include <dicestack/learners/train.hpp>
+
+using namespace dicestack;
+
+namespace {
+
+struct Options {
+  std::string demos = "human";
+  int starts = 100, threads = 0, keep = 0;
+  std::uint64_t seed = 1000, subset_seed = 0;
+  TrackerConfig tracker;
+  double noise = 0.0, noise_from = 0.0, noise_to = 1e9;
+  bool per_path = false, json = false;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--demos") o.demos = next();
+    else if (a == "--starts") o.starts = std::stoi(next());
+    else if (a == "--seed") o.seed = std::stoull(next());
+    else if (a == "--threads") o.threads = std::stoi(next());
+    else if (a == "--recordings") o.keep = std::stoi(next());
+    else if (a == "--subset-seed") o.subset_seed = std::stoull(next());
+    else if (a == "--probes") o.tracker.probes = std::stoi(next());
+    else if (a == "--no-optimise") o.tracker.optimise = false;
+    else if (a == "--noise") o.noise = std::stod(next());
+    else if (a == "--noise-window") {
+      const std::string v = next();
+      if (std::sscanf(v.c_str(), "%lf,%lf", &o.noise_from, &o.noise_to) != 2) throw std::runtime_error("--noise-window FROM,TO");
+    } else if (a == "--per-path") o.per_path = true;
+    else if (a == "--json") o.json = true;
+    else throw std::runtime_error("unknown argument " + a);
+  }
+  if (o.starts < 1) throw std::runtime_error("--starts must be >= 1");
+  return o;
+}
+
+// Follows `follower` from env's state to the end of the episode, with the options' noise.
+Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std::uint64_t noise_seed, bool noisy) {
+  Rng rng(noise_seed);
+  const int first = env.t();
+  while (env.t() < env.config().episode.max_steps) {
+    Action a = follower.act(env.get_state(), env.t());
+    const double at = static_cast<double>(env.t() - first) / std::max(1, follower.length());
+    if (noisy && at >= o.noise_from && at < o.noise_to)
+      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += o.noise * env.config().action.scale[k] * rng.normal();
+    if (env.step(a).terminated) break;
+  }
+  return env.outcome();
+}
+
+int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, const Options& o) {
+  const auto paths = cup_paths(episodes);
+  const auto n = static_cast<std::size_t>(o.starts);
+  std::vector<int> ok(paths.size() * n), ok_noisy(paths.size() * n);
+  EnvPool envs(world, o.threads);
+  parallel_for(paths.size() * n, o.threads, [&](std::size_t item, int w) {
+    const std::uint64_t s = evaluation_start_seed(o.seed, item % n);
+    for (const bool noisy : {false, true}) {
+      DiceEnv& env = envs.at(w);
+      env.reset_to(random_start_state(world, s), s);
+      const PathFollower follower(paths[item / n], {}, env.get_state(), 0, o.tracker.gain);
+      (noisy ? ok_noisy : ok)[item] = follow(env, follower, o, derive_seed(s, 2), noisy).realistic_success();
+    }
+  });
+  std::vector<std::tuple<int, int, std::string>> rows;
+  for (std::size_t p = 0; p < paths.size(); ++p) {
+    int a = 0, b = 0;
+    for (std::size_t i = 0; i < n; ++i) a += ok[p * n + i], b += ok_noisy[p * n + i];
+    rows.emplace_back(a, b, paths[p].name);
+  }
+  std::sort(rows.rbegin(), rows.rend());
+  std::printf("recording: realistic successes of %d starts as recorded, and with noise %.3f\n", o.starts, o.noise);
+  for (const auto& [a, b, name] : rows) std::printf("%s %d %d\n", name.c_str(), a, b);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  const Options o = parse(argc, argv);
+  const WorldConfig world;
+  std::vector<Episode> episodes = read_demo_set(resolve_demo_set(o.demos, world)).episodes;
+  if (o.keep > 0 && o.keep < static_cast<int>(episodes.size())) {
+    Rng rng(o.subset_seed);
+    for (std::size_t i = episodes.size() - 1; i > 0; --i) std::swap(episodes[i], episodes[rng.below(i + 1)]);
+    episodes.resize(static_cast<std::size_t>(o.keep));
+  }
+  if (o.per_path) return per_path(episodes, world, o);
+
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const auto recordings = make_recordings(episodes, world, o.tracker, 0, o.threads);
+  const double rank_seconds = std::chrono::duration<double>(clock::now() - t0).count();
+
+  struct Result {
+    TrackerChoice choice;
+    Outcome outcome;
+  };
+  std::vector<Result> results(static_cast<std::size_t>(o.starts));
+  EnvPool envs(world, o.threads), sims(world, o.threads);
+  const auto t1 = clock::now();
+  parallel_for(results.size(), o.threads, [&](std::size_t i, int w) {
+    DiceEnv& env = envs.at(w);
+    const std::uint64_t s = evaluation_start_seed(o.seed, i);
+    env.reset_to(random_start_state(world, s), s);
+    Result& r = results[i];
+    r.choice = choose_path(*recordings, env, sims.at(w), s);
+    const PathFollower follower(recordings->paths()[r.choice.path], r.choice.warp, env.get_state(), env.t(),
+                                o.tracker.gain);
+    r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0);
+  });
+  const double seconds = std::chrono::duration<double>(clock::now() - t1).count();
+
+  int success = 0, wall = 0, found = 0, warped = 0, sims_total = 0, sims_max = 0;
+  std::map<std::string, int> chosen;
+  for (const auto& r : results) {
+    success += r.outcome.realistic_success();
+    wall += r.outcome.wall_contact;
+    found += r.choice.success;
+    warped += r.choice.warp.time_scale != 1.0 || r.choice.warp.offset != 0.0 || r.choice.warp.amplitude != 1.0;
+    sims_total += r.choice.simulations;
+    sims_max = std::max(sims_max, r.choice.simulations);
+    ++chosen[recordings->paths()[r.choice.path].name];
+  }
+  std::vector<std::pair<int, std::string>> by_count;
+  for (const auto& [name, n] : chosen) by_count.emplace_back(n, name);
+  std::sort(by_count.rbegin(), by_count.rend());
+  const double ms = 1e3 * seconds / o.starts;
+  if (o.json) {
+    std::printf("{\"demos\": \"%s\", \"recordings\": %zu, \"starts\": %d, \"seed\": %llu, \"threads\": %d, \"noise\": %g, "
+                "\"realistic_success\": %d, \"wall_contact\": %d, \"search_found\": %d, \"warped\": %d, "
+                "\"distinct_paths\": %zu, \"simulations_mean\": %.2f, \"simulations_max\": %d, \"rank_seconds\": %.3f, "
+                "\"seconds\": %.3f, \"ms_per_start\": %.2f}\n",
+                o.demos.c_str(), episodes.size(), o.starts, static_cast<unsigned long long>(o.seed),
+                resolve_threads(o.threads), o.noise, success, wall, found, warped, chosen.size(),
+                static_cast<double>(sims_total) / o.starts, sims_max, rank_seconds, seconds, ms);
+    return 0;
+  }
+  std::printf("tracker on %s (%zu recordings), %d starts from evaluation seed %llu, %d threads, noise %g\n",
+              o.demos.c_str(), episodes.size(), o.starts, static_cast<unsigned long long>(o.seed),
+              resolve_threads(o.threads), o.noise);
+  std::printf("ranking: %d probe starts per recording, %.2f s\n", o.tracker.probes, rank_seconds);
+  std::printf("realistic success %d / %d, wall contact %d; the search found a success for %d, %d of them warped\n",
+              success, o.starts, wall, found, warped);
+  std::printf("simulations per start: mean %.2f, max %d; %.3f s in all (%.2f ms per start)\n",
+              static_cast<double>(sims_total) / o.starts, sims_max, seconds, ms);
+  std::printf("distinct recordings chosen: %zu; most chosen:", chosen.size());
+  for (std::size_t k = 0; k < std::min<std::size_t>(8, by_count.size()); ++k)
+    std::printf(" %s %d", by_count[k].second.c_str(), by_count[k].first);
+  std::printf("\n");
+  return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "dicestack_tracker_bench: %s\n", e.what());
+  return 1;
+}
