@@ -2,7 +2,7 @@
 // realistic success, wall contact, which recordings it chose and how many simulations its
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
-//       [--recordings K [--subset-seed S]] [--probes P] [--no-optimise]
+//       [--recordings K [--subset-seed S]] [--probes P] [--paths N] [--no-optimise]
 //       [--noise F [--noise-window FROM,TO]] [--per-path] [--json]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
 // --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
@@ -53,6 +53,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--recordings") o.keep = std::stoi(next());
     else if (a == "--subset-seed") o.subset_seed = std::stoull(next());
     else if (a == "--probes") o.tracker.probes = std::stoi(next());
+    else if (a == "--paths") o.tracker.keep = std::stoi(next());
     else if (a == "--no-optimise") o.tracker.optimise = false;
     else if (a == "--noise") o.noise = std::stod(next());
     else if (a == "--noise-window") {
@@ -111,12 +112,8 @@ int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, con
 int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
   const WorldConfig world;
-  std::vector<Episode> episodes = read_demo_set(resolve_demo_set(o.demos, world)).episodes;
-  if (o.keep > 0 && o.keep < static_cast<int>(episodes.size())) {
-    Rng rng(o.subset_seed);
-    for (std::size_t i = episodes.size() - 1; i > 0; --i) std::swap(episodes[i], episodes[rng.below(i + 1)]);
-    episodes.resize(static_cast<std::size_t>(o.keep));
-  }
+  const std::vector<Episode> episodes =
+      pick_recordings(read_demo_set(resolve_demo_set(o.demos, world)).episodes, o.keep, o.subset_seed);
   if (o.per_path) return per_path(episodes, world, o);
 
   using clock = std::chrono::steady_clock;

@@ -1,14 +1,28 @@
 #include <dicestack/learners/demonstrator.hpp>
 
+#include <utility>
+
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/rng.hpp>
 
 namespace dicestack {
+namespace {
+constexpr std::uint64_t kRecordingsStream = 0x7265636f7264ULL;  // "record": the subset a learner follows
+}  // namespace
 
 std::vector<CupPath> cup_paths(const std::vector<Episode>& episodes) {
   std::vector<CupPath> paths;
   paths.reserve(episodes.size());
   for (const auto& e : episodes) paths.push_back({e.name, e.states, e.actions});
   return paths;
+}
+
+std::vector<Episode> pick_recordings(std::vector<Episode> episodes, int k, std::uint64_t seed) {
+  if (k <= 0 || k >= static_cast<int>(episodes.size())) return episodes;
+  Rng rng(seed);
+  for (std::size_t i = episodes.size() - 1; i > 0; --i) std::swap(episodes[i], episodes[rng.below(i + 1)]);
+  episodes.resize(static_cast<std::size_t>(k));
+  return episodes;
 }
 
 std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& demos, const WorldConfig& world,
@@ -23,7 +37,11 @@ std::vector<ParamSpec> tracker_param_specs() {
   return {{"tracker_probes", ParamType::integer, std::to_string(d.probes), 0, 100000,
            "tracker: training starts that rank the recordings (most successes first)", {}},
           {"tracker_optimise", ParamType::boolean, d.optimise ? "true" : "false", 0, 1,
-           "tracker: search timing, offset and amplitude when no recording succeeds as recorded", {}}};
+           "tracker: search timing, offset and amplitude when no recording succeeds as recorded", {}},
+          {"tracker_paths", ParamType::integer, std::to_string(d.keep), 0, 1000000,
+           "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all)", {}},
+          {"tracker_recordings", ParamType::integer, "0", 0, 1000000,
+           "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}}};
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
@@ -34,7 +52,10 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     TrackerConfig tracker;
     tracker.probes = static_cast<int>(params.integer("tracker_probes"));
     tracker.optimise = params.boolean("tracker_optimise");
-    config.recordings = make_recordings(c.demos, c.world, tracker, c.seed, c.threads, *c.cluster);
+    tracker.keep = static_cast<int>(params.integer("tracker_paths"));
+    const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
+                                          derive_seed(c.seed, kRecordingsStream));
+    config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);
   }
   return config;
 }

@@ -90,6 +90,12 @@ TEST(Recordings, RankingDoesNotDependOnThreads) {
   const Recordings one(paths, w, c, 7, 1), two(paths, w, c, 7, 2);
   EXPECT_EQ(one.order(), two.order());
   EXPECT_EQ(one.probe_successes(), two.probe_successes());
+  // keep: only the best-ranked recordings are ever tried, in the same order.
+  c.keep = 2;
+  const Recordings kept(paths, w, c, 7, 2);
+  EXPECT_EQ(kept.order(), std::vector<std::size_t>(one.order().begin(), one.order().begin() + 2));
+  c.keep = -1;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"keep\""), std::string::npos);
 }
 
 TEST(ChoosePath, FindsARecordingThatSucceedsAndIsDeterministic) {

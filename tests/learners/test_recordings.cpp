@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 #include <unistd.h>
 
 #include <dicestack/core/error.hpp>
@@ -97,6 +98,25 @@ TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
   const Forbidden none({"mpc", "scripted", "tracker"});
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, test::short_world(), 3, 0, 2);
   EXPECT_EQ(s.episodes, 3);
+}
+
+TEST(Recordings, PickedSubsetsAreSeededAndAllMeansAll) {
+  const auto names = [](const std::vector<Episode>& es) {
+    std::vector<std::string> out;
+    for (const auto& e : es) out.push_back(e.name);
+    return out;
+  };
+  EXPECT_EQ(names(pick_recordings(human_six(), 0, 1)), names(human_six()));
+  EXPECT_EQ(names(pick_recordings(human_six(), 6, 1)), names(human_six()));
+  const auto three = pick_recordings(human_six(), 3, 1);
+  ASSERT_EQ(three.size(), 3u);
+  EXPECT_EQ(names(pick_recordings(human_six(), 3, 1)), names(three));
+  std::set<std::string> distinct;
+  for (const auto& n : names(three)) distinct.insert(n);
+  EXPECT_EQ(distinct.size(), 3u);
+  bool another = false;  // some other seed draws another subset
+  for (std::uint64_t seed = 2; seed < 10 && !another; ++seed) another = names(pick_recordings(human_six(), 3, seed)) != names(three);
+  EXPECT_TRUE(another);
 }
 
 TEST(HonestLearning, TheTrackerNeedsDemonstrations) {

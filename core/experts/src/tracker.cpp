@@ -82,6 +82,7 @@ void validate(const TrackerConfig& c) {
   };
   require(c.gain > 0.0 && c.gain < 1e6, "gain", "in (0, 1e6)", c.gain);
   require(c.probes >= 0 && c.probes <= 100000, "probes", "in [0, 100000]", c.probes);
+  require(c.keep >= 0 && c.keep <= 1000000, "keep", "in [0, 1000000]", c.keep);
   require(c.optimise_paths >= 1 && c.optimise_paths <= 100000, "optimise_paths", "in [1, 100000]", c.optimise_paths);
   require(c.optimise_evaluations >= 1 && c.optimise_evaluations <= 100000, "optimise_evaluations", "in [1, 100000]",
           c.optimise_evaluations);
@@ -157,6 +158,8 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
   std::iota(order_.begin(), order_.end(), std::size_t{0});
   std::stable_sort(order_.begin(), order_.end(),
                    [&](std::size_t a, std::size_t b) { return probe_successes_[a] > probe_successes_[b]; });
+  if (config_.keep > 0 && static_cast<std::size_t>(config_.keep) < order_.size())
+    order_.resize(static_cast<std::size_t>(config_.keep));
 }
 
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed) {

@@ -2,10 +2,10 @@
 // The demonstrator made of demonstrations (issue 24): a demonstration set turned into the
 // tracker expert's Recordings (core/tracker.hpp), for record, DART, DAgger, the leaderboard and
 // Python.
+#include <cstdint>
 #include <memory>
-#include <vector>
-
 #include <string>
+#include <vector>
 
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/expert.hpp>
@@ -18,6 +18,10 @@ namespace dicestack {
 /// Each episode's states and actions as a cup path named after the episode.
 std::vector<CupPath> cup_paths(const std::vector<Episode>& episodes);
 
+/// `k` of `episodes` drawn without replacement with `seed` (all of them when k is 0 or not
+/// smaller than their number), in the order drawn: the ablation "from k recordings".
+std::vector<Episode> pick_recordings(std::vector<Episode> episodes, int k, std::uint64_t seed);
+
 /// The tracker's recordings from `demos` (ranked by simulation from config.probes training
 /// starts of `seed`: see Recordings). Throws InputError if `demos` is empty. Collective over
 /// `cluster`.
@@ -26,7 +30,8 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
                                                   Cluster& cluster = local_cluster());
 
 /// The options of a learner whose expert may be the tracker (DART, DAgger): tracker_probes,
-/// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations).
+/// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations) and
+/// tracker_recordings (follow only that many of the demonstrations, drawn with the run's seed).
 std::vector<ParamSpec> tracker_param_specs();
 
 /// The ExpertConfig of a learner's expert `name` (DART, DAgger): for "tracker", its recordings

@@ -36,6 +36,7 @@ struct PathWarp {
 struct TrackerConfig {
   double gain = 10.0;        ///< feedback gain on the cup's pose, 1/s (the issue's k)
   int probes = 16;           ///< training starts that rank the recordings (most successes first), >= 0
+  int keep = 0;              ///< follow only the first `keep` recordings of the ranking (0: all), >= 0
   bool optimise = true;      ///< when no recording succeeds as recorded, search warps
   int optimise_paths = 4;    ///< the warp search tries the recordings that came closest, >= 1
   int optimise_evaluations = 60;   ///< simulated warps per recording (CMA-ES), >= 1
@@ -83,7 +84,8 @@ class Recordings {
              int threads = 0, Cluster& cluster = local_cluster());
 
   const std::vector<CupPath>& paths() const { return paths_; }
-  /// Path indices in the order the tracker tries them: most probe successes first, then by index.
+  /// Path indices in the order the tracker tries them: most probe successes first, then by index;
+  /// only the first config.keep of them when keep > 0 (the others are never followed).
   const std::vector<std::size_t>& order() const { return order_; }
   /// Probe successes per path (index as in paths()).
   const std::vector<int>& probe_successes() const { return probe_successes_; }
