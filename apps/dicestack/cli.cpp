@@ -42,6 +42,7 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   add_regressors_command(app);
   add_render_command(app);
   add_rollout_command(app);
+  add_robustness_command(app, cluster);
   if (cluster.size() > 1)
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
       const std::string name = sub->get_name();

@@ -33,6 +33,7 @@ void add_record_command(CLI::App& app, Cluster& cluster);
 void add_regressors_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
+void add_robustness_command(CLI::App& app, Cluster& cluster);
 void add_bench_regressors_command(CLI::App& bench);  // under `bench`
 void add_bench_load_command(CLI::App& bench);        // under `bench`
 void add_bench_dataset_command(CLI::App& bench);     // under `bench`

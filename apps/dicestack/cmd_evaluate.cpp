@@ -24,11 +24,13 @@ struct EvaluateOptions {
   std::uint64_t seed = 0;
   int threads = 0;
   std::string push = "none";
+  std::string perturb = "none";
   bool json = false;
 };
 
 int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
+  const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   auto model = std::make_shared<const Model>(load_model(opt.model));
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
   if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))
@@ -38,8 +40,14 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     errors = score(*model, DemoSplit(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, "episodes"));
   const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
   std::vector<Episode> rollouts;
-  const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, opt.episodes, opt.seed,
-                               opt.threads, initial_push_from(opt.push), keep ? &rollouts : nullptr, {}, cluster);
+  EvalRequest request;
+  request.episodes = opt.episodes;
+  request.seed = opt.seed;
+  request.threads = opt.threads;
+  request.push = initial_push_from(opt.push);
+  request.perturbation = perturbation;
+  request.rollouts = keep ? &rollouts : nullptr;
+  const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
   if (!opt.video_dir.empty()) {
     // One video per rollout, named as --save-rollouts names its episodes (as robomimic's
@@ -60,22 +68,24 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.world = world;
     set.description = "rollouts of " + opt.model.string();
     set.provenance = "dicestack evaluate --model " + opt.model.string() + " --episodes " + std::to_string(opt.episodes) +
+                     (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
                      " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
   }
   if (opt.json) {
-    print_line(evaluation_json({opt.model.string(), opt.seed, opt.push}, *model, s,
+    print_line(evaluation_json({opt.model.string(), opt.seed, opt.push, opt.perturb}, *model, s,
                                errors ? &*errors : nullptr));
     return 0;
   }
   char line[512];
   std::snprintf(line, sizeof line,
-                "%s (%s): %d episodes from seed %llu\n"
+                "%s (%s): %d episodes from seed %llu%s\n"
                 "  realistic success %.1f%% [%.1f, %.1f], stacked %.1f%% [%.1f, %.1f], wall contact %.1f%% [%.1f, %.1f]\n"
                 "  dice in cup (most, mean) %.2f, all three %.1f%%, mean length %.0f steps, %.2f us per step",
                 opt.model.string().c_str(), model->regressor().name().c_str(), s.episodes,
-                static_cast<unsigned long long>(opt.seed), 100 * s.realistic_success.value, 100 * s.realistic_success.low,
+                static_cast<unsigned long long>(opt.seed), opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb).c_str(),
+                100 * s.realistic_success.value, 100 * s.realistic_success.low,
                 100 * s.realistic_success.high, 100 * s.stacked.value, 100 * s.stacked.low, 100 * s.stacked.high,
                 100 * s.wall_contact.value, 100 * s.wall_contact.low, 100 * s.wall_contact.high, s.dice_in_cup_mean,
                 100 * s.dice_in_cup_3.value, s.mean_length, s.policy_us_per_step);
@@ -101,6 +111,10 @@ void add_evaluate_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--initial-push", opt->push, "The paper's jump-start: none, left or right")
       ->check(CLI::IsMember({"none", "left", "right"}))
+      ->capture_default_str();
+  cmd->add_option("--perturb", opt->perturb,
+                  "Perturbed worlds: none, easy, medium, hard (every factor at that level) or a perturbation file "
+                  "(docs/robustness.md)")
       ->capture_default_str();
   cmd->add_option("--save-rollouts", opt->save_rollouts,
                   "Also write the rollouts as a demonstration set (source policy; outcomes in meta.json)");

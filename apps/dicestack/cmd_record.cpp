@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/record.hpp>
@@ -24,6 +25,7 @@ struct RecordOptions {
   std::filesystem::path demos;  // the tracker's recordings
   int threads = 0;
   double noise = 0.0;
+  std::string perturb = "none";
   bool successes_only = false, no_replan = false;
   bool json = false;
 };
@@ -31,6 +33,7 @@ struct RecordOptions {
 int run_record(const RecordOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
+  const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
@@ -45,8 +48,13 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   } else if (!opt.demos.empty()) {
     throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
   }
-  std::vector<Episode> eps = record_expert(opt.expert, expert, world, opt.episodes, opt.seed, opt.threads,
-                                         {opt.noise, opt.noise, opt.noise}, cluster);
+  RecordRequest request;
+  request.episodes = opt.episodes;
+  request.seed = opt.seed;
+  request.threads = opt.threads;
+  request.noise = {opt.noise, opt.noise, opt.noise};
+  request.perturbation = perturbation;
+  std::vector<Episode> eps = record_expert(opt.expert, expert, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int success = 0, stacked = 0, walls = 0;
@@ -63,12 +71,15 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
                    std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
                    (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
+                   (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
                    (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
                    "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
                    (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
                                           std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
                                           "actions recorded"
-                                    : "");
+                                    : "") +
+                   (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its "
+                                                  "seed (" + perturbation_summary(perturbation) + ")");
   for (auto& e : eps)
     if (!opt.successes_only || e.outcome.realistic_success()) set.episodes.push_back(std::move(e));
   write_demo_set(set, opt.out);
@@ -113,6 +124,10 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--demos", opt->demos,
                   "tracker: the recordings it follows (a demonstration folder, builtin or human)");
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--perturb", opt->perturb,
+                  "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "
+                  "medium, hard or a perturbation file (docs/robustness.md)")
+      ->capture_default_str();
   cmd->add_option("--noise", opt->noise,
                   "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "
                   "expert's clean actions are recorded")

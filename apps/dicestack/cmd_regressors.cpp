@@ -30,7 +30,7 @@ void print_params(const std::vector<ParamSpec>& params, const char* flag) {
     std::string range;
     if (p.type == ParamType::choice) {
       for (const auto& c : p.choices) range += (range.empty() ? "" : "|") + c;
-    } else if (p.type != ParamType::boolean) {
+    } else if (p.type != ParamType::boolean && p.type != ParamType::text) {
       std::ostringstream os;
       os << "[" << p.min << ", " << p.max << "]";
       range = os.str();

@@ -97,6 +97,7 @@ void write_episode_csv(const Episode& e, const fs::path& path, AtomicFile::Lefto
 
 json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
   json episodes = json::array();
+  bool perturbed = false;
   for (std::size_t i = 0; i < set.episodes.size(); ++i) {
     const Episode& e = set.episodes[i];
     std::set<std::string_view> sources;
@@ -110,9 +111,14 @@ json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
                         {"final_state", e.final_state ? json(*e.final_state) : json(nullptr)},
                         {"terminated", e.terminated},
                         {"truncated", e.truncated}});
+    if (!e.perturbation.empty()) {
+      episodes.back()["perturbation"] = json::parse(e.perturbation);
+      perturbed = true;
+    }
   }
+  // Version 3 only adds the perturbation: a set without one is written as version 2.
   return {{"format", kDemoFormat},
-          {"version", kDemoFormatVersion},
+          {"version", perturbed ? kDemoFormatVersion : 2},
           {"dicestack_version", DICESTACK_VERSION},
           {"description", set.description},
           {"provenance", set.provenance},
@@ -374,6 +380,11 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
     if (!entry.contains("outcome")) meta_error(meta_path, "missing the outcome of " + e.file);
     e.outcome = outcome_from(entry["outcome"], meta_path, e.file);
     if (version >= 2) transitions_from(entry, meta_path, e);
+    if (version >= 3 && entry.contains("perturbation")) {
+      if (!entry["perturbation"].is_object())
+        meta_error(meta_path, "\"perturbation\" of " + e.file + " must be an object (the values its world drew)");
+      e.perturbation = entry["perturbation"].dump();
+    }
     out.episodes.push_back(std::move(e));
   }
   return out;
@@ -409,6 +420,7 @@ DemoSet read_demo_set(const fs::path& dir) {
     e.truncated = entry.truncated;
     e.seed = entry.seed;
     e.origin = std::move(entry.origin);
+    e.perturbation = std::move(entry.perturbation);
     if (entry.steps != e.size())
       meta_error(meta_path, "says " + entry.file + " has " + std::to_string(entry.steps) + " steps; the file has " +
                                 std::to_string(e.size()));

@@ -6,7 +6,7 @@ void pack_episode(Packer& out, const Episode& e) {
   out.put_string(e.name).put(e.seed).put_vector(e.states).put_vector(e.actions).put_vector(e.sources);
   out.put(e.outcome).put_string(e.origin).put<std::uint8_t>(e.final_state.has_value());
   if (e.final_state) out.put(*e.final_state);
-  out.put_vector(e.rewards).put<std::uint8_t>(e.terminated).put<std::uint8_t>(e.truncated);
+  out.put_vector(e.rewards).put<std::uint8_t>(e.terminated).put<std::uint8_t>(e.truncated).put_string(e.perturbation);
 }
 
 Episode unpack_episode(Unpacker& in) {
@@ -22,6 +22,7 @@ Episode unpack_episode(Unpacker& in) {
   e.rewards = in.get_vector<double>();
   e.terminated = in.get<std::uint8_t>() != 0;
   e.truncated = in.get<std::uint8_t>() != 0;
+  e.perturbation = in.get_string();
   return e;
 }
 

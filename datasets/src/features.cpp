@@ -17,6 +17,7 @@ struct Blocks {
   bool start = false;
   bool previous = false;
   bool start_state = false;  // the whole start state instead of its two summary numbers
+  bool open_loop = false;    // no current state: the clock and the start alone choose the action
 };
 
 class BuiltinFeatureMap final : public FeatureMap {
@@ -29,13 +30,14 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
 
   std::size_t width() const override {
-    return kStateDim + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
+    return (blocks_.open_loop ? 0 : kStateDim) + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
            (blocks_.start_state ? kStateDim : 0);
   }
 
   std::vector<std::string> column_names() const override {
     std::vector<std::string> out;
-    for (auto n : state_names()) out.emplace_back(n);
+    if (!blocks_.open_loop)
+      for (auto n : state_names()) out.emplace_back(n);
     if (blocks_.clock) out.emplace_back("t");
     if (blocks_.start) out.insert(out.end(), {"start_cup_x", "start_dice_mean_x"});
     if (blocks_.previous)
@@ -47,8 +49,11 @@ class BuiltinFeatureMap final : public FeatureMap {
 
   void compute(const History& h, std::span<double> out) const override {
     const State& s = h.current();
-    std::copy(s.begin(), s.end(), out.begin());
-    std::size_t at = kStateDim;
+    std::size_t at = 0;
+    if (!blocks_.open_loop) {
+      std::copy(s.begin(), s.end(), out.begin());
+      at = kStateDim;
+    }
     if (blocks_.clock) out[at++] = static_cast<double>(h.t());
     if (blocks_.start) {
       const State& s0 = h.start();
@@ -82,6 +87,9 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "state+history", "the state and the previous state (the start repeated at t = 0)", Blocks{false, false, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>("state+clock+start_state", "the state, t and the whole start state",
                                                      Blocks{true, false, false, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
+        Blocks{true, false, false, true, true}));
     return v;
   }();
   return *maps;

@@ -25,6 +25,7 @@ class Dagger final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
+    const Perturbation perturbation = learner_perturbation(params(), c.world, "dagger");  // before any work
     const int iterations = static_cast<int>(params().integer("iterations"));
     const int rollouts = static_cast<int>(params().integer("rollouts"));
     const std::string expert_name = params().choice("expert");
@@ -57,7 +58,8 @@ class Dagger final : public Learner {
             auto& expert = experts[static_cast<std::size_t>(w)];
             if (!expert) expert = make_expert(expert_name, expert_config);
             Episode e = mixture_rollout(envs.at(w), *expert, model.get(), beta,
-                                        training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k));
+                                        training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k),
+                                        perturbation);
             const int done = std::min(rollouts, ++finished * ranks);
             if (c.progress && w == 0)  // one thread reports
               c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
@@ -78,6 +80,7 @@ class Dagger final : public Learner {
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";
     model->record["expert"] = expert_name;
+    if (!perturbation.nominal()) model->record["perturb"] = params().choice("perturb");
     result.model = model;
     return result;
   }
@@ -93,6 +96,7 @@ class Dagger final : public Learner {
             {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the world leaves its prediction", {}},
             {"include_demos", ParamType::boolean, "true", 0, 1, "start the aggregate from the demonstrations", {}}};
     for (auto& p : tracker_param_specs()) specs.push_back(std::move(p));
+    specs.push_back(perturb_param_spec());
     return specs;
   }
 
@@ -109,11 +113,18 @@ class Dagger final : public Learner {
     return std::pow(params().real("beta"), i - 1);
   }
 
-  // One episode of the mixture policy; every visited state is labelled with the expert's action.
-  // A step's source says who acted: the expert, or the learner ("policy").
-  static Episode mixture_rollout(DiceEnv& env, Expert& expert, const Model* model, double beta, std::uint64_t seed) {
+  // One episode of the mixture policy, in the world `perturbation` draws for it; every visited
+  // state is labelled with the expert's action. A step's source says who acted: the expert, or
+  // the learner ("policy").
+  static Episode mixture_rollout(DiceEnv& pooled, Expert& expert, const Model* model, double beta, std::uint64_t seed,
+                                 const Perturbation& perturbation) {
+    const PerturbationDraw draw = draw_perturbation(perturbation, pooled.config(), seed);
+    std::optional<DiceEnv> own;
+    DiceEnv& env = episode_env(draw, pooled, own);
     MixturePolicy mixture(expert, env, model, beta);
-    Episode e = rollout(env, mixture, random_start_state(env.config(), seed), seed, StepSource::policy);
+    RolloutOptions options;
+    options.perturbation = &draw;
+    Episode e = rollout(env, mixture, random_start_state(draw.world, seed), seed, StepSource::policy, options);
     e.origin = "dagger";
     return e;
   }
@@ -124,6 +135,7 @@ class Dagger final : public Learner {
    public:
     MixturePolicy(Expert& expert, const DiceEnv& env, const Model* model, double beta)
         : expert_(expert, env), model_(model), beta_(beta) {}
+    void attach(const DiceEnv& env) override { expert_.attach(env); }
     void reset(std::uint64_t seed) override {
       expert_.reset(seed);
       coin_ = Rng(derive_seed(seed, 7));

@@ -15,6 +15,7 @@ class Dart final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
+    const Perturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
     const int episodes = static_cast<int>(params().integer("episodes"));
     const double noise = params().real("noise");
     Action fraction{noise, noise, noise};
@@ -27,7 +28,13 @@ class Dart final : public Learner {
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
-    auto recorded = record_expert(params().choice("expert"), expert, c.world, episodes, c.seed, c.threads, fraction, *c.cluster);
+    RecordRequest request;
+    request.episodes = episodes;
+    request.seed = c.seed;
+    request.threads = c.threads;
+    request.noise = fraction;
+    request.perturbation = perturbation;
+    auto recorded = record_expert(params().choice("expert"), expert, c.world, request, *c.cluster);
     int successes = 0;
     const bool successes_only = params().boolean("successes_only");
     for (auto& e : recorded) {
@@ -45,6 +52,7 @@ class Dart final : public Learner {
     r.model->record["expert"] = params().choice("expert");
     r.model->record["dart_episodes"] = std::to_string(episodes);
     r.model->record["dart_expert_successes"] = std::to_string(successes);
+    if (!perturbation.nominal()) r.model->record["perturb"] = params().choice("perturb");
     if (c.progress) c.progress({"fit", 1, 1, 0, 0, 1, 1, 1.0});
     return r;
   }
@@ -65,6 +73,7 @@ class Dart final : public Learner {
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
     std::vector<ParamSpec> out = specs;
     for (auto& p : tracker_param_specs()) out.push_back(std::move(p));
+    out.push_back(perturb_param_spec());
     return out;
   }
 };

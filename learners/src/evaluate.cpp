@@ -22,6 +22,12 @@ InitialPush initial_push_from(std::string_view text) {
   throw ConfigError("initial push \"" + std::string(text) + "\" is not one of none, left, right");
 }
 
+DiceEnv& episode_env(const PerturbationDraw& draw, DiceEnv& pooled, std::optional<DiceEnv>& own) {
+  if (!draw.physics) return pooled;
+  own.emplace(draw.world);
+  return *own;
+}
+
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
                 const RolloutOptions& options) {
   Episode e;
@@ -30,15 +36,20 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
   const auto& limit = env.config().action.limit;
   const bool noisy = options.noise[0] > 0.0 || options.noise[1] > 0.0 || options.noise[2] > 0.0;
   Rng noise(options.noise_seed);
+  std::optional<PerturbedChannel> perturbed;
+  std::vector<State> seen;  // what the policy was shown, when that is not the true states
+  if (options.perturbation && options.perturbation->acts) perturbed.emplace(*options.perturbation);
   std::vector<Action> applied;
+  policy.attach(env);
   e.states.push_back(env.reset_to(start, seed));
   policy.reset(seed);
   while (true) {
     if (options.before_step) options.before_step(env, applied.size());
-    Action a = policy.act(History{e.states, applied});
+    if (perturbed) seen.push_back(perturbed->observe(e.states.back()));
+    Action a = policy.act(History{perturbed ? seen : e.states, applied});
     if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
     for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
-    Action executed = a;
+    Action executed = perturbed ? perturbed->execute(a) : a;
     if (noisy)
       for (std::size_t k = 0; k < kActionDim; ++k) executed[k] += options.noise[k] * noise.normal();
     const auto label = policy.label();
@@ -56,6 +67,8 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
     e.states.push_back(r.observation);
   }
   e.outcome = env.outcome();
+  if (options.perturbation && (options.perturbation->physics || options.perturbation->acts))
+    e.perturbation = draw_to_json(*options.perturbation);
   return e;
 }
 
@@ -75,6 +88,7 @@ class TimedPolicy final : public Policy {
  public:
   TimedPolicy(Policy& inner, double& seconds) : inner_(inner), seconds_(seconds) {}
   void reset(std::uint64_t seed) override { inner_.reset(seed); }
+  void attach(const DiceEnv& env) override { inner_.attach(env); }
   Action act(const History& h) override {
     const auto t0 = std::chrono::steady_clock::now();
     const Action a = inner_.act(h);
@@ -144,28 +158,35 @@ Episode unpack_one(std::string_view bytes) { return episode_from_bytes(bytes); }
 
 }  // namespace
 
-EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
-                   int threads, InitialPush push, std::vector<Episode>* rollouts, const RolloutProgress& progress,
+EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,
                    Cluster& cluster) {
+  validate(request.perturbation, world);
   RolloutOptions options;
-  options.push = push;
-  const int workers = resolve_threads(threads);
-  EnvPool envs(world, threads);
+  options.push = request.push;
+  options.max_steps = request.max_steps;
+  const int episodes = std::max(0, request.episodes);
+  const int workers = resolve_threads(request.threads);
+  EnvPool envs(world, request.threads);
   std::vector<std::unique_ptr<Policy>> policies(static_cast<std::size_t>(workers));
   std::atomic<int> finished{0};
   const int ranks = cluster.size();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Timed> done = distributed_map<Timed>(
-      cluster, static_cast<std::size_t>(std::max(0, episodes)), threads,
+      cluster, static_cast<std::size_t>(episodes), request.threads,
       [&](std::size_t i, int w) {
         const auto slot = static_cast<std::size_t>(w);
         if (!policies[slot]) policies[slot] = make_policy();
         Timed t;
         TimedPolicy timed(*policies[slot], t.policy_seconds);
-        const std::uint64_t episode_seed = evaluation_start_seed(seed, i);
-        const State start = random_start_state(world, episode_seed);
-        t.episode = rollout(envs.at(w), timed, start, episode_seed, StepSource::policy, options);
-        if (progress) progress(std::min(episodes, ++finished * ranks), episodes);
+        const std::uint64_t episode_seed = evaluation_start_seed(request.seed, i);
+        const PerturbationDraw draw = draw_perturbation(request.perturbation, world, episode_seed);
+        RolloutOptions episode_options = options;
+        episode_options.perturbation = &draw;
+        std::optional<DiceEnv> own;
+        DiceEnv& env = episode_env(draw, envs.at(w), own);
+        const State start = random_start_state(draw.world, episode_seed);
+        t.episode = rollout(env, timed, start, episode_seed, StepSource::policy, episode_options);
+        if (request.progress) request.progress(std::min(episodes, ++finished * ranks), episodes);
         return t;
       },
       pack_timed, unpack_timed);
@@ -177,7 +198,7 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, i
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EvalStats stats = summarise(eps, total_policy, wall);
-  if (rollouts) *rollouts = std::move(eps);
+  if (request.rollouts) *request.rollouts = std::move(eps);
   return stats;
 }
 

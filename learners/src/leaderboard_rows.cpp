@@ -94,10 +94,12 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   const std::string rollouts_text = row_text + ": " + std::to_string(s_.episodes) + " rollouts";
   report_(rollouts_text, at(0.5), true);
   std::shared_ptr<const Model> model = learned.model;
-  r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, s_.world, s_.episodes, seed, s_.threads,
-                     InitialPush::none, nullptr, [&](int finished, int of) {
-                       report_(rollouts_text, at(0.5 + 0.5 * finished / of), false);
-                     }, inner);
+  EvalRequest request;
+  request.episodes = s_.episodes;
+  request.seed = seed;
+  request.threads = s_.threads;
+  request.progress = [&](int finished, int of) { report_(rollouts_text, at(0.5 + 0.5 * finished / of), false); };
+  r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, s_.world, request, inner);
   return r;
 }
 
@@ -109,11 +111,14 @@ LeaderboardRow RowRunner::baseline_row(const std::string& name, Cluster& inner, 
   row.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   row.train_error = row.test_error = -1;
   for (int k = 0; k < s_.seeds; ++k) {
-    const EvalStats st = evaluate(policy, s_.world, s_.episodes, s_.seed + static_cast<std::uint64_t>(k), s_.threads,
-                                  InitialPush::none, nullptr, [&](int finished, int of) {
-                                    report_("baseline " + name, from + span * (k + static_cast<double>(finished) / of) / s_.seeds,
-                                            false);
-                                  }, inner);
+    EvalRequest request;
+    request.episodes = s_.episodes;
+    request.seed = s_.seed + static_cast<std::uint64_t>(k);
+    request.threads = s_.threads;
+    request.progress = [&](int finished, int of) {
+      report_("baseline " + name, from + span * (k + static_cast<double>(finished) / of) / s_.seeds, false);
+    };
+    const EvalStats st = evaluate(policy, s_.world, request, inner);
     add_outcomes(row, st, s_.seeds);
   }
   return row;

@@ -105,4 +105,19 @@ void write_curve_csv(const std::vector<CurvePoint>& curve, const fs::path& path)
   f.commit();
 }
 
+ParamSpec perturb_param_spec() {
+  return {"perturb", ParamType::text, "none", 0, 0,
+          "domain randomisation: each episode in its own world drawn from its seed (none, easy, medium, hard or a "
+          "perturbation file; docs/robustness.md)",
+          {}};
+}
+
+Perturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner) {
+  try {
+    return load_perturbation(params.choice("perturb"), world);
+  } catch (const Error& e) {
+    throw ConfigError(learner + ": option perturb: " + e.what());
+  }
+}
+
 }  // namespace dicestack

@@ -15,29 +15,35 @@
 namespace dicestack {
 
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads, const Action& noise, Cluster& cluster) {
+                                   const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
+  validate(request.perturbation, world);
   RolloutOptions options;
   for (std::size_t k = 0; k < kActionDim; ++k) {
-    if (!(noise[k] >= 0.0) || !std::isfinite(noise[k]))
+    const double noise = request.noise[k];
+    if (!(noise >= 0.0) || !std::isfinite(noise))
       throw ConfigError("noise for " + std::string(action_names()[k]) + " must be a finite fraction >= 0, got " +
-                        std::to_string(noise[k]));
-    options.noise[k] = noise[k] * world.action.scale[k];
+                        std::to_string(noise));
+    options.noise[k] = noise * world.action.scale[k];
   }
+  const int threads = request.threads;
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
   EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Expert>> experts(workers);
   return distributed_map<Episode>(
-      cluster, static_cast<std::size_t>(std::max(0, episodes)), threads,
+      cluster, static_cast<std::size_t>(std::max(0, request.episodes)), threads,
       [&](std::size_t i, int w) {
-        DiceEnv& env = envs.at(w);
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!expert) expert = make_expert(name, config);
-        const std::uint64_t s = training_start_seed(seed, i);
+        const std::uint64_t s = training_start_seed(request.seed, i);
+        const PerturbationDraw draw = draw_perturbation(request.perturbation, world, s);
+        std::optional<DiceEnv> own;
+        DiceEnv& env = episode_env(draw, envs.at(w), own);
         ExpertPolicy policy(*expert, env);
         RolloutOptions o = options;
         o.noise_seed = derive_seed(s, 2);
-        Episode e = rollout(env, policy, random_start_state(world, s), s, StepSource::expert, o);
+        o.perturbation = &draw;
+        Episode e = rollout(env, policy, random_start_state(draw.world, s), s, StepSource::expert, o);
         e.origin = "expert " + name;
         return e;
       },
@@ -60,7 +66,11 @@ std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
     if (batch_start > 50 * kBuiltinSuccesses)
       throw Error("built-in demonstrations: the mpc expert found too few successes in this world");
     // Episodes batch_start.. of the seeded sequence; successes kept in index order.
-    auto batch = record_expert("mpc", {}, world, kBuiltinSuccesses, derive_seed(kBuiltinSeed, static_cast<std::uint64_t>(batch_start)), threads);
+    RecordRequest request;
+    request.episodes = kBuiltinSuccesses;
+    request.seed = derive_seed(kBuiltinSeed, static_cast<std::uint64_t>(batch_start));
+    request.threads = threads;
+    auto batch = record_expert("mpc", {}, world, request);
     for (auto& e : batch) {
       ++tried;
       if (e.outcome.realistic_success() && static_cast<int>(set.episodes.size()) < kBuiltinSuccesses)

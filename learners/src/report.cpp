@@ -28,6 +28,7 @@ std::string evaluation_json(const EvaluationRun& run, const Model& model, const 
                    {"mean_episode_length", s.mean_length},
                    {"us_per_step", s.policy_us_per_step},
                    {"seconds", s.seconds}};
+  if (run.perturb != "none") j["perturb"] = run.perturb;
   if (errors) {
     j["train_error"] = errors->train_error;
     if (errors->test_error) j["test_error"] = *errors->test_error;

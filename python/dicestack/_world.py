@@ -24,6 +24,35 @@ def resolve_world(world=None):
     raise TypeError(f"world must be None, a path, a dict or a WorldConfig, got {type(world).__name__}")
 
 
+def resolve_perturbation(perturb, world):
+    """The _dicestack.Perturbation for `perturb`: None or "none" (the nominal world), a level
+    ("easy", "medium", "hard"), a path to a perturbation file, or a dict in that file's format
+    (the "format" and "version" keys may be left out). ValueError names a bad field."""
+    if perturb is None:
+        return _dicestack.Perturbation()
+    if isinstance(perturb, _dicestack.Perturbation):
+        return perturb
+    if isinstance(perturb, dict):
+        fields = {"format": "dicestack-perturbation", "version": 1, **perturb}
+        try:
+            text = json.dumps(fields, allow_nan=False)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"perturbation <dict>: not JSON: {e}") from None
+        return _dicestack.Perturbation.from_json(text, "perturbation <dict>", world)
+    if isinstance(perturb, (str, os.PathLike)):
+        return _dicestack.Perturbation.load(os.fspath(perturb), world)
+    raise TypeError(f"perturb must be None, a level, a path, a dict or a Perturbation, got {type(perturb).__name__}")
+
+
+def perturbation_name(perturb):
+    """How reports name `perturb`: its level or file, "<dict>", or "none"."""
+    if perturb is None:
+        return "none"
+    if isinstance(perturb, (str, os.PathLike)):
+        return os.fspath(perturb)
+    return "<dict>" if isinstance(perturb, dict) else "<Perturbation>"
+
+
 def default_world():
     """The paper's world as a dict in `dicestack config`'s format: edit it and pass it as `world`."""
     return json.loads(_dicestack.WorldConfig().to_json())

@@ -1,10 +1,12 @@
 """DiceStackEnv: the dice-stacking world under the Gymnasium API (a gymnasium.Env when gymnasium
 is importable). Stepping, rendering and snapshots run in C++ (_dicestack.Env)."""
+import json
+
 import numpy as np
 
 from . import _dicestack
 from ._spaces import box, gymnasium
-from ._world import resolve_world, world_dict
+from ._world import resolve_perturbation, resolve_world, world_dict
 
 
 def check_seed(seed):
@@ -69,15 +71,22 @@ class DiceStackEnv(_EnvBase):
     Seeding follows Gymnasium: reset(seed=s) starts from dicestack's random start s (the same as
     DiceEnv::reset(s) in C++); reset() without a seed continues a stream derived from the last
     seed. options={"state": 24 numbers} starts from a given state instead.
+
+    perturb (issue 25; docs/robustness.md): None, a level ("easy", "medium", "hard"), a
+    perturbation file or a dict of its fields. Each episode then runs in the world drawn from its
+    seed (frictions, masses, gravity, wider starts), its observations arrive late and noisy and
+    its actions late, biased and noisy, exactly as `dicestack evaluate --perturb` runs it.
+    options={"perturb": ...} perturbs that one episode instead. info["perturbation"] (at reset)
+    holds the values drawn; `state` stays the true state.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
-    def __init__(self, world=None, render_mode=None):
+    def __init__(self, world=None, render_mode=None, perturb=None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         self._world = resolve_world(world)
-        self._env = _dicestack.Env(self._world)
+        self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world))
         self.render_mode = render_mode
         self.metadata = dict(type(self).metadata, render_fps=int(round(1.0 / self._world.control_dt)))
         self.observation_space = box(*self._env.observation_bounds())
@@ -86,13 +95,18 @@ class DiceStackEnv(_EnvBase):
     def reset(self, *, seed=None, options=None):
         seed = check_seed(seed)
         super().reset(seed=seed)  # seeds self.np_random as Gymnasium expects; episodes use dicestack's seeds
-        state = None
+        state = perturbation = None
         if options:
-            unknown = set(options) - {"state"}
+            unknown = set(options) - {"state", "perturb"}
             if unknown:
-                raise ValueError(f"unknown reset option(s) {sorted(unknown)}; the one option is 'state'")
+                raise ValueError(f"unknown reset option(s) {sorted(unknown)}; the options are 'state' and 'perturb'")
             state = options.get("state")
-        return self._env.reset(seed, state)
+            if "perturb" in options:
+                perturbation = resolve_perturbation(options["perturb"], self._world)
+        obs, info = self._env.reset(seed, state, perturbation)
+        if self._env.perturbed:
+            info["perturbation"] = json.loads(self._env.draw)
+        return obs, info
 
     def step(self, action):
         return self._env.step(action)

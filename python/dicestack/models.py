@@ -7,7 +7,7 @@ import os
 
 from . import _dicestack
 from ._progress import progress_bar
-from ._world import resolve_world
+from ._world import perturbation_name, resolve_perturbation, resolve_world
 from .demos import Episode, _records
 
 Model = _dicestack.Model
@@ -93,24 +93,29 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
 
 
 def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None, initial_push="none",
-             progress=None):
+             perturb=None, progress=None):
     """Rolls `model` out from `episodes` random starts, as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
-    given). The result does not depend on `threads`. progress: a progress bar on stderr (None:
-    when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt."""
+    given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
+    a perturbation file or a dict of its fields; docs/robustness.md). progress: a progress bar on
+    stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt."""
     if not isinstance(model, Model):
         raise TypeError(f"model must be a dicestack.Model, got {type(model).__name__}")
+    w = resolve_world(world)
+    perturbation = resolve_perturbation(perturb, w)
     return json.loads(
         _dicestack.evaluate(
             model,
-            resolve_world(world),
+            w,
             episodes,
             seed,
             threads,
             initial_push,
             None if demos is None else _demos_argument(demos),
             progress_bar(progress),
+            perturbation,
+            perturbation_name(perturb),
         )
     )
 

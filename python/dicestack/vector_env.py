@@ -4,7 +4,7 @@ import numbers
 
 from . import _dicestack
 from ._spaces import batch, box, gymnasium
-from ._world import resolve_world, world_dict
+from ._world import resolve_perturbation, resolve_world, world_dict
 from .env import check_seed
 
 if gymnasium is not None:
@@ -29,6 +29,8 @@ class DiceStackVectorEnv(_VectorBase):
     Autoreset is Gymnasium 1.x's "next-step" mode: after an environment's episode ends, its
     next step() ignores its action, resets it (no seed: the next seed of its stream) and returns
     the first observation with reward 0 and terminated = truncated = False.
+
+    perturb: as DiceStackEnv's; each environment draws its own world from its own episode seed.
     """
 
     metadata = {"render_modes": [], "autoreset_mode": _NEXT_STEP}
@@ -36,12 +38,12 @@ class DiceStackVectorEnv(_VectorBase):
     spec = None
     closed = False
 
-    def __init__(self, num_envs, world=None, threads=None):
+    def __init__(self, num_envs, world=None, threads=None, perturb=None):
         if isinstance(num_envs, bool) or not isinstance(num_envs, numbers.Integral) or num_envs < 1:
             raise ValueError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
         self.num_envs = int(num_envs)
         self._world = resolve_world(world)
-        self._vec = _dicestack.VectorEnv(self._world, self.num_envs, threads)
+        self._vec = _dicestack.VectorEnv(self._world, self.num_envs, threads, resolve_perturbation(perturb, self._world))
         probe = _dicestack.Env(self._world)
         obs_low, obs_high = probe.observation_bounds()
         act_low, act_high = probe.action_bounds()

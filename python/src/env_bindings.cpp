@@ -29,10 +29,16 @@ struct Snapshot {
 constexpr int kSnapshotPickleVersion = 1;
 
 Snapshot take_snapshot(EnvCore& core) {
+  if (core.channelled())
+    throw py::value_error("snapshot: this episode's actions or observations are perturbed; their delays and noise are "
+                          "not in a snapshot, so it could not continue bit for bit");
   return {core.env().snapshot(), core.world_hash(), core.episode_seed(), core.seeds().base(), core.seeds().count()};
 }
 
 void restore_snapshot(EnvCore& core, const Snapshot& s) {
+  if (core.channelled())
+    throw py::value_error("restore: this episode's actions or observations are perturbed (delays and noise are not in a "
+                          "snapshot); restore into an environment without actuation or sensing perturbations");
   if (s.world_hash != core.world_hash())
     throw py::value_error("snapshot was taken in another world (world config hash " + std::to_string(s.world_hash) +
                           ", this environment's " + std::to_string(core.world_hash()) + ")");
@@ -175,11 +181,12 @@ class BatchArrays {
 /// terminated = truncated = False.
 class VectorEnv {
  public:
-  VectorEnv(const WorldConfig& world, int num_envs, int threads)
+  VectorEnv(const WorldConfig& world, int num_envs, int threads, const Perturbation& perturbation)
       : pool_(std::min(resolve_threads(threads), std::max(num_envs, 1))) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
     envs_.reserve(static_cast<std::size_t>(num_envs));
-    for (int i = 0; i < num_envs; ++i) envs_.emplace_back(world);
+    validate(perturbation, world);
+    for (int i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation);
     done_.assign(envs_.size(), 0);
     slots_.resize(envs_.size());
   }
@@ -304,16 +311,34 @@ void bind_env(py::module_& m) {
       .def_property_readonly("world_hash", [](const Snapshot& s) { return s.world_hash; })
       .def(py::pickle(&snapshot_state, &snapshot_from_state));
 
+  py::class_<Perturbation>(m, "Perturbation", "How far each factor of a perturbed world may go (docs/robustness.md)")
+      .def(py::init<>())
+      .def_static(
+          "load", [](const std::string& level_or_file, const WorldConfig& world) { return load_perturbation(level_or_file, world); },
+          py::arg("level_or_file"), py::arg("world"))
+      .def_static(
+          "from_json",
+          [](const std::string& text, const std::string& source, const WorldConfig& world) {
+            return perturbation_from_json(text, source, world);
+          },
+          py::arg("text"), py::arg("source"), py::arg("world"))
+      .def("to_json", [](const Perturbation& p) { return perturbation_to_json(p); })
+      .def_property_readonly("nominal", &Perturbation::nominal);
+
   py::class_<EnvCore>(m, "Env", "One dice-stacking environment (the core of dicestack.DiceStackEnv)")
-      .def(py::init<const WorldConfig&>(), py::arg("world"))
+      .def(py::init<const WorldConfig&, const Perturbation&>(), py::arg("world"), py::arg("perturbation") = Perturbation{})
       .def(
           "reset",
-          [](EnvCore& core, const py::object& seed, const py::object& state) {
+          [](EnvCore& core, const py::object& seed, const py::object& state, const std::optional<Perturbation>& p) {
             const auto s = seed_from(seed);
-            const State obs = state.is_none() ? core.reset(s) : core.reset_to(state_from(state, "options[\"state\"]"), s);
+            const Perturbation* override = p ? &*p : nullptr;
+            const State obs = state.is_none() ? core.reset(s, override)
+                                              : core.reset_to(state_from(state, "options[\"state\"]"), s, override);
             return py::make_tuple(to_array(obs), info_dict(core.info()));
           },
-          py::arg("seed") = py::none(), py::arg("state") = py::none())
+          py::arg("seed") = py::none(), py::arg("state") = py::none(), py::arg("perturbation") = py::none())
+      .def_property_readonly("draw", [](const EnvCore& c) { return draw_to_json(c.draw()); })
+      .def_property_readonly("perturbed", [](const EnvCore& c) { return c.draw().physics || c.draw().acts; })
       .def("step", [](EnvCore& core, const py::handle& action) { return step_tuple(core.step(action_from(action))); },
            py::arg("action"))
       .def("snapshot", &take_snapshot)
@@ -329,10 +354,10 @@ void bind_env(py::module_& m) {
       .def_property_readonly("episode_seed", &EnvCore::episode_seed);
 
   py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
-      .def(py::init([](const WorldConfig& world, int num_envs, const py::object& threads) {
-             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads));
+      .def(py::init([](const WorldConfig& world, int num_envs, const py::object& threads, const Perturbation& perturbation) {
+             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation);
            }),
-           py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none())
+           py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none(), py::arg("perturbation") = Perturbation{})
       .def("__len__", &VectorEnv::size)
       .def(
           "reset",

@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <optional>
 
+#include <memory>
+
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/perturbation.hpp>
 
 namespace dicestack::python {
 
@@ -26,23 +29,31 @@ class EpisodeSeeds {
   std::uint64_t count_ = 0;
 };
 
-/// A DiceEnv with its seed stream and what the Python info dict reports.
+/// A DiceEnv with its seed stream and what the Python info dict reports. Under a perturbation
+/// (issue 25) each episode runs in the world drawn from its seed, and observations and actions
+/// pass through the draw's PerturbedChannel, as in rollout(): the same episodes as C++.
 class EnvCore {
  public:
-  explicit EnvCore(const WorldConfig& world);
+  explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {});
 
-  /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds.
-  State reset(std::optional<std::uint64_t> seed);
+  /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds, under
+  /// `perturbation` if given (this episode only), else the environment's own.
+  State reset(std::optional<std::uint64_t> seed, const Perturbation* perturbation = nullptr);
   /// Starts an episode from a bare state; `seed` (per EpisodeSeeds) seeds the action noise.
-  State reset_to(const State& state, std::optional<std::uint64_t> seed);
+  State reset_to(const State& state, std::optional<std::uint64_t> seed, const Perturbation* perturbation = nullptr);
   /// One control step. Throws std::logic_error before the first reset (Gymnasium's order).
   StepResult step(const Action& action);
+  /// What the current episode drew (nominal: the world unchanged, nothing else).
+  const PerturbationDraw& draw() const { return draw_; }
+  /// True when the current episode's actuation or sensing is perturbed (its delays and noise
+  /// stream are not in a snapshot).
+  bool channelled() const { return channel_.has_value(); }
 
   /// The info of the episode's latest state (what reset reports; step's own is in StepResult).
   StepInfo info() const;
 
-  DiceEnv& env() { return env_; }
-  const DiceEnv& env() const { return env_; }
+  DiceEnv& env() { return *env_; }
+  const DiceEnv& env() const { return *env_; }
   std::uint64_t world_hash() const { return world_hash_; }
   /// The seed of the current episode (0 before the first reset).
   std::uint64_t episode_seed() const { return episode_seed_; }
@@ -54,9 +65,17 @@ class EnvCore {
   void restored(std::uint64_t episode_seed);
 
  private:
-  DiceEnv env_;
+  // Draws the new episode's perturbation and makes its world.
+  void begin(const Perturbation* perturbation);
+  State observed(const State& s) { return channel_ ? channel_->observe(s) : s; }
+
+  WorldConfig world_;  // the nominal world
+  Perturbation perturbation_;
+  std::unique_ptr<DiceEnv> env_;
   State goal_;
-  std::uint64_t world_hash_;
+  std::uint64_t nominal_hash_, world_hash_;
+  PerturbationDraw draw_;
+  std::optional<PerturbedChannel> channel_;
   EpisodeSeeds seeds_;
   std::uint64_t episode_seed_ = 0;
   std::uint64_t episodes_ = 0;

@@ -159,9 +159,11 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
 }
 
 std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episodes, const py::handle& seed,
-                           const py::handle& threads, const std::string& push, const py::handle& demos, py::object bar) {
+                           const py::handle& threads, const std::string& push, const py::handle& demos, py::object bar,
+                           const Perturbation& perturbation, const std::string& perturb) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
-  const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push};
+  const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push,
+                          perturbation.nominal() ? "none" : perturb};
   const InitialPush initial_push = initial_push_from(push);
   const int t = threads_from(threads);
   std::optional<std::vector<Episode>> demo_episodes;
@@ -169,11 +171,16 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   std::shared_ptr<const Model> model = m.model;
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
-  const EvalStats stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, episodes, run.seed, t,
-                                   initial_push, nullptr, [&](int finished, int of) {
-                                     call.poll(static_cast<double>(finished) / of,
-                                               "evaluate: " + std::to_string(finished) + "/" + std::to_string(of) + " rollouts");
-                                   });
+  EvalRequest request;
+  request.episodes = episodes;
+  request.seed = run.seed;
+  request.threads = t;
+  request.push = initial_push;
+  request.perturbation = perturbation;
+  request.progress = [&](int finished, int of) {
+    call.poll(static_cast<double>(finished) / of, "evaluate: " + std::to_string(finished) + "/" + std::to_string(of) + " rollouts");
+  };
+  const EvalStats stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request);
   std::optional<Score> errors;
   if (demo_episodes) errors = score(*model, DemoSplit(*demo_episodes, "episodes"));
   return evaluation_json(run, *model, stats, errors ? &*errors : nullptr);
@@ -273,7 +280,8 @@ void bind_models(py::module_& m) {
         py::arg("options"), py::arg("features"), py::arg("split"), py::arg("seed"), py::arg("threads"), py::arg("out"),
         py::arg("bar"));
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
-        py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"));
+        py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"),
+        py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none");
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),

@@ -62,7 +62,8 @@ py::dict keyword_arguments(const Params& params, const std::vector<ParamSpec>& s
       case ParamType::integer: kwargs[key] = params.integer(spec.name); break;
       case ParamType::real: kwargs[key] = params.real(spec.name); break;
       case ParamType::boolean: kwargs[key] = params.boolean(spec.name); break;
-      case ParamType::choice: kwargs[key] = params.choice(spec.name); break;
+      case ParamType::choice:
+      case ParamType::text: kwargs[key] = params.choice(spec.name); break;
     }
   }
   return kwargs;

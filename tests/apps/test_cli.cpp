@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <algorithm>
 #include <sstream>
 #include <string>
@@ -16,6 +17,7 @@
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/hash.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/version.hpp>
 
 #include <dicestack/test/helpers.hpp>
@@ -549,6 +551,95 @@ TEST(CliSafeOutputs, TrainRefusesAUsersTextFile) {
   std::getline(in, text);
   EXPECT_EQ(text, "my notes");
   std::filesystem::remove_all(root);
+}
+
+// The bytes of every file under `root`, by relative path.
+std::map<std::string, std::string> tree_bytes(const std::filesystem::path& root) {
+  std::map<std::string, std::string> out;
+  for (const auto& f : std::filesystem::recursive_directory_iterator(root)) {
+    if (!f.is_regular_file()) continue;
+    std::ifstream in(f.path(), std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    out[std::filesystem::relative(f.path(), root).string()] = text.str();
+  }
+  return out;
+}
+
+TEST(CliPerturb, NoneChangesNoByteAndBadPerturbationsAreRefusedBeforeAnyWork) {
+  const auto model = test::scratch_path("dicestack_cli_perturb.dsm");
+  const auto world = test::scratch_path("dicestack_cli_perturb_world.json");
+  const auto a = test::scratch_path("dicestack_cli_perturb_a"), b = test::scratch_path("dicestack_cli_perturb_b");
+  std::ofstream(world) << to_json(test::short_world(40));
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + model.string()).status, 0);
+  const std::string eval = "evaluate --model " + model.string() + " --world " + world.string() + " --episodes 2 ";
+  Process p = run(eval + "--save-rollouts " + a.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  p = run(eval + "--perturb none --save-rollouts " + b.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(tree_bytes(a), tree_bytes(b));
+  std::filesystem::remove_all(b);
+  p = run(eval + "--perturb hard --save-rollouts " + b.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("perturbed: hard"));
+  EXPECT_NE(tree_bytes(a), tree_bytes(b));
+  const auto meta = nlohmann::json::parse(tree_bytes(b).at("meta.json"));
+  EXPECT_EQ(meta["version"], 3) << "the values drawn are saved";
+  EXPECT_EQ(meta["episodes"][0]["perturbation"]["action_delay"], 6);
+  EXPECT_THAT(meta["provenance"].get<std::string>(), HasSubstr("--perturb hard"));
+  std::filesystem::remove_all(b);
+  p = run("record --expert scripted --episodes 2 --world " + world.string() + " --perturb easy --out " + b.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  const auto recorded = nlohmann::json::parse(tree_bytes(b).at("meta.json"));
+  EXPECT_EQ(recorded["episodes"][1]["perturbation"]["action_delay"], 1);
+  EXPECT_THAT(recorded["provenance"].get<std::string>(), HasSubstr("domain randomisation"));
+  std::filesystem::remove_all(b);
+  p = run(eval + "--perturb extreme --save-rollouts " + b.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("none, easy, medium, hard"));
+  const auto file = test::scratch_path("dicestack_cli_perturb.json");
+  std::ofstream(file) << R"({"format": "dicestack-perturbation", "version": 1, "action_delay": 40})";
+  p = run(eval + "--perturb " + file.string() + " --save-rollouts " + b.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("\"action_delay\""));
+  EXPECT_FALSE(std::filesystem::exists(b)) << "refused before any work";
+  std::filesystem::remove_all(a);
+  std::filesystem::remove(file);
+  std::filesystem::remove(world);
+  std::filesystem::remove(model);
+}
+
+TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable) {
+  const auto model = test::scratch_path("dicestack_cli_robust.dsm");
+  const auto world = test::scratch_path("dicestack_cli_robust_world.json");
+  const auto out = test::scratch_path("dicestack_cli_robust.csv");
+  std::ofstream(world) << to_json(test::short_world(20));
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + model.string()).status, 0);
+  const std::string cmd = "robustness --model " + model.string() + " --world " + world.string() + " --episodes 2 ";
+  Process p = run(cmd + "--format csv --out " + out.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  std::ifstream in(out);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) ++lines;
+  EXPECT_EQ(lines, 1 + 1 + 3 * static_cast<int>(perturbation_factors().size()) + 3) << "header, none, factors, all";
+  EXPECT_EQ(run(cmd + "--format csv --out " + out.string()).status, 0) << "its own table is replaced";
+  p = run(cmd + "--format json", false);
+  ASSERT_EQ(p.status, 0);
+  EXPECT_EQ(nlohmann::json::parse(p.output)["format"], "dicestack-robustness");
+  std::ofstream(out) << "my notes\n";
+  p = run(cmd + "--format csv --out " + out.string());
+  EXPECT_EQ(p.status, 1);
+  std::ifstream mine(out);
+  std::getline(mine, line);
+  EXPECT_EQ(line, "my notes");
+  p = run("robustness --expert nobody --world " + world.string() + " --episodes 2");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("nobody"));
+  EXPECT_NE(run("robustness --world " + world.string()).status, 0) << "a model or an expert";
+  std::filesystem::remove(out);
+  std::filesystem::remove(world);
+  std::filesystem::remove(model);
 }
 
 }  // namespace

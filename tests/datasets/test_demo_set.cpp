@@ -154,6 +154,30 @@ TEST(DemoSet, VersionTwoKeepsTransitionsAndVersionOneReadsWithoutThem) {
   fs::remove_all(old);
 }
 
+// Format v3: an episode's perturbation (the values its world drew) travels with it; a set
+// without one is still written as version 2, byte for byte.
+TEST(DemoSet, VersionThreeKeepsPerturbationsAndNominalSetsStayVersionTwo) {
+  DemoSet set = read_demo_set(kData / "good");
+  const fs::path dir = test::scratch_path("dicestack_demo_v3");
+  fs::remove_all(dir);
+  write_demo_set(set, dir);
+  EXPECT_EQ(parse_demo_meta(slurp(dir / "meta.json"), "m.json").version, 2);
+  fs::remove_all(dir);
+  set.episodes[1].perturbation = R"({"action_delay":3,"dice_mass":0.05})";
+  write_demo_set(set, dir);
+  EXPECT_EQ(parse_demo_meta(slurp(dir / "meta.json"), "m.json").version, 3);
+  const DemoSet back = read_demo_set(dir);
+  EXPECT_TRUE(back.episodes[0].perturbation.empty());
+  EXPECT_EQ(back.episodes[1].perturbation, set.episodes[1].perturbation);
+  std::string meta = slurp(dir / "meta.json");
+  const auto at = meta.find("\"perturbation\": {");
+  ASSERT_NE(at, std::string::npos);
+  std::ofstream(dir / "meta.json", std::ios::binary) << meta.substr(0, at) + "\"perturbation\": 7, \"ignored\": {" +
+                                                             meta.substr(at + 17);
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }), HasSubstr("\"perturbation\" of episode_0001.csv must be an object"));
+  fs::remove_all(dir);
+}
+
 TEST(DemoSet, AppendAddsEpisodesAndKeepsTheOldOnes) {
   const fs::path dir = test::scratch_path("dicestack_demo_append");
   fs::remove_all(dir);
@@ -203,7 +227,7 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("missing_file"), HasSubstr("meta.json: lists episode_0009.csv, which does not exist"));
   EXPECT_THAT(read_error("extra_file"), HasSubstr("episode_0002.csv: not listed in meta.json"));
   EXPECT_THAT(read_error("newer_version"),
-              HasSubstr("meta.json: format version 3 is newer than this dicestack reads (2); upgrade dicestack"));
+              HasSubstr("meta.json: format version 4 is newer than this dicestack reads (3); upgrade dicestack"));
   EXPECT_THAT(read_error("wrong_format"), HasSubstr("format \"robomimic\" is not dicestack-demos"));
   EXPECT_THAT(read_error("steps_mismatch"), HasSubstr("says episode_0000.csv has 7 steps; the file has 4"));
   EXPECT_THAT(read_error("no_meta"), HasSubstr("meta.json: missing; not a dicestack demonstration folder"));

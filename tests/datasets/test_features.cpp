@@ -51,6 +51,18 @@ TEST(Features, StartStateCarriesTheWholeStart) {
   EXPECT_EQ(m.column_names()[25], "start_cup_x");
 }
 
+TEST(Features, OpenLoopSeesTheClockAndTheStartButNeverTheCurrentState) {
+  const FeatureMap& m = feature_map("clock+start_state");
+  ASSERT_EQ(m.width(), 25u);
+  const std::vector<State> a{numbered(100), numbered(200)}, b{numbered(100), numbered(900)};
+  const auto row = row_of(m, History{a, {}});
+  EXPECT_EQ(row, row_of(m, History{b, {}})) << "the current state changes nothing";
+  EXPECT_EQ(row[0], 1.0);
+  for (std::size_t j = 0; j < kStateDim; ++j) EXPECT_EQ(row[1 + j], 100.0 + static_cast<double>(j));
+  EXPECT_EQ(m.column_names()[0], "t");
+  EXPECT_EQ(m.column_names()[1], "start_cup_x");
+}
+
 TEST(Features, HistoryRepeatsTheStartAtStepZero) {
   const FeatureMap& m = feature_map("state+history");
   ASSERT_EQ(m.width(), 48u);

@@ -18,6 +18,7 @@
 
 #include <dicestack/test/episodes.hpp>
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/requests.hpp>
 
 namespace dicestack {
 namespace {
@@ -53,7 +54,7 @@ DemoSet small_set() {
   }
   WorldConfig w = set.world;
   w.episode.max_steps = 40;
-  for (auto e : record_expert("scripted", {}, w, 4, 3, 1)) {
+  for (auto e : record_expert("scripted", {}, w, test::record_request(4, 3, 1))) {
     e.name = "recorded_" + std::to_string(set.episodes.size());
     set.episodes.push_back(std::move(e));
   }

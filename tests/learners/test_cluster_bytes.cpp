@@ -7,13 +7,14 @@
 #include <dicestack/regressors/model.hpp>
 #include <dicestack/test/episodes.hpp>
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/requests.hpp>
 
 namespace dicestack {
 namespace {
 
 // What travels between ranks must come back bit for bit, or results would change with the rank count.
 TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
-  auto eps = record_expert("scripted", {}, test::short_world(40), 2, 11, 1);
+  auto eps = record_expert("scripted", {}, test::short_world(40), test::record_request(2, 11, 1));
   eps[1].final_state.reset();
   eps[1].rewards.clear();
   eps[1].name = "episode_0001";
@@ -28,7 +29,7 @@ TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
 TEST(ClusterBytes, ModelBytesRoundTripForEveryRegressor) {
   LearnContext c;
   c.world = test::short_world(40);
-  c.demos = record_expert("scripted", {}, c.world, 2, 3, 1);
+  c.demos = record_expert("scripted", {}, c.world, test::record_request(2, 3, 1));
   for (const std::string& name : RegressorRegistry::global().names()) {
     c.regressor = name;
     c.regressor_sets = name == "mlp" ? std::vector<std::string>{"layers=2", "width=8"} : std::vector<std::string>{};

@@ -13,13 +13,14 @@
 #include <dicestack/learners/record.hpp>
 
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/requests.hpp>
 
 namespace dicestack {
 namespace {
 
 // Scripted-expert episodes of 60 steps: demonstrations the world replays bit for bit.
 const std::vector<Episode>& demos() {
-  static const std::vector<Episode> d = record_expert("scripted", {}, test::short_world(), 3, 5, 1);
+  static const std::vector<Episode> d = record_expert("scripted", {}, test::short_world(), test::record_request(3, 5, 1));
   return d;
 }
 

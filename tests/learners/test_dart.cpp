@@ -12,6 +12,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 
+#include <dicestack/test/requests.hpp>
 #include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
@@ -29,9 +30,9 @@ TEST(Starts, TrainingAndEvaluationStreamsShareNoStart) {
     for (std::uint64_t i = 0; i < 500; ++i) ASSERT_FALSE(evaluation.contains(training_start_seed(s, i))) << s << " " << i;
   // And the starts themselves: record --seed 0 against evaluate --seed 0.
   const WorldConfig w = test::short_world();
-  const auto recorded = record_expert("scripted", {}, w, 5, 0, 1);
+  const auto recorded = record_expert("scripted", {}, w, test::record_request(5, 0, 1));
   std::vector<Episode> evaluated;
-  evaluate([] { return std::make_unique<PlaybackPolicy>(Episode{}); }, w, 5, 0, 1, InitialPush::none, &evaluated);
+  evaluate([] { return std::make_unique<PlaybackPolicy>(Episode{}); }, w, test::eval_request(5, 0, 1, &evaluated));
   for (const auto& r : recorded)
     for (const auto& e : evaluated) EXPECT_NE(r.states.front(), e.states.front());
 }
@@ -110,6 +111,42 @@ TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
   EXPECT_EQ(LearnerRegistry::global().info("dart").default_features, "state+clock+start_state");
 }
 
+TEST(Dart, TrainsUnderRandomisedWorldsOnAnyThreadCount) {
+  LearnContext c;
+  c.world = test::short_world();
+  c.regressor = "knn";
+  c.features = "state+clock+start";
+  c.seed = 5;
+  c.threads = 1;
+  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false", "perturb=medium"});
+  const LearnResult one = learner->learn(c);
+  c.threads = 2;
+  const LearnResult two = learner->learn(c);
+  EXPECT_EQ(one.model->regressor().save_payload(), two.model->regressor().save_payload());
+  EXPECT_EQ(one.model->record.at("perturb"), "medium");
+  const auto nominal = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false"})->learn(c);
+  EXPECT_NE(nominal.model->regressor().save_payload(), one.model->regressor().save_payload());
+  EXPECT_FALSE(nominal.model->record.contains("perturb"));
+  // A bad perturbation is refused before any episode, naming the option.
+  for (const char* learner_name : {"dart", "dagger"})
+    EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create(learner_name, {"perturb=extreme"})->learn(c); }),
+                HasSubstr(std::string(learner_name) + ": option perturb: "));
+}
+
+TEST(Dart, RecordedEpisodesUnderAPerturbationAreThreadIndependent) {
+  const WorldConfig w = test::short_world(40);
+  RecordRequest r = test::record_request(3, 8, 1);
+  r.perturbation = perturbation_level("hard");
+  const auto one = record_expert("scripted", {}, w, r);
+  r.threads = 2;
+  const auto two = record_expert("scripted", {}, w, r);
+  const auto nominal = record_expert("scripted", {}, w, test::record_request(3, 8, 2));
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states);
+    EXPECT_NE(one[i].states, nominal[i].states);
+  }
+}
+
 TEST(Dart, AModelFileAloneRollsOut) {
   // At evaluation only the regressor acts: the model is read back from its file, and the
   // rollout gets no expert, no simulation ahead and no snapshot (ModelPolicy sees a History).
@@ -123,8 +160,8 @@ TEST(Dart, AModelFileAloneRollsOut) {
   save_model(*learned.model, path);
   auto model = std::make_shared<const Model>(load_model(path));
   fs::remove(path);
-  const EvalStats a = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, c.world, 3, 0, 1);
-  const EvalStats b = evaluate([&] { return std::make_unique<ModelPolicy>(learned.model); }, c.world, 3, 0, 2);
+  const EvalStats a = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, c.world, test::eval_request(3, 0, 1));
+  const EvalStats b = evaluate([&] { return std::make_unique<ModelPolicy>(learned.model); }, c.world, test::eval_request(3, 0, 2));
   EXPECT_EQ(a.episodes, 3);
   EXPECT_EQ(a.dice_in_cup_mean, b.dice_in_cup_mean);
   EXPECT_EQ(a.mean_length, b.mean_length);
@@ -133,7 +170,7 @@ TEST(Dart, AModelFileAloneRollsOut) {
 TEST(Dad, RefusesAFeatureMapBeyondTheState) {
   LearnContext c;
   c.world = test::short_world();
-  c.demos = record_expert("scripted", {}, c.world, 2, 1, 1);
+  c.demos = record_expert("scripted", {}, c.world, test::record_request(2, 1, 1));
   c.features = "state+clock";
   const std::string error =
       test::error_of([&] { LearnerRegistry::global().create("dad", {"windows=1", "iterations=1"})->learn(c); });

@@ -10,6 +10,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/metrics.hpp>
 #include <dicestack/learners/baseline.hpp>
+#include <dicestack/test/requests.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/leaderboard.hpp>
 #include <dicestack/learners/profile.hpp>
@@ -100,7 +101,7 @@ TEST(Baselines, APolicyMadeWithATinyBudgetDependsOnItsSeedNotOnTheThreads) {
   tiny.reinforce_iterations = 1;
   auto actions_of = [&](const std::string& name, std::uint64_t seed, int threads) {
     std::vector<Episode> rollouts;
-    const EvalStats s = evaluate(baseline(name).make(world, tiny, seed, threads), world, 1, 0, 1, InitialPush::none, &rollouts);
+    const EvalStats s = evaluate(baseline(name).make(world, tiny, seed, threads), world, test::eval_request(1, 0, 1, &rollouts));
     EXPECT_EQ(s.episodes, 1) << name;
     return rollouts.at(0).actions;
   };

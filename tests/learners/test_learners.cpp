@@ -16,6 +16,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/core/expert.hpp>
 
+#include <dicestack/test/requests.hpp>
 #include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
@@ -51,8 +52,8 @@ TEST(Evaluate, ResultsDoNotDependOnThreadCount) {
   c.episode.max_steps = 60;
   std::vector<Episode> one, two;
   const auto make = [] { return std::make_unique<Swing>(); };
-  const EvalStats a = evaluate(make, c, 6, 3, 1, InitialPush::none, &one);
-  const EvalStats b = evaluate(make, c, 6, 3, 2, InitialPush::none, &two);
+  const EvalStats a = evaluate(make, c, test::eval_request(6, 3, 1, &one));
+  const EvalStats b = evaluate(make, c, test::eval_request(6, 3, 2, &two));
   ASSERT_EQ(one.size(), two.size());
   for (std::size_t i = 0; i < one.size(); ++i) {
     EXPECT_EQ(one[i].states, two[i].states) << "episode " << i;
@@ -66,7 +67,7 @@ TEST(Evaluate, RatesAgreeWithRollingOutByHand) {
   WorldConfig c;
   c.episode.max_steps = 80;
   std::vector<Episode> eps;
-  const EvalStats s = evaluate([] { return std::make_unique<Swing>(); }, c, 5, 9, 2, InitialPush::left, &eps);
+  const EvalStats s = evaluate([] { return std::make_unique<Swing>(); }, c, test::eval_request(5, 9, 2, &eps, InitialPush::left));
   int walls = 0;
   double cup = 0.0;
   DiceEnv env(c);
@@ -140,14 +141,14 @@ LearnContext small_context(int threads) {
 TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
   WorldConfig w;
   w.episode.max_steps = 80;
-  const auto a = record_expert("scripted", {}, w, 4, 3, 1), b = record_expert("scripted", {}, w, 4, 3, 2);
+  const auto a = record_expert("scripted", {}, w, test::record_request(4, 3, 1)), b = record_expert("scripted", {}, w, test::record_request(4, 3, 2));
   ASSERT_EQ(a.size(), 4u);
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].states, b[i].states);
     EXPECT_EQ(a[i].actions, b[i].actions);
     EXPECT_EQ(a[i].sources.front(), StepSource::expert);
   }
-  EXPECT_THROW(record_expert("nobody", {}, w, 1, 0, 1), ConfigError);
+  EXPECT_THROW(record_expert("nobody", {}, w, test::record_request(1, 0, 1)), ConfigError);
 }
 
 TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {

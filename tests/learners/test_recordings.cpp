@@ -16,6 +16,7 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 
+#include <dicestack/test/requests.hpp>
 #include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
@@ -96,7 +97,7 @@ TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
   auto model = std::make_shared<const Model>(load_model(path));
   fs::remove(path);
   const Forbidden none({"mpc", "scripted", "tracker"});
-  const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, test::short_world(), 3, 0, 2);
+  const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, test::short_world(), test::eval_request(3, 0, 2));
   EXPECT_EQ(s.episodes, 3);
 }
 
@@ -132,8 +133,8 @@ TEST(Tracker, RecordingThroughItDoesNotDependOnThreadsAndNamesItsExpert) {
   t.optimise = false;
   ExpertConfig config;
   config.recordings = make_recordings(human_six(), WorldConfig{}, t, 0, 2);
-  const auto one = record_expert("tracker", config, WorldConfig{}, 2, 4, 1);
-  const auto two = record_expert("tracker", config, WorldConfig{}, 2, 4, 2);
+  const auto one = record_expert("tracker", config, WorldConfig{}, test::record_request(2, 4, 1));
+  const auto two = record_expert("tracker", config, WorldConfig{}, test::record_request(2, 4, 2));
   ASSERT_EQ(one.size(), 2u);
   for (std::size_t i = 0; i < one.size(); ++i) {
     EXPECT_EQ(one[i].states, two[i].states);

@@ -8,6 +8,7 @@
 #include <dicestack/datasets/replay.hpp>
 #include <dicestack/learners/record.hpp>
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/requests.hpp>
 
 namespace dicestack {
 namespace {
@@ -15,7 +16,7 @@ namespace {
 TEST(Transitions, RolloutsRecordTheFinalStateRewardsAndEnd) {
   const WorldConfig w = test::short_world();
   const State goal = goal_state(w);
-  for (const Episode& e : record_expert("scripted", {}, w, 3, 4, 1)) {
+  for (const Episode& e : record_expert("scripted", {}, w, test::record_request(3, 4, 1))) {
     ASSERT_TRUE(e.has_transitions()) << e.name;
     ASSERT_EQ(e.rewards.size(), e.size());
     for (std::size_t t = 0; t < e.size(); ++t) {
@@ -29,7 +30,7 @@ TEST(Transitions, RolloutsRecordTheFinalStateRewardsAndEnd) {
 
 TEST(Transitions, VersionOneEpisodesAreRecoveredExactlyByReplay) {
   const WorldConfig w = test::short_world();
-  const auto recorded = record_expert("scripted", {}, w, 3, 9, 1);
+  const auto recorded = record_expert("scripted", {}, w, test::record_request(3, 9, 1));
   std::vector<Episode> v1 = recorded;
   for (auto& e : v1) e.clear_transitions();
   EXPECT_TRUE(recover_transitions(v1, w).empty());
@@ -44,7 +45,7 @@ TEST(Transitions, VersionOneEpisodesAreRecoveredExactlyByReplay) {
 TEST(Transitions, EpisodesThatDoNotReplayAreNamedAndLeftAlone) {
   const WorldConfig w = test::short_world();
   // DART: the world executed noisy actions, the file holds the clean labels.
-  auto noisy = record_expert("scripted", {}, w, 2, 1, 1, Action{0.3, 0.3, 0.3});
+  auto noisy = record_expert("scripted", {}, w, test::record_request(2, 1, 1, Action{0.3, 0.3, 0.3}));
   noisy[0].name = "noisy_0";
   noisy[1].name = "noisy_1";
   for (auto& e : noisy) e.clear_transitions();
@@ -52,7 +53,7 @@ TEST(Transitions, EpisodesThatDoNotReplayAreNamedAndLeftAlone) {
   EXPECT_FALSE(noisy[0].has_transitions());
   EXPECT_TRUE(noisy[0].rewards.empty());
   // One recorded state moved by more than the tolerance.
-  auto edited = record_expert("scripted", {}, w, 1, 2, 1);
+  auto edited = record_expert("scripted", {}, w, test::record_request(1, 2, 1));
   edited[0].clear_transitions();
   edited[0].states[5][state_index::kCupX] += 1e-6;
   EXPECT_FALSE(recover_transitions(edited[0], w));

@@ -19,6 +19,13 @@ namespace {
 namespace si = state_index;
 using detail::SwingPlan;
 
+// The simulator an expert plans in: a world like `env`'s, made again when an episode brings
+// another (a perturbed world, issue 25), so a plan never depends on which episode came first.
+DiceEnv& planning_sim(std::optional<DiceEnv>& sim, const DiceEnv& env) {
+  if (!sim || world_hash(sim->config()) != world_hash(env.config())) sim.emplace(env.config());
+  return *sim;
+}
+
 void require_config(bool ok, const char* field, const std::string& rule, double got) {
   if (!ok) throw ConfigError("expert config: field \"" + std::string(field) + "\" must be " + rule + ", got " +
                              std::to_string(got));
@@ -166,7 +173,7 @@ class MpcExpert final : public Expert {
   }
 
   void replan(const DiceEnv& env) {
-    if (!sim_) sim_.emplace(env.config());
+    planning_sim(sim_, env);
     const EnvSnapshot start = env.snapshot();
     const State s = env.get_state();
     const int t = env.t();
@@ -230,8 +237,7 @@ class TrackerExpert final : public Expert {
   Action do_act(const DiceEnv& env) override {
     const int t = env.t();
     if (!follower_.valid() || t < start_step_) {
-      if (!sim_) sim_.emplace(env.config());
-      choice_ = choose_path(*recordings_, env, *sim_, seed_);
+      choice_ = choose_path(*recordings_, env, planning_sim(sim_, env), seed_);
       start_step_ = t;
       follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, env.get_state(), t,
                                recordings_->config().gain);

@@ -59,6 +59,9 @@ Params::Value parse_value(const ParamSpec& spec, std::string_view text, std::str
         for (const auto& c : spec.choices) list += (list.empty() ? "" : ", ") + c;
         bad(owner, who + " must be one of " + list + ", got " + quoted);
       }
+    case ParamType::text:
+      if (text.empty()) bad(owner, who + " must not be empty");
+      return std::string(text);
   }
   bad(owner, who + " has an unknown type");
 }
@@ -78,6 +81,7 @@ std::string_view to_string(ParamType type) {
     case ParamType::real: return "real";
     case ParamType::boolean: return "boolean";
     case ParamType::choice: return "choice";
+    case ParamType::text: return "text";
   }
   return "unknown";
 }

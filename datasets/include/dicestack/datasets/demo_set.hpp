@@ -16,8 +16,10 @@ namespace dicestack {
 
 inline constexpr const char* kDemoFormat = "dicestack-demos";
 /// Version 2 adds each episode's final state, terminated and truncated (meta.json) and the
-/// reward of each step (a `reward` column); version 1 folders stay readable (docs/formats.md).
-inline constexpr int kDemoFormatVersion = 2;
+/// reward of each step (a `reward` column); version 3 each episode's perturbation (the values
+/// its perturbed world drew), written only by sets that hold one, so that nominal sets stay
+/// byte for byte version 2. Older folders stay readable (docs/formats.md).
+inline constexpr int kDemoFormatVersion = 3;
 /// Format marker of the JSON summaries the baselines (optimise, reinforce, rrt) write into a set.
 inline constexpr const char* kBaselineFormat = "dicestack-baseline";
 
@@ -59,11 +61,12 @@ struct DemoMetaEntry {
   std::optional<State> final_state;  ///< version 2's "final_state" (null or absent: unknown)
   bool terminated = false;           ///< version 2's "terminated"
   bool truncated = false;            ///< version 2's "truncated"
+  std::string perturbation;          ///< version 3's "perturbation" (a JSON object), or empty
 };
 
 /// What a set's meta.json says, checked on its own (no episode file is opened).
 struct DemoMeta {
-  int version = kDemoFormatVersion;  ///< the file's format version (1 or 2)
+  int version = kDemoFormatVersion;  ///< the file's format version (1, 2 or 3)
   WorldConfig world;
   std::string description;
   std::string provenance;

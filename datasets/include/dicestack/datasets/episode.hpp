@@ -37,6 +37,9 @@ struct Episode {
   std::vector<double> rewards;  ///< the environment's reward of each step (DiceEnv::step); T, or empty when unknown
   bool terminated = false;      ///< the last step ended the episode in success (DiceEnv's terminated)
   bool truncated = false;       ///< it ended otherwise: time limit, a cut rollout, a stopped recording
+  /// The values its perturbed world drew (draw_to_json, a JSON object; format v3), empty for the
+  /// nominal world.
+  std::string perturbation;
 
   std::size_t size() const { return states.size(); }
   /// True when final_state, rewards and the end flags are known (format v2's additions).

@@ -6,6 +6,7 @@
 
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/policy.hpp>
 
@@ -30,7 +31,16 @@ struct RolloutOptions {
   /// Called before each step's action is chosen, with the environment and the step index
   /// (DaD snapshots the world there). May be empty.
   std::function<void(const DiceEnv&, std::size_t)> before_step;
+  /// Actuation and sensing of a perturbed world (issue 25), or null: the policy sees each state
+  /// with the draw's observation noise and delay; what it chooses runs action_delay steps late,
+  /// plus the bias and per-step noise. The episode records the true states. The draw's physics
+  /// is the environment's own (made from draw.world).
+  const PerturbationDraw* perturbation = nullptr;
 };
+
+/// The environment an episode of `draw` runs in: `pooled` when its physics is the nominal one,
+/// else a world of its own, made in `own`.
+DiceEnv& episode_env(const PerturbationDraw& draw, DiceEnv& pooled, std::optional<DiceEnv>& own);
 
 /// The one rollout loop. Runs `policy` from `start` until termination, the time limit or
 /// options.max_steps, and records the episode: the state before each action, the outcome, and
@@ -75,15 +85,30 @@ using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
 /// several at once. An exception it throws stops the evaluation and is rethrown.
 using RolloutProgress = std::function<void(int finished, int total)>;
 
-/// Rolls a policy out from `episodes` random starts (evaluation_start_seed(seed, i)), in parallel
-/// on `threads` threads with one world each; the result does not depend on the thread count.
+/// What an evaluation runs: the shape of a training request, so that a new perturbation is one
+/// field.
+struct EvalRequest {
+  int episodes = 100;
+  std::uint64_t seed = 0;  ///< starts: evaluation_start_seed(seed, i)
+  int threads = 0;         ///< 0: every core
+  InitialPush push = InitialPush::none;
+  /// Drawn per episode from its seed (draw_perturbation); nominal: today's world, byte for byte.
+  Perturbation perturbation;
+  std::size_t max_steps = 0;  ///< 0: the world's time limit
+  std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
+  RolloutProgress progress;
+};
+
+/// Rolls a policy out from request.episodes random starts (evaluation_start_seed(seed, i), in
+/// the episode's perturbed world), in parallel on `threads` threads with one world each; the
+/// result does not depend on the thread count.
 /// Collective over `cluster`: the rollouts are dealt round-robin among its ranks and gathered
 /// in index order, so every rank gets the same result for any number of ranks (timings aside:
 /// policy_us_per_step sums every rank's policy time, seconds is this rank's wall time).
-/// `progress` counts this rank's rollouts, scaled to the whole.
-EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, int episodes, std::uint64_t seed,
-                   int threads, InitialPush push = InitialPush::none, std::vector<Episode>* rollouts = nullptr,
-                   const RolloutProgress& progress = {}, Cluster& cluster = local_cluster());
+/// `progress` counts this rank's rollouts, scaled to the whole. Throws ConfigError for a
+/// perturbation the world cannot take (validate), before any rollout.
+EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,
+                   Cluster& cluster = local_cluster());
 
 /// Replays every demonstration's actions from its own first state (paper VI-A). Collective over
 /// `cluster`, like evaluate.

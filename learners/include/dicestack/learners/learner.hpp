@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <dicestack/core/cluster.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/core/world_config.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/regressors/model.hpp>
@@ -122,5 +123,11 @@ LearnerSpec parse_learner_spec(std::string_view text, const LearnerRegistry& reg
 /// behaviour cloning's one step. Collective over context.cluster: the root fits, the others
 /// receive its model file's bytes (so every rank acts with the very same model).
 std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed);
+
+/// The `perturb` option of the learners that record episodes (DART, DAgger): domain
+/// randomisation, each training episode in its own world drawn from its seed (LEVEL or FILE).
+ParamSpec perturb_param_spec();
+/// That option's perturbation, checked against `world`; throws ConfigError naming the option.
+Perturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner);
 
 }  // namespace dicestack

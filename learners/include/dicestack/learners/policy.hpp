@@ -30,6 +30,9 @@ class Policy {
  public:
   virtual ~Policy() = default;
   virtual void reset(std::uint64_t seed) { (void)seed; }
+  /// The environment the next episode runs in, before reset (rollout calls it): a policy that
+  /// simulates, an expert, reads it; the others ignore it.
+  virtual void attach(const DiceEnv& env) { (void)env; }
   virtual Action act(const History& history) = 0;
   virtual std::string name() const = 0;
   /// The label of the step `act` just chose, if it differs from the action (default: none).
@@ -64,14 +67,31 @@ class PlaybackPolicy final : public Policy {
 /// An automatic expert acting in `env` (which must be the environment the rollout steps).
 class ExpertPolicy final : public Policy {
  public:
-  ExpertPolicy(Expert& expert, const DiceEnv& env) : expert_(expert), env_(env) {}
+  /// Acts in `env` until rollout attaches another.
+  ExpertPolicy(Expert& expert, const DiceEnv& env) : expert_(expert), env_(&env) {}
+  void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_.reset(seed); }
-  Action act(const History&) override { return expert_.act(env_); }
+  Action act(const History&) override { return expert_.act(*env_); }
   std::string name() const override { return "expert " + expert_.name(); }
 
  private:
   Expert& expert_;
-  const DiceEnv& env_;
+  const DiceEnv* env_;
+};
+
+/// An expert of its own, acting in whichever environment rollout attaches (evaluation of an
+/// expert, the robustness table). It reads the world itself, not the observations.
+class OwnedExpertPolicy final : public Policy {
+ public:
+  explicit OwnedExpertPolicy(std::unique_ptr<Expert> expert) : expert_(std::move(expert)) {}
+  void attach(const DiceEnv& env) override { env_ = &env; }
+  void reset(std::uint64_t seed) override { expert_->reset(seed); }
+  Action act(const History&) override { return expert_->act(*env_); }
+  std::string name() const override { return "expert " + expert_->name(); }
+
+ private:
+  std::unique_ptr<Expert> expert_;
+  const DiceEnv* env_ = nullptr;
 };
 
 }  // namespace dicestack

@@ -6,21 +6,32 @@
 
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/expert.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
 namespace dicestack {
 
-/// Runs expert `name` from `episodes` random starts (episode i from
-/// random_start_state(world, training_start_seed(seed, i))), in parallel with one world and one
-/// expert per thread. With `noise` (per action dimension, a fraction of world.action.scale) the
-/// executed actions are perturbed as DART does and the expert's clean actions are recorded.
-/// Returns every episode, successes and failures, each with its outcome; the result does not
-/// depend on the thread count. Throws ConfigError for an unknown expert or a negative noise.
-/// Collective over `cluster`: episodes dealt round-robin among its ranks, every rank gets all of
-/// them in index order, the same for any number of ranks.
+/// What record_expert runs.
+struct RecordRequest {
+  int episodes = 0;
+  std::uint64_t seed = 0;  ///< episode i starts from random_start_state(world, training_start_seed(seed, i))
+  int threads = 0;         ///< 0: every core; the result does not depend on it
+  /// DART's noise: per action dimension, a fraction of world.action.scale; the executed actions
+  /// are perturbed and the expert's clean actions recorded.
+  Action noise{0.0, 0.0, 0.0};
+  /// Domain randomisation: each episode runs in its own draw (draw_perturbation from its seed);
+  /// nominal: today's recordings, byte for byte.
+  Perturbation perturbation;
+};
+
+/// Runs expert `name` from request.episodes random starts, in parallel with one world and one
+/// expert per thread. Returns every episode, successes and failures, each with its outcome (and,
+/// when perturbed, the values drawn). Throws ConfigError for an unknown expert, a negative noise
+/// or a perturbation the world cannot take, before any episode. Collective over `cluster`:
+/// episodes dealt round-robin among its ranks, every rank gets all of them in index order, the
+/// same for any number of ranks.
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
-                                   int episodes, std::uint64_t seed, int threads, const Action& noise = {0.0, 0.0, 0.0},
-                                   Cluster& cluster = local_cluster());
+                                   const RecordRequest& request, Cluster& cluster = local_cluster());
 
 /// Seed and size of the built-in set.
 inline constexpr std::uint64_t kBuiltinSeed = 2026;

@@ -19,6 +19,7 @@ struct EvaluationRun {
   std::string model;                ///< the model file as the user named it
   std::uint64_t seed = 0;
   std::string initial_push = "none";
+  std::string perturb = "none";  ///< --perturb as given: a level or a file (in the JSON unless none)
 };
 
 /// The `evaluate --json` object as one line of JSON: model, regressor, features, episodes,

@@ -9,7 +9,8 @@
 
 namespace dicestack {
 
-enum class ParamType { integer, real, boolean, choice };
+/// text: any non-empty value, checked by its owner (e.g. a perturbation level or file).
+enum class ParamType { integer, real, boolean, choice, text };
 
 /// One parameter a regressor accepts.
 struct ParamSpec {
@@ -22,7 +23,7 @@ struct ParamSpec {
   std::vector<std::string> choices;  ///< for ParamType::choice
 };
 
-/// "integer", "real", "boolean" or "choice".
+/// "integer", "real", "boolean", "choice" or "text".
 std::string_view to_string(ParamType type);
 
 /// Validated parameter values, one per schema entry.
@@ -39,7 +40,7 @@ class Params {
   long long integer(std::string_view name) const;
   double real(std::string_view name) const;
   bool boolean(std::string_view name) const;
-  const std::string& choice(std::string_view name) const;
+  const std::string& choice(std::string_view name) const;  ///< a choice or text parameter
 
   /// name -> value as text, in schema order (for model files and reports).
   const std::vector<std::pair<std::string, std::string>>& as_text() const { return text_; }

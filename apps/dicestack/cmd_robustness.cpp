@@ -1,0 +1,94 @@
+// `dicestack robustness`: a model's or an expert's realistic success in perturbed worlds, factor
+// by factor and level by level (issue 25; docs/robustness.md). The work is the library's
+// (learners/robustness.hpp): this parses, calls it and prints.
+#include <iostream>
+#include <memory>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
+#include <dicestack/learners/policy.hpp>
+#include <dicestack/learners/robustness.hpp>
+#include <dicestack/learners/train.hpp>
+
+#include "cli.hpp"
+#include "options.hpp"
+
+namespace dicestack::cli {
+namespace {
+
+struct RobustnessOptions {
+  WorldOption world;
+  std::filesystem::path model, demos, out;
+  std::string expert, format = "md";
+  int episodes = 100;
+  std::uint64_t seed = 0;
+  int threads = 0;
+};
+
+void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
+  const WorldConfig world = opt.world.load();
+  if (opt.model.empty() == opt.expert.empty()) throw ConfigError("robustness: give one of --model M or --expert NAME");
+  if (!opt.demos.empty() && opt.expert != "tracker")
+    throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
+  if (!opt.out.empty() && cluster.is_root()) check_robustness_out(opt.out, opt.format);  // before any work
+  PolicyFactory factory;
+  std::string subject;
+  RobustnessRequest request;
+  request.episodes = opt.episodes;
+  request.seed = opt.seed;
+  request.threads = opt.threads;
+  if (!opt.model.empty()) {
+    auto model = std::make_shared<const Model>(load_model(opt.model));
+    factory = [model] { return std::make_unique<ModelPolicy>(model); };
+    subject = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
+  } else {
+    ExpertConfig config;
+    if (opt.expert == "tracker") {
+      if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
+      config.recordings =
+          make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, {}, opt.seed, opt.threads, cluster);
+    }
+    make_expert(opt.expert, config);  // an unknown name fails here, before any row
+    factory = [name = opt.expert, config] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config)); };
+    subject = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")");
+    request.reads_world = true;
+  }
+  if (cluster.is_root())
+    request.progress = [&](int row, int rows, const std::string& factor, const std::string& level) {
+      std::cerr << "[" << row + 1 << "/" << rows << "] " << factor << " " << level << '\n' << std::flush;
+    };
+  const auto rows = robustness(factory, world, request, cluster);
+  if (!cluster.is_root()) return;
+  const std::string header = "dicestack robustness: " + subject + "; " + std::to_string(opt.episodes) +
+                             " rollouts per row from evaluation starts (seed " + std::to_string(opt.seed) +
+                             "); rates with 95% Wilson intervals (successes)" +
+                             (request.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "");
+  const std::string table = render_robustness(rows, opt.format, header);
+  std::cout << table << std::flush;
+  if (!opt.out.empty()) {
+    write_robustness(rows, opt.format, header, opt.out);
+    std::cout << "wrote " << opt.out.string() << '\n' << std::flush;
+  }
+}
+
+}  // namespace
+
+void add_robustness_command(CLI::App& app, Cluster& cluster) {
+  auto opt = std::make_shared<RobustnessOptions>();
+  CLI::App* cmd = app.add_subcommand("robustness", "A model's or an expert's success in perturbed worlds, factor x level");
+  opt->world.add_to(*cmd);
+  cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->check(CLI::ExistingFile);
+  cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
+  cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
+  cmd->add_option("--episodes", opt->episodes, "Rollouts per row")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the starts and the draws")->check(seed_check())->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--format", opt->format, "md, csv or json")
+      ->check(CLI::IsMember({"md", "csv", "json"}))
+      ->capture_default_str();
+  cmd->add_option("--out", opt->out, "Also write the table to this file (atomically; only a table of ours is replaced)");
+  cmd->callback([opt, &cluster] { run_robustness(*opt, cluster); });
+}
+
+}  // namespace dicestack::cli

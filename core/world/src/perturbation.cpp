@@ -1,0 +1,305 @@
+#include <dicestack/core/perturbation.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/rng.hpp>
+
+namespace dicestack {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr const char* kFormat = "dicestack-perturbation";
+constexpr int kVersion = 1;
+constexpr std::uint64_t kPerturbStream = 0x70657274ULL;  // "pert": a stream of its own per episode
+
+// The level table (docs/robustness.md). Index 0 none, 1 easy, 2 medium, 3 hard. Anchors:
+// robosuite (friction +-10 %, mass +-2 %), Isaac Lab's cube (friction x[0.7, 1.3], mass
+// x[0.5, 1.5], gravity +N(0, 0.4), action noise 0.05 with bias 0.015), RWRL (delays 3 / 6 / 9).
+struct Row {
+  const char* name;
+  double levels[4];
+};
+constexpr Row kTable[] = {
+    {"friction", {0, 0.1, 0.3, 0.6}},
+    {"dice_mass", {0, 0.1, 0.5, 0.8}},
+    {"cup_mass", {0, 0.1, 0.3, 0.6}},
+    {"gravity", {0, 0.1, 0.4, 1.0}},
+    {"action_noise", {0, 0.02, 0.05, 0.2}},  // its bias: a third of it (Isaac Lab's 0.05 / 0.015)
+    {"action_delay", {0, 1, 3, 6}},
+    {"observation_noise", {0, 0.01, 0.05, 0.2}},
+    {"observation_delay", {0, 1, 3, 6}},
+    {"start", {0, 0.25, 0.5, 1.0}},
+};
+
+void set(Perturbation& p, std::string_view factor, double v) {
+  if (factor == "friction") p.friction = v;
+  else if (factor == "dice_mass") p.dice_mass = v;
+  else if (factor == "cup_mass") p.cup_mass = v;
+  else if (factor == "gravity") p.gravity = v;
+  else if (factor == "action_noise") p.action_noise = v, p.action_bias = v * 0.3;
+  else if (factor == "action_delay") p.action_delay = static_cast<int>(v);
+  else if (factor == "observation_noise") p.observation_noise = v;
+  else if (factor == "observation_delay") p.observation_delay = static_cast<int>(v);
+  else if (factor == "start") p.start_widening = v;
+}
+
+std::size_t level_index(std::string_view level) {
+  const auto& levels = perturbation_levels();
+  for (std::size_t i = 0; i < levels.size(); ++i)
+    if (levels[i] == level) return i;
+  throw ConfigError("perturbation: level \"" + std::string(level) + "\" is not one of none, easy, medium, hard");
+}
+
+std::string list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+// The JSON keys and their fields, in file order.
+struct Key {
+  const char* name;
+  double Perturbation::*real;
+  int Perturbation::*whole;
+};
+constexpr Key kKeys[] = {
+    {"friction", &Perturbation::friction, nullptr},
+    {"dice_mass", &Perturbation::dice_mass, nullptr},
+    {"cup_mass", &Perturbation::cup_mass, nullptr},
+    {"gravity", &Perturbation::gravity, nullptr},
+    {"action_noise", &Perturbation::action_noise, nullptr},
+    {"action_bias", &Perturbation::action_bias, nullptr},
+    {"action_delay", nullptr, &Perturbation::action_delay},
+    {"observation_noise", &Perturbation::observation_noise, nullptr},
+    {"observation_delay", nullptr, &Perturbation::observation_delay},
+    {"start_widening", &Perturbation::start_widening, nullptr},
+};
+
+}  // namespace
+
+const std::vector<std::string>& perturbation_factors() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& r : kTable) out.emplace_back(r.name);
+    return out;
+  }();
+  return names;
+}
+
+const std::vector<std::string>& perturbation_levels() {
+  static const std::vector<std::string> names{"none", "easy", "medium", "hard"};
+  return names;
+}
+
+Perturbation perturbation_level(std::string_view level) {
+  const std::size_t i = level_index(level);
+  Perturbation p;
+  for (const auto& r : kTable) set(p, r.name, r.levels[i]);
+  return p;
+}
+
+Perturbation perturbation_factor(std::string_view factor, std::string_view level) {
+  const std::size_t i = level_index(level);
+  for (const auto& r : kTable)
+    if (r.name == factor) {
+      Perturbation p;
+      set(p, factor, r.levels[i]);
+      return p;
+    }
+  throw ConfigError("perturbation: factor \"" + std::string(factor) + "\" is not one of " + list(perturbation_factors()));
+}
+
+void validate(const Perturbation& p, const WorldConfig& world, const std::string& source) {
+  auto require = [&](bool ok, const char* field, const std::string& rule, double got) {
+    if (!ok || !std::isfinite(got)) {
+      std::ostringstream text;
+      text << source << ": field \"" << field << "\" must be " << rule << ", got " << got;
+      throw ConfigError(text.str());
+    }
+  };
+  require(p.friction >= 0 && p.friction < 1, "friction", "in [0, 1) (friction would turn negative)", p.friction);
+  require(p.dice_mass >= 0 && p.dice_mass < 1, "dice_mass", "in [0, 1) (a mass would turn non-positive)", p.dice_mass);
+  require(p.cup_mass >= 0 && p.cup_mass < 1, "cup_mass", "in [0, 1) (a mass would turn non-positive)", p.cup_mass);
+  require(p.gravity >= 0 && p.gravity <= 2, "gravity", "in [0, 2] m/s^2", p.gravity);
+  require(p.action_noise >= 0 && p.action_noise <= 10, "action_noise", "in [0, 10]", p.action_noise);
+  require(p.action_bias >= 0 && p.action_bias <= 10, "action_bias", "in [0, 10]", p.action_bias);
+  require(p.observation_noise >= 0 && p.observation_noise <= 10, "observation_noise", "in [0, 10]", p.observation_noise);
+  require(p.start_widening >= 0 && p.start_widening <= 3, "start_widening", "in [0, 3]", p.start_widening);
+  const int room = std::min(100, world.episode.max_steps - 1);
+  const std::string delays = "in [0, " + std::to_string(room) + "] (shorter than the episode's " +
+                             std::to_string(world.episode.max_steps) + " steps)";
+  require(p.action_delay >= 0 && p.action_delay <= room, "action_delay", delays, p.action_delay);
+  require(p.observation_delay >= 0 && p.observation_delay <= room, "observation_delay", delays, p.observation_delay);
+  // The widened starts must still fit inside the walls with the dice apart (the world's own
+  // check); the physics factors stay in range by the bounds above.
+  if (p.start_widening > 0) {
+    WorldConfig wide = world;
+    auto& r = wide.randomization;
+    for (double* range : {&r.shift, &r.cup_lift, &r.cup_tilt}) *range *= 1.0 + p.start_widening;
+    try {
+      validate(wide);
+    } catch (const ConfigError& e) {
+      throw ConfigError(source + ": field \"start_widening\" " + std::to_string(p.start_widening) +
+                        " makes starts that do not fit this world (" + e.what() + ")");
+    }
+  }
+}
+
+std::string perturbation_to_json(const Perturbation& p) {
+  json j = json::object();
+  j["format"] = kFormat;
+  j["version"] = kVersion;
+  for (const auto& k : kKeys) j[k.name] = k.real ? json(p.*k.real) : json(p.*k.whole);
+  return j.dump(2) + "\n";
+}
+
+std::string perturbation_summary(const Perturbation& p) {
+  std::ostringstream out;
+  for (const auto& k : kKeys) {
+    const double v = k.real ? p.*k.real : p.*k.whole;
+    if (v != 0.0) out << (out.tellp() > 0 ? ", " : "") << k.name << ' ' << v;
+  }
+  return out.tellp() > 0 ? out.str() : "none";
+}
+
+Perturbation perturbation_from_json(std::string_view text, const std::string& source, const WorldConfig& world) {
+  json j;
+  try {
+    j = parse_json_limited<json>(text, source);
+  } catch (const json::exception& e) {
+    throw InputError(source + ": not JSON (" + e.what() + ")");
+  }
+  if (!j.is_object() || j.value("format", json()) != kFormat)
+    throw InputError(source + ": not a perturbation file (no \"format\": \"" + std::string(kFormat) + "\")");
+  const json& v = j.value("version", json());
+  if (!v.is_number_integer() || v.get<long long>() < 1)
+    throw InputError(source + ": field \"version\" must be a positive integer");
+  if (v.get<long long>() != kVersion)
+    throw InputError(source + ": perturbation format version " + std::to_string(v.get<long long>()) +
+                     " is not one this dicestack reads (" + std::to_string(kVersion) + ")");
+  Perturbation p;
+  for (const auto& [key, value] : j.items()) {
+    if (key == "format" || key == "version") continue;
+    const Key* k = nullptr;
+    for (const auto& candidate : kKeys)
+      if (key == candidate.name) k = &candidate;
+    if (!k) throw InputError(source + ": unknown field \"" + key + "\"");
+    if (k->real) {
+      if (!value.is_number()) throw InputError(source + ": field \"" + key + "\" must be a number");
+      p.*k->real = value.get<double>();
+    } else {
+      if (!value.is_number_integer()) throw InputError(source + ": field \"" + key + "\" must be an integer");
+      const long long n = value.get<long long>();
+      if (n < 0 || n > 1'000'000) throw InputError(source + ": field \"" + key + "\" must be in [0, 1000000]");
+      p.*k->whole = static_cast<int>(n);
+    }
+  }
+  validate(p, world, source);
+  return p;
+}
+
+Perturbation load_perturbation(const std::string& level_or_file, const WorldConfig& world) {
+  for (const auto& level : perturbation_levels())
+    if (level_or_file == level) return perturbation_level(level);
+  const std::filesystem::path path(level_or_file);
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(level_or_file + ": not a perturbation level (none, easy, medium, hard) nor a file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) throw InputError(level_or_file + ": cannot read");
+  return perturbation_from_json(text.str(), level_or_file, world);
+}
+
+const State& observation_spread() {
+  // Standard deviations of each component over the built-in set's 15,190 frames (the mpc
+  // expert's 80 episodes), rounded; angles as recorded (unwrapped).
+  static const State spread{1.5,  0.05, 0.47,                // cup x, y, angle
+                            1.6,  0.54, 3.1,  5.9, 0.95, 3.1,  // die 0 x, y, angle, vx, vy, w
+                            1.6,  0.54, 3.1,  5.9, 0.95, 3.1,  // die 1
+                            1.6,  0.54, 3.1,  5.9, 0.95, 3.1,  // die 2
+                            5.7,  0.54, 1.9};                  // cup vx, vy, w
+  return spread;
+}
+
+PerturbationDraw draw_perturbation(const Perturbation& p, const WorldConfig& world, std::uint64_t episode_seed) {
+  PerturbationDraw d;
+  d.world = world;
+  if (p.nominal()) return d;
+  // Every quantity is drawn, in one fixed order, whatever the magnitudes: a factor's draw does
+  // not depend on which other factors are on.
+  Rng rng(derive_seed(episode_seed, kPerturbStream));
+  auto scale = [&](double a) { return 1.0 + a * rng.uniform(-1.0, 1.0); };
+  d.world.dice.friction *= scale(p.friction);
+  d.world.cup.friction *= scale(p.friction);
+  d.world.walls.friction *= scale(p.friction);
+  d.world.dice.mass *= scale(p.dice_mass);
+  d.world.cup.segment_mass *= scale(p.cup_mass);
+  d.world.physics.gravity.y += p.gravity * rng.normal();
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    d.action_bias[k] = p.action_bias * world.action.scale[k] * rng.normal();
+    d.action_noise[k] = p.action_noise * world.action.scale[k];
+  }
+  d.noise_seed = rng.next();
+  d.action_delay = p.action_delay;
+  for (std::size_t k = 0; k < kStateDim; ++k) d.observation_noise[k] = p.observation_noise * observation_spread()[k];
+  d.observation_delay = p.observation_delay;
+  auto& r = d.world.randomization;
+  for (double* range : {&r.shift, &r.cup_lift, &r.cup_tilt}) *range *= 1.0 + p.start_widening;
+  d.physics = p.friction > 0 || p.dice_mass > 0 || p.cup_mass > 0 || p.gravity > 0 || p.start_widening > 0;
+  d.acts = p.action_noise > 0 || p.action_bias > 0 || p.action_delay > 0 || p.observation_noise > 0 ||
+           p.observation_delay > 0;
+  return d;
+}
+
+std::string draw_to_json(const PerturbationDraw& d) {
+  const WorldConfig& w = d.world;
+  json j{{"dice_friction", w.dice.friction},
+         {"cup_friction", w.cup.friction},
+         {"walls_friction", w.walls.friction},
+         {"dice_mass", w.dice.mass},
+         {"cup_segment_mass", w.cup.segment_mass},
+         {"gravity_y", w.physics.gravity.y},
+         {"action_bias", d.action_bias},
+         {"action_noise_std", d.action_noise},
+         {"action_delay", d.action_delay},
+         {"observation_noise_std", d.observation_noise},
+         {"observation_delay", d.observation_delay},
+         {"start_shift", w.randomization.shift},
+         {"start_cup_lift", w.randomization.cup_lift},
+         {"start_cup_tilt", w.randomization.cup_tilt},
+         {"noise_seed", d.noise_seed}};
+  return j.dump();
+}
+
+PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw) : draw_(draw), noise_(draw.noise_seed) {}
+
+State PerturbedChannel::observe(const State& state) {
+  states_.push_back(state);
+  if (states_.size() > static_cast<std::size_t>(draw_.observation_delay) + 1) states_.pop_front();
+  State seen = states_.front();
+  for (std::size_t k = 0; k < kStateDim; ++k)
+    if (draw_.observation_noise[k] > 0.0) seen[k] += draw_.observation_noise[k] * noise_.normal();
+  return seen;
+}
+
+Action PerturbedChannel::execute(const Action& chosen) {
+  chosen_.push_back(chosen);
+  const auto delay = static_cast<std::size_t>(draw_.action_delay);
+  if (chosen_.size() > delay + 1) chosen_.pop_front();
+  Action a = chosen_.size() > delay ? chosen_.front() : Action{0.0, 0.0, 0.0};
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    a[k] += draw_.action_bias[k];
+    if (draw_.action_noise[k] > 0.0) a[k] += draw_.action_noise[k] * noise_.normal();
+  }
+  return a;
+}
+
+}  // namespace dicestack

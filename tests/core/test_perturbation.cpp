@@ -1,0 +1,141 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/perturbation.hpp>
+
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(Perturbation, LevelsGrowAndNoneIsNominal) {
+  EXPECT_TRUE(perturbation_level("none").nominal());
+  const Perturbation easy = perturbation_level("easy"), medium = perturbation_level("medium"),
+                     hard = perturbation_level("hard");
+  EXPECT_LT(easy.friction, medium.friction);
+  EXPECT_LT(medium.friction, hard.friction);
+  EXPECT_LT(easy.action_delay, hard.action_delay);
+  EXPECT_GT(hard.action_bias, 0.0);
+  const WorldConfig w;
+  for (const auto& level : perturbation_levels()) EXPECT_NO_THROW(validate(perturbation_level(level), w)) << level;
+}
+
+TEST(Perturbation, OneFactorLeavesTheOthersNominal) {
+  for (const auto& f : perturbation_factors()) {
+    const Perturbation p = perturbation_factor(f, "medium");
+    EXPECT_FALSE(p.nominal()) << f;
+    EXPECT_TRUE(perturbation_factor(f, "none").nominal()) << f;
+  }
+  const Perturbation p = perturbation_factor("gravity", "hard");
+  EXPECT_GT(p.gravity, 0.0);
+  EXPECT_EQ(p.friction, 0.0);
+  EXPECT_EQ(p.action_delay, 0);
+}
+
+TEST(Perturbation, UnknownFactorOrLevelIsRefusedNamingTheChoices) {
+  EXPECT_THAT(test::error_of([] { perturbation_factor("wind", "easy"); }), HasSubstr("friction, dice_mass"));
+  EXPECT_THAT(test::error_of([] { perturbation_level("extreme"); }), HasSubstr("none, easy, medium, hard"));
+  EXPECT_THAT(test::error_of([] { perturbation_factor("friction", "extreme"); }), HasSubstr("\"extreme\""));
+}
+
+TEST(Perturbation, InvalidRangesAreRefusedNamingTheField) {
+  const WorldConfig w = test::short_world(60);
+  Perturbation p;
+  p.friction = 1.0;  // a friction coefficient could reach 0 or below
+  EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"friction\""));
+  p = {};
+  p.dice_mass = -0.1;
+  EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"dice_mass\""));
+  p = {};
+  p.action_delay = 60;  // the whole episode
+  EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"action_delay\""));
+  p = {};
+  p.observation_delay = -1;
+  EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"observation_delay\""));
+  p = {};
+  p.gravity = std::nan("");
+  EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"gravity\""));
+}
+
+TEST(Perturbation, NominalDrawLeavesTheWorldAlone) {
+  const WorldConfig w;
+  const PerturbationDraw d = draw_perturbation(Perturbation{}, w, 42);
+  EXPECT_EQ(to_json(d.world), to_json(w));
+  EXPECT_FALSE(d.physics);
+  EXPECT_FALSE(d.acts);
+}
+
+TEST(Perturbation, DrawsArePureFunctionsOfTheSeed) {
+  const WorldConfig w;
+  const Perturbation p = perturbation_level("hard");
+  const PerturbationDraw a = draw_perturbation(p, w, 7), b = draw_perturbation(p, w, 7), c = draw_perturbation(p, w, 8);
+  EXPECT_EQ(to_json(a.world), to_json(b.world));
+  EXPECT_EQ(a.action_bias, b.action_bias);
+  EXPECT_EQ(a.noise_seed, b.noise_seed);
+  EXPECT_NE(a.world.dice.mass, c.world.dice.mass);
+  EXPECT_TRUE(a.physics);
+  EXPECT_TRUE(a.acts);
+  // Within the level's ranges.
+  EXPECT_GE(a.world.dice.mass, w.dice.mass * (1 - p.dice_mass));
+  EXPECT_LE(a.world.dice.mass, w.dice.mass * (1 + p.dice_mass));
+  EXPECT_GT(a.world.dice.friction, 0.0);
+  EXPECT_DOUBLE_EQ(a.world.randomization.shift, w.randomization.shift * (1 + p.start_widening));
+  EXPECT_NO_THROW(validate(a.world));
+}
+
+TEST(Perturbation, StartsTooWideForTheWallsAreRefused) {
+  WorldConfig wide;
+  wide.randomization.shift = 1.2;  // valid alone; four times it puts the scene through a wall
+  ASSERT_NO_THROW(validate(wide));
+  Perturbation p;
+  p.start_widening = 3.0;
+  EXPECT_NO_THROW(validate(p, WorldConfig{}));
+  EXPECT_THAT(test::error_of([&] { validate(p, wide); }), HasSubstr("\"start_widening\""));
+}
+
+TEST(Perturbation, AFactorsDrawDoesNotDependOnTheOthers) {
+  const WorldConfig w;
+  const PerturbationDraw alone = draw_perturbation(perturbation_factor("dice_mass", "hard"), w, 3);
+  Perturbation both = perturbation_factor("dice_mass", "hard");
+  both.friction = 0.5;
+  const PerturbationDraw with = draw_perturbation(both, w, 3);
+  EXPECT_EQ(alone.world.dice.mass, with.world.dice.mass);
+  EXPECT_NE(alone.world.dice.friction, with.world.dice.friction);
+}
+
+TEST(Perturbation, JsonRoundTripsAndLoadsByLevelOrFile) {
+  const WorldConfig w;
+  const Perturbation p = perturbation_level("medium");
+  EXPECT_EQ(perturbation_from_json(perturbation_to_json(p), "p.json", w), p);
+  EXPECT_EQ(load_perturbation("hard", w), perturbation_level("hard"));
+  const auto path = std::filesystem::temp_directory_path() / ("perturb-" + std::to_string(getpid()) + ".json");
+  std::ofstream(path) << perturbation_to_json(p);
+  EXPECT_EQ(load_perturbation(path.string(), w), p);
+  std::filesystem::remove(path);
+  EXPECT_THAT(test::error_of([&] { load_perturbation("nowhere.json", w); }), HasSubstr("nowhere.json"));
+}
+
+TEST(Perturbation, BadFilesAreRefusedNamingTheField) {
+  const WorldConfig w = test::short_world(60);
+  auto error = [&](const std::string& text) { return test::error_of([&] { perturbation_from_json(text, "p.json", w); }); };
+  const std::string head = R"({"format": "dicestack-perturbation", "version": 1, )";
+  EXPECT_THAT(error(R"({"format": "dicestack-perturbation", "version": 2})"), HasSubstr("version 2"));
+  EXPECT_THAT(error(R"({"format": "dicestack-world", "version": 1})"), HasSubstr("not a perturbation file"));
+  EXPECT_THAT(error(head + R"("wind": 0.1})"), HasSubstr("unknown field \"wind\""));
+  EXPECT_THAT(error(head + R"("friction": "lots"})"), HasSubstr("\"friction\" must be a number"));
+  EXPECT_THAT(error(head + R"("cup_mass": -0.5})"), HasSubstr("\"cup_mass\""));
+  EXPECT_THAT(error(head + R"("action_delay": 1.5})"), HasSubstr("\"action_delay\" must be an integer"));
+  EXPECT_THAT(error(head + R"("observation_delay": 500})"), HasSubstr("\"observation_delay\""));
+  EXPECT_THAT(error("{"), HasSubstr("p.json: not JSON"));
+}
+
+}  // namespace
+}  // namespace dicestack

@@ -1,0 +1,168 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+
+#include <nlohmann/json.hpp>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/robustness.hpp>
+
+#include <dicestack/test/requests.hpp>
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A fixed swing that reads the state it is shown, and remembers every state it saw.
+class Watcher final : public Policy {
+ public:
+  Action act(const History& h) override {
+    seen.push_back(h.current());
+    const State& s = h.current();
+    return {(h.t() / 10) % 2 ? 0.4 : -0.4, 4.0 / 30.0 - s[state_index::kCupVy] * 0.5, -0.1 * s[state_index::kCupW]};
+  }
+  std::string name() const override { return "watcher"; }
+  std::vector<State> seen;
+};
+
+const PolicyFactory watcher = [] { return std::make_unique<Watcher>(); };
+
+TEST(Perturbed, NoneIsTodaysEvaluationByteForByte) {
+  // Today's evaluation, by hand: each start from its seed in the nominal world, one rollout.
+  const WorldConfig w = test::short_world(50);
+  std::vector<Episode> eps;
+  EvalRequest r = test::eval_request(4, 21, 2, &eps);
+  r.perturbation = perturbation_level("none");
+  evaluate(watcher, w, r);
+  DiceEnv env(w);
+  for (std::size_t i = 0; i < eps.size(); ++i) {
+    Watcher p;
+    const std::uint64_t seed = evaluation_start_seed(21, i);
+    const Episode e = rollout(env, p, random_start_state(w, seed), seed, StepSource::policy);
+    ASSERT_EQ(e.states.size(), eps[i].states.size());
+    for (std::size_t t = 0; t < e.states.size(); ++t) ASSERT_TRUE(test::bit_equal(e.states[t], eps[i].states[t]));
+    EXPECT_EQ(e.actions, eps[i].actions);
+  }
+}
+
+TEST(Perturbed, EvaluationIsTheSameOnAnyThreadCountAndDiffersFromNominal) {
+  const WorldConfig w = test::short_world(50);
+  std::vector<Episode> one, two, nominal;
+  EvalRequest r = test::eval_request(4, 5, 1, &one);
+  r.perturbation = perturbation_level("hard");
+  evaluate(watcher, w, r);
+  r.threads = 2;
+  r.rollouts = &two;
+  evaluate(watcher, w, r);
+  evaluate(watcher, w, test::eval_request(4, 5, 2, &nominal));
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states) << i;
+    EXPECT_NE(one[i].states, nominal[i].states) << i;
+  }
+}
+
+TEST(Perturbed, AnExpertPlansInEachEpisodesOwnWorldOnAnyThreadCount) {
+  // An expert keeps its planning simulator between episodes; each perturbed episode must plan
+  // in its own world, not in the first one the thread happened to run.
+  const WorldConfig w = test::short_world(40);
+  const PolicyFactory mpc = [] { return std::make_unique<OwnedExpertPolicy>(make_expert("mpc", ExpertConfig{})); };
+  std::vector<Episode> one, two;
+  EvalRequest r = test::eval_request(4, 2, 1, &one);
+  r.perturbation = perturbation_factor("dice_mass", "hard");
+  evaluate(mpc, w, r);
+  r.threads = 2;
+  r.rollouts = &two;
+  evaluate(mpc, w, r);
+  for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].states, two[i].states) << i;
+}
+
+TEST(Perturbed, ObservationDelayShowsOlderStates) {
+  const WorldConfig w = test::short_world(30);
+  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
+  d.observation_delay = 3;
+  d.acts = true;
+  RolloutOptions o;
+  o.perturbation = &d;
+  DiceEnv env(w);
+  Watcher p;
+  const Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::policy, o);
+  ASSERT_EQ(p.seen.size(), e.actions.size());
+  for (std::size_t t = 0; t < p.seen.size(); ++t) EXPECT_EQ(p.seen[t], e.states[t >= 3 ? t - 3 : 0]) << t;
+}
+
+TEST(Perturbed, ActionDelayExecutesNothingUntilTheFirstChoiceArrives) {
+  const WorldConfig w = test::short_world(30);
+  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
+  d.action_delay = 4;
+  d.acts = true;
+  RolloutOptions o;
+  o.perturbation = &d;
+  DiceEnv env(w), plain(w);
+  Watcher p, q;
+  const State start = random_start_state(w, 1);
+  const Episode late = rollout(env, p, start, 1, StepSource::policy, o);
+  const Episode now = rollout(plain, q, start, 1, StepSource::policy);
+  // Doing nothing for 4 steps is not what the policy chose: the states part.
+  EXPECT_NE(late.states[5], now.states[5]);
+  // The first 4 steps are the world left alone.
+  DiceEnv idle(w);
+  idle.reset_to(start, 1);
+  State s{};
+  for (int t = 0; t < 4; ++t) s = idle.step({0.0, 0.0, 0.0}).observation;
+  EXPECT_TRUE(test::bit_equal(s, late.states[4]));
+}
+
+TEST(Perturbed, AnInvalidPerturbationIsRefusedBeforeAnyRollout) {
+  std::atomic<int> made{0};
+  EvalRequest r = test::eval_request(3, 0, 1);
+  r.perturbation.friction = 1.5;
+  EXPECT_THAT(test::error_of([&] {
+                evaluate([&] { ++made; return std::make_unique<Watcher>(); }, test::short_world(30), r);
+              }),
+              HasSubstr("\"friction\""));
+  EXPECT_EQ(made, 0);
+}
+
+TEST(Robustness, RowsCoverEveryFactorAndLevelAndAreThreadIndependent) {
+  RobustnessRequest r;
+  r.episodes = 2;
+  r.seed = 3;
+  r.threads = 1;
+  const WorldConfig w = test::short_world(25);
+  const auto one = robustness(watcher, w, r);
+  ASSERT_EQ(one.size(), 1 + 3 * perturbation_factors().size() + 3);
+  EXPECT_EQ(one.front().factor, "none");
+  EXPECT_EQ(one.back().factor, "all");
+  EXPECT_EQ(one.back().level, "hard");
+  r.threads = 2;
+  const auto two = robustness(watcher, w, r);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].stats.dice_in_cup_mean, two[i].stats.dice_in_cup_mean) << one[i].factor << one[i].level;
+    EXPECT_EQ(one[i].stats.realistic_success.value, two[i].stats.realistic_success.value);
+  }
+  r.reads_world = true;  // an expert: the sensing factors are left out
+  EXPECT_EQ(robustness(watcher, w, r).size(), 1 + 3 * (perturbation_factors().size() - 2) + 3);
+}
+
+TEST(Robustness, RendersTheLeaderboardsFormats) {
+  RobustnessRow row{"friction", "hard", {}};
+  row.stats.episodes = 10;
+  row.stats.realistic_success = wilson(7, 10);
+  const std::vector<RobustnessRow> rows{row};
+  EXPECT_THAT(render_robustness(rows, "md", "head"), HasSubstr("| friction | hard | 70% ["));
+  EXPECT_THAT(render_robustness(rows, "csv", ""), HasSubstr("\nfriction,hard,0.7,"));
+  const auto j = nlohmann::json::parse(render_robustness(rows, "json", "head"));
+  EXPECT_EQ(j["format"], "dicestack-robustness");
+  EXPECT_EQ(j["rows"][0]["realistic_success_rate"], 0.7);
+  EXPECT_THAT(test::error_of([&] { render_robustness(rows, "html", ""); }), HasSubstr("md, csv, json"));
+}
+
+}  // namespace
+}  // namespace dicestack

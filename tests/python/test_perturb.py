@@ -1,0 +1,103 @@
+"""Perturbed worlds from Python (issue 25): DiceStackEnv(perturb=...), the reset option, the
+vector env's per-environment draws, evaluate(perturb=...), and bad perturbations refused."""
+import json
+
+import numpy as np
+import pytest
+
+import dicestack
+from conftest import random_actions, short_world
+
+DRAW_KEYS = {"dice_friction", "cup_friction", "walls_friction", "dice_mass", "cup_segment_mass", "gravity_y",
+             "action_bias", "action_noise_std", "action_delay", "observation_noise_std", "observation_delay",
+             "start_shift", "start_cup_lift", "start_cup_tilt", "noise_seed"}
+
+
+def episode(env, seed, actions, options=None):
+    obs, info = env.reset(seed=seed, options=options)
+    observations, states = [obs], [env.state]
+    for a in actions:
+        obs, *_ = env.step(a)
+        observations.append(obs)
+        states.append(env.state)
+    return np.array(observations), np.array(states), info
+
+
+def test_none_is_the_nominal_world_exactly(rng):
+    actions = random_actions(rng, 30)
+    plain = episode(dicestack.DiceStackEnv(), 4, actions)
+    none = episode(dicestack.DiceStackEnv(perturb="none"), 4, actions)
+    assert np.array_equal(plain[0], none[0]) and "perturbation" not in none[2]
+
+
+def test_a_perturbed_episode_reports_its_draw_and_hides_the_true_state(rng):
+    env = dicestack.DiceStackEnv(perturb="hard")
+    observations, states, info = episode(env, 7, random_actions(rng, 20))
+    assert set(info["perturbation"]) == DRAW_KEYS
+    assert info["perturbation"]["action_delay"] == 6
+    assert not np.array_equal(observations, states)  # sensing noise and delay: the policy sees another state
+    again = episode(dicestack.DiceStackEnv(perturb="hard"), 7, random_actions(np.random.default_rng(1234), 20))
+    other = dicestack.DiceStackEnv(perturb="hard").reset(seed=8)[1]["perturbation"]
+    assert info["perturbation"] != other  # each episode its own draw
+    assert json.dumps(info["perturbation"]) == json.dumps(dicestack.DiceStackEnv(perturb="hard").reset(seed=7)[1]["perturbation"])
+    assert again[2]["perturbation"] == info["perturbation"]
+
+
+def test_the_reset_option_perturbs_one_episode(rng):
+    actions = random_actions(rng, 25)
+    env = dicestack.DiceStackEnv()
+    perturbed = episode(env, 2, actions, options={"perturb": {"friction": 0.6, "dice_mass": 0.8}})
+    assert perturbed[2]["perturbation"]["dice_mass"] != dicestack.default_world()["dice"]["mass"]
+    after = episode(env, 2, actions)
+    fresh = episode(dicestack.DiceStackEnv(), 2, actions)
+    assert np.array_equal(after[1], fresh[1]) and not np.array_equal(perturbed[1], fresh[1])
+
+
+def test_the_vector_env_gives_each_environment_its_own_draw(rng):
+    world = short_world(30)
+    actions = random_actions(rng, 12)
+    vec = dicestack.DiceStackVectorEnv(3, world=world, perturb="medium", threads=2)
+    obs, _ = vec.reset(seed=[11, 12, 13])
+    rows = [obs]
+    for a in actions:
+        rows.append(vec.step(np.tile(a, (3, 1)))[0])
+    rows = np.array(rows)
+    for i, seed in enumerate([11, 12, 13]):
+        one = episode(dicestack.DiceStackEnv(world=world, perturb="medium"), seed, actions)[0]
+        assert np.array_equal(rows[:, i], one)
+    assert not np.array_equal(rows[:, 0], rows[:, 1])
+
+
+@pytest.mark.parametrize("perturb, message", [
+    ("extreme", "none, easy, medium, hard"),
+    ({"friction": 1.5}, "\"friction\""),
+    ({"action_delay": 1000}, "\"action_delay\""),
+    ({"wind": 0.1}, "unknown field \"wind\""),
+])
+def test_bad_perturbations_are_refused_naming_the_field(perturb, message):
+    with pytest.raises(ValueError, match=message.replace('"', '.')):
+        dicestack.DiceStackEnv(perturb=perturb)
+    env = dicestack.DiceStackEnv()
+    with pytest.raises(ValueError, match=message.replace('"', '.')):
+        env.reset(seed=0, options={"perturb": perturb})
+
+
+def test_snapshots_refuse_perturbed_sensing_but_keep_perturbed_physics():
+    env = dicestack.DiceStackEnv(perturb={"dice_mass": 0.5})
+    env.reset(seed=1)
+    env.restore(env.snapshot())
+    env = dicestack.DiceStackEnv(perturb={"action_delay": 2})
+    env.reset(seed=1)
+    with pytest.raises(ValueError, match="perturbed"):
+        env.snapshot()
+
+
+def test_evaluate_takes_a_perturbation(builtin_episodes):
+    model = dicestack.train("knn", demos=builtin_episodes[:2], params={"k": 1}, split="none")
+    world = short_world(40)
+    nominal = dicestack.evaluate(model, 3, seed=1, world=world, threads=1)
+    none = dicestack.evaluate(model, 3, seed=1, world=world, threads=1, perturb="none")
+    hard = dicestack.evaluate(model, 3, seed=1, world=world, threads=1, perturb="hard")
+    assert "perturb" not in nominal and hard["perturb"] == "hard"
+    for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate"):
+        assert nominal[key] == none[key]
