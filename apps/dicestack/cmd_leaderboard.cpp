@@ -89,6 +89,10 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--format", r.format, "md, csv, latex or json")->check(CLI::IsMember({"md", "csv", "latex", "json"}))->capture_default_str();
   cmd->add_option("--out", r.out, "Also write the table to this file (atomically)");
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--perturb", r.perturb,
+                  "Roll out in perturbed worlds: none, easy, medium, hard or a perturbation file (docs/robustness.md); "
+                  "training stays nominal")
+      ->capture_default_str();
   cmd->callback([opt, &cluster] { run_leaderboard(*opt, cluster); });
 }
 

@@ -11,13 +11,18 @@ namespace {
 
 namespace si = state_index;
 
-// The built-in maps differ only in which blocks follow the current state.
+// What a map shows of the current state: all of it, the cup's six numbers alone (a pattern
+// played with feedback on the cup, none on the dice), or nothing (open loop).
+enum class Current { state, cup, none };
+constexpr std::size_t kCupParts[] = {si::kCupX, si::kCupY, si::kCupAngle, si::kCupVx, si::kCupVy, si::kCupW};
+
+// The built-in maps differ in how much of the current state they show and which blocks follow.
 struct Blocks {
   bool clock = false;
   bool start = false;
   bool previous = false;
   bool start_state = false;  // the whole start state instead of its two summary numbers
-  bool open_loop = false;    // no current state: the clock and the start alone choose the action
+  Current current = Current::state;
 };
 
 class BuiltinFeatureMap final : public FeatureMap {
@@ -30,14 +35,16 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
 
   std::size_t width() const override {
-    return (blocks_.open_loop ? 0 : kStateDim) + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
+    return current_width() + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
            (blocks_.start_state ? kStateDim : 0);
   }
 
   std::vector<std::string> column_names() const override {
     std::vector<std::string> out;
-    if (!blocks_.open_loop)
+    if (blocks_.current == Current::state)
       for (auto n : state_names()) out.emplace_back(n);
+    if (blocks_.current == Current::cup)
+      for (auto k : kCupParts) out.emplace_back(state_names()[k]);
     if (blocks_.clock) out.emplace_back("t");
     if (blocks_.start) out.insert(out.end(), {"start_cup_x", "start_dice_mean_x"});
     if (blocks_.previous)
@@ -50,10 +57,10 @@ class BuiltinFeatureMap final : public FeatureMap {
   void compute(const History& h, std::span<double> out) const override {
     const State& s = h.current();
     std::size_t at = 0;
-    if (!blocks_.open_loop) {
-      std::copy(s.begin(), s.end(), out.begin());
-      at = kStateDim;
-    }
+    if (blocks_.current == Current::state) std::copy(s.begin(), s.end(), out.begin());
+    if (blocks_.current == Current::cup)
+      for (auto k : kCupParts) out[at++] = s[k];
+    at = current_width();
     if (blocks_.clock) out[at++] = static_cast<double>(h.t());
     if (blocks_.start) {
       const State& s0 = h.start();
@@ -71,6 +78,10 @@ class BuiltinFeatureMap final : public FeatureMap {
   }
 
  private:
+  std::size_t current_width() const {
+    return blocks_.current == Current::state ? kStateDim : blocks_.current == Current::cup ? std::size(kCupParts) : 0;
+  }
+
   std::string name_, description_;
   Blocks blocks_;
 };
@@ -89,7 +100,11 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
                                                      Blocks{true, false, false, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
-        Blocks{true, false, false, true, true}));
+        Blocks{true, false, false, true, Current::none}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "cup+clock+start_state",
+        "a pattern with feedback on the cup alone: the cup's position and velocity, t and the whole start state",
+        Blocks{true, false, false, true, Current::cup}));
     return v;
   }();
   return *maps;

@@ -215,6 +215,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   };
   auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
   const WorldConfig& world = opt.world;
+  const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   const int episodes = opt.episodes > 0 ? opt.episodes : profile.rollouts;
   const auto& dir = opt.demos;
   const DemoSet set = read_demo_set(dir);
@@ -299,10 +300,13 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
         return std::any_of(regressors.begin(), regressors.end(), [&](const std::string& r) { return left_out(l, r); });
       }))
     header << "; " << profile.left_out_note;
+  if (!perturbation.nominal())
+    header << "; rollouts in perturbed worlds (" << opt.perturb << ": " << perturbation_summary(perturbation)
+           << "), drawn per episode; training nominal";
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
            << " budgets, then played from the same random starts";
-  const json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
+  json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
                   {"split", split.matrices().description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
                   {"training_seeds", opt.seeds}, {"seed", opt.seed}};
 
@@ -313,6 +317,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     check_replaceable(opt.out, table_ownership(opt.format));
     check_replaceable(partial, partial_ownership());
   }
+  // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
+  if (!perturbation.nominal()) meta["perturb"] = json::parse(perturbation_to_json(perturbation));
   json done = json::parse(on_root(cluster, [&] {
     json rows_done = json::object();
     if (!partial.empty() && std::filesystem::exists(partial)) {
@@ -358,6 +364,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   settings.seeds = opt.seeds;
   settings.seed = opt.seed;
   settings.threads = opt.threads;
+  settings.perturbation = perturbation;
   settings.learner_options = options_for;
   const RowRunner runner(settings, report);
 

@@ -98,6 +98,7 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   request.episodes = s_.episodes;
   request.seed = seed;
   request.threads = s_.threads;
+  request.perturbation = s_.perturbation;
   request.progress = [&](int finished, int of) { report_(rollouts_text, at(0.5 + 0.5 * finished / of), false); };
   r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, s_.world, request, inner);
   return r;
@@ -115,6 +116,7 @@ LeaderboardRow RowRunner::baseline_row(const std::string& name, Cluster& inner, 
     request.episodes = s_.episodes;
     request.seed = s_.seed + static_cast<std::uint64_t>(k);
     request.threads = s_.threads;
+    request.perturbation = s_.perturbation;
     request.progress = [&](int finished, int of) {
       report_("baseline " + name, from + span * (k + static_cast<double>(finished) / of) / s_.seeds, false);
     };

@@ -26,6 +26,7 @@ struct RowSettings {
   int seeds = 1;                     ///< training seeds per row
   std::uint64_t seed = 0;            ///< the first training seed, and the rollouts' starts
   int threads = 0;
+  Perturbation perturbation;  ///< the rollouts' worlds, drawn per episode
   /// The options a learner runs with (the profile's, then the user's).
   std::function<std::vector<std::string>(const std::string& learner)> learner_options;
 };

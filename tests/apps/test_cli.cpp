@@ -609,6 +609,23 @@ TEST(CliPerturb, NoneChangesNoByteAndBadPerturbationsAreRefusedBeforeAnyWork) {
   std::filesystem::remove(model);
 }
 
+TEST(CliPerturb, TheLeaderboardRollsOutInPerturbedWorldsAndSaysSo) {
+  const std::string args = "leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 2 --seed 4 ";
+  const Process nominal = run(args + "--format json", false), none = run(args + "--format json --perturb none", false),
+                hard = run(args + "--format json --perturb hard", false);
+  ASSERT_EQ(hard.status, 0) << hard.output;
+  const auto jn = nlohmann::json::parse(nominal.output), j0 = nlohmann::json::parse(none.output),
+             jh = nlohmann::json::parse(hard.output);
+  EXPECT_FALSE(j0.contains("perturb"));
+  for (const char* key : {"wall_contact", "dice_in_cup_mean", "realistic_success"})
+    EXPECT_EQ(jn["rows"][0][key], j0["rows"][0][key]) << key;
+  EXPECT_EQ(jh["perturb"]["action_delay"], 6);
+  EXPECT_THAT(run(args + "--perturb hard", false).output, HasSubstr("rollouts in perturbed worlds (hard: friction 0.6"));
+  const Process bad = run(args + "--perturb sideways");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("none, easy, medium, hard"));
+}
+
 TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable) {
   const auto model = test::scratch_path("dicestack_cli_robust.dsm");
   const auto world = test::scratch_path("dicestack_cli_robust_world.json");

@@ -127,7 +127,7 @@ TEST(Perturbation, BadFilesAreRefusedNamingTheField) {
   const WorldConfig w = test::short_world(60);
   auto error = [&](const std::string& text) { return test::error_of([&] { perturbation_from_json(text, "p.json", w); }); };
   const std::string head = R"({"format": "dicestack-perturbation", "version": 1, )";
-  EXPECT_THAT(error(R"({"format": "dicestack-perturbation", "version": 2})"), HasSubstr("version 2"));
+  EXPECT_THAT(error(R"({"format": "dicestack-perturbation", "version": 2})"), HasSubstr("format version 2 is newer than this dicestack reads (1)"));
   EXPECT_THAT(error(R"({"format": "dicestack-world", "version": 1})"), HasSubstr("not a perturbation file"));
   EXPECT_THAT(error(head + R"("wind": 0.1})"), HasSubstr("unknown field \"wind\""));
   EXPECT_THAT(error(head + R"("friction": "lots"})"), HasSubstr("\"friction\" must be a number"));

@@ -63,6 +63,20 @@ TEST(Features, OpenLoopSeesTheClockAndTheStartButNeverTheCurrentState) {
   EXPECT_EQ(m.column_names()[1], "start_cup_x");
 }
 
+TEST(Features, CupFeedbackSeesTheCupButNotTheDice) {
+  const FeatureMap& m = feature_map("cup+clock+start_state");
+  ASSERT_EQ(m.width(), 31u);
+  std::vector<State> a{numbered(100), numbered(200)};
+  const auto row = row_of(m, History{a, {}});
+  EXPECT_EQ(row[0], 200.0);   // cup x
+  EXPECT_EQ(row[5], 223.0);   // cup angular velocity
+  EXPECT_EQ(row[6], 1.0);     // t
+  EXPECT_EQ(row[7], 100.0);   // start cup x
+  EXPECT_EQ(m.column_names()[3], "cup_vx");
+  a[1][state_index::die(0)] += 5.0;  // a die moves: the row does not
+  EXPECT_EQ(row_of(m, History{a, {}}), row);
+}
+
 TEST(Features, HistoryRepeatsTheStartAtStepZero) {
   const FeatureMap& m = feature_map("state+history");
   ASSERT_EQ(m.width(), 48u);

@@ -88,14 +88,20 @@ TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
   EXPECT_NE(r.observation, perturbed.states[1]);  // the executed action differed
 }
 
-TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
-  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2", "successes_only=false"});
+// knn on the short world, seed 5, one thread: DART's test runs.
+LearnContext knn_context() {
   LearnContext c;
   c.world = test::short_world();
   c.regressor = "knn";
   c.features = "state+clock+start";
   c.seed = 5;
   c.threads = 1;
+  return c;
+}
+
+TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
+  const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "noise=0.2", "successes_only=false"});
+  LearnContext c = knn_context();
   const LearnResult one = learner->learn(c);
   c.threads = 2;
   const LearnResult two = learner->learn(c);
@@ -112,12 +118,7 @@ TEST(Dart, RecordsUnderNoiseAndIgnoresTheThreadCount) {
 }
 
 TEST(Dart, TrainsUnderRandomisedWorldsOnAnyThreadCount) {
-  LearnContext c;
-  c.world = test::short_world();
-  c.regressor = "knn";
-  c.features = "state+clock+start";
-  c.seed = 5;
-  c.threads = 1;
+  LearnContext c = knn_context();
   const auto learner = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false", "perturb=medium"});
   const LearnResult one = learner->learn(c);
   c.threads = 2;

@@ -83,11 +83,17 @@ TEST(Perturbed, AnExpertPlansInEachEpisodesOwnWorldOnAnyThreadCount) {
   for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].states, two[i].states) << i;
 }
 
+// A draw with nothing on but what the caller sets next.
+PerturbationDraw bare_draw(const WorldConfig& w) {
+  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
+  d.acts = true;
+  return d;
+}
+
 TEST(Perturbed, ObservationDelayShowsOlderStates) {
   const WorldConfig w = test::short_world(30);
-  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
+  PerturbationDraw d = bare_draw(w);
   d.observation_delay = 3;
-  d.acts = true;
   RolloutOptions o;
   o.perturbation = &d;
   DiceEnv env(w);
@@ -99,9 +105,8 @@ TEST(Perturbed, ObservationDelayShowsOlderStates) {
 
 TEST(Perturbed, ActionDelayExecutesNothingUntilTheFirstChoiceArrives) {
   const WorldConfig w = test::short_world(30);
-  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
+  PerturbationDraw d = bare_draw(w);
   d.action_delay = 4;
-  d.acts = true;
   RolloutOptions o;
   o.perturbation = &d;
   DiceEnv env(w), plain(w);

@@ -181,9 +181,9 @@ Perturbation perturbation_from_json(std::string_view text, const std::string& so
   const json& v = j.value("version", json());
   if (!v.is_number_integer() || v.get<long long>() < 1)
     throw InputError(source + ": field \"version\" must be a positive integer");
-  if (v.get<long long>() != kVersion)
-    throw InputError(source + ": perturbation format version " + std::to_string(v.get<long long>()) +
-                     " is not one this dicestack reads (" + std::to_string(kVersion) + ")");
+  if (v.get<long long>() > kVersion)
+    throw InputError(source + ": format version " + std::to_string(v.get<long long>()) +
+                     " is newer than this dicestack reads (" + std::to_string(kVersion) + "); upgrade dicestack");
   Perturbation p;
   for (const auto& [key, value] : j.items()) {
     if (key == "format" || key == "version") continue;

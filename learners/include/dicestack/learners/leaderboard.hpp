@@ -34,6 +34,9 @@ struct LeaderboardRequest {
   int seeds = 1;                  ///< training seeds per row, >= 1
   std::uint64_t seed = 0;         ///< the first training seed, and the seed of the rollouts' starts
   int threads = 0;                ///< 0 = all cores; results do not depend on it
+  /// The rollouts' worlds (issue 25): "none" (the nominal world: today's table byte for byte),
+  /// a level or a perturbation file; training stays nominal (learners take perturb= for that).
+  std::string perturb = "none";
   /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
   /// before any work (a user's file is refused), and finished rows go to <out>.partial.json as
   /// they come, so that a rerun with the same settings resumes.
