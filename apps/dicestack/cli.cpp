@@ -2,6 +2,8 @@
 
 #include <exception>
 #include <iostream>
+#include <set>
+#include <string>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/regressors/registry.hpp>
@@ -46,8 +48,11 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   if (cluster.size() > 1)
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
       const std::string name = sub->get_name();
-      if (name != "evaluate" && name != "record" && name != "train" && name != "leaderboard" && name != "optimise" &&
-          name != "reinforce" && name != "rrt")
+      // The subcommands every rank runs (their work is dealt over the cluster); the others run
+      // on the root alone.
+      static const std::set<std::string> distributed{"evaluate", "record",    "train", "leaderboard",
+                                                     "optimise", "reinforce", "rrt",   "robustness"};
+      if (!distributed.contains(name))
         sub->preparse_callback([&cluster](std::size_t) {
           if (!cluster.is_root()) throw RootOnly{};
         });

@@ -3,7 +3,7 @@
 # under mpirun -np 2 and -np 3 (with 1 and 2 threads per rank), outputs compared byte for byte
 # (timing fields removed from JSON). `failure` checks that a rank that fails or dies ends the
 # whole run quickly with a clear message.
-#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | tracker | evaluate | dagger | dad | dart | leaderboard | optimise | reinforce | rrt | failure
+#   mpi_ranks.sh DICESTACK MPIRUN MODE     MODE: record | tracker | evaluate | perturb | dagger | dad | dart | leaderboard | optimise | reinforce | rrt | failure
 set -euo pipefail
 exe="$1"
 mpirun="$2"
@@ -83,6 +83,24 @@ case "$mode" in
     same "$work/eval-1.txt" "$work/eval-3.txt"
     same "$work/roll-1" "$work/roll-2"
     same "$work/roll-1" "$work/roll-3"
+    ;;
+  perturb)  # perturbed worlds: the robustness table, a perturbed evaluation and recording with their draws
+    "$exe" train --regressor knn --demos "$work/demos" --out "$work/knn.dsm" "${world[@]}" > /dev/null
+    for run in "1 2" "2 1" "3 2"; do
+      set -- $run
+      ranks "$1" robustness --model "$work/knn.dsm" --episodes 3 --seed 2 --threads "$2" --format csv \
+        --out "$work/rob-$1.csv" "${world[@]}" > /dev/null 2>&1
+      ranks "$1" evaluate --model "$work/knn.dsm" --episodes 5 --seed 5 --threads "$2" --perturb hard \
+        --save-rollouts "$work/roll-$1" "${world[@]}" > /dev/null
+      ranks "$1" record --expert scripted --episodes 5 --seed 3 --threads "$2" --perturb medium \
+        --out "$work/rec-$1" "${world[@]}" > /dev/null
+    done
+    grep -q '"perturbation"' "$work/roll-1/meta.json" || fail "the rollouts do not carry their draws"
+    for n in 2 3; do
+      same "$work/rob-1.csv" "$work/rob-$n.csv"
+      same "$work/roll-1" "$work/roll-$n"
+      same "$work/rec-1" "$work/rec-$n"
+    done
     ;;
   dagger|dad|dart)
     if [ "$mode" = dagger ]; then
