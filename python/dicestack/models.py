@@ -136,7 +136,7 @@ def _names(values, what):
 
 def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
                 profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, threads=None,
-                out=None, format=None, progress=None):
+                out=None, format=None, perturb=None, progress=None):
     """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
     learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
     with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
@@ -149,7 +149,9 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     dict of learner options applied to every learner that has the key; baselines: names
     (cmaes, de, basinhop, bayes, reinforce, rrt) or "all"; profile "quick" or "paper"; split
     "episodes" or "rows"; episodes: rollouts per row and seed (None: 20 quick, 100 paper);
-    seeds: training seeds per row. demos: "builtin", "human" or a folder.
+    seeds: training seeds per row. demos: "builtin", "human" or a folder. perturb: roll out in
+    perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
+    nominal; docs/robustness.md).
 
     out: also write the table there, in `format` (md, csv, latex or json; None: from the file's
     suffix, .md .csv .tex .json, else md), atomically and never over a file that is not a
@@ -161,6 +163,8 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
         format = _FORMATS.get(os.path.splitext(os.fspath(out))[1].lower(), "md") if out is not None else "md"
     if not isinstance(demos, (str, os.PathLike)):
         raise TypeError("demos must be 'builtin', 'human' or a folder")
+    if perturb is not None and not isinstance(perturb, (str, os.PathLike)):
+        raise TypeError("perturb must be a level (none, easy, medium, hard) or a perturbation file")
     for name, value in (("episodes", episodes), ("seeds", seeds)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
             raise ValueError(f"{name} must be a positive int, got {value!r}")
@@ -181,5 +185,6 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
         os.fspath(out) if out is not None else "",
         format,
         progress_bar(progress),
+        "none" if perturb is None else os.fspath(perturb),
     )
     return json.loads(table)["rows"]

@@ -192,7 +192,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
                         const std::vector<std::string>& baselines, const std::vector<std::string>& features,
                         const std::string& profile, const std::string& split, int episodes, int seeds,
                         const py::handle& seed, const py::handle& threads, const std::string& out,
-                        const std::string& format, py::object bar) {
+                        const std::string& format, py::object bar, const std::string& perturb) {
   LeaderboardRequest request;
   request.world = world;
   request.regressors = regressors;
@@ -208,6 +208,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
   request.threads = threads_from(threads);
   request.out = out;
   request.format = format;
+  request.perturb = perturb;
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
   request.demos = resolve_demo_set(demos, world);
@@ -285,7 +286,7 @@ void bind_models(py::module_& m) {
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),
-        py::arg("bar"));
+        py::arg("bar"), py::arg("perturb") = "none");
 }
 
 }  // namespace dicestack::python

@@ -101,3 +101,16 @@ def test_evaluate_takes_a_perturbation(builtin_episodes):
     assert "perturb" not in nominal and hard["perturb"] == "hard"
     for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate"):
         assert nominal[key] == none[key]
+
+
+def test_the_leaderboard_rolls_out_in_perturbed_worlds(builtin_episodes, tmp_path):
+    demos = tmp_path / "demos"
+    dicestack.save_demos(builtin_episodes[:3], demos)
+    args = dict(regressors=["knn"], learners=["bc"], demos=demos, episodes=2, seed=3, threads=1, progress=False)
+    nominal = dicestack.leaderboard(**args)
+    none = dicestack.leaderboard(perturb="none", **args)
+    for key in ("dice_in_cup_mean", "wall_contact", "realistic_success"):
+        assert [r[key] for r in nominal] == [r[key] for r in none]
+    dicestack.leaderboard(perturb="hard", **args)
+    with pytest.raises(ValueError, match="none, easy, medium, hard"):
+        dicestack.leaderboard(perturb="sideways", **args)
