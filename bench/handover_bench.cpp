@@ -18,10 +18,44 @@
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
+#include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/policy.hpp>
 #include <dicestack/learners/train.hpp>
 
 using namespace dicestack;
+
+namespace {
+
+// The model acts for the first k steps, the expert after; the expert is asked every step (its
+// plan and latches follow the episode, as DAgger asks it), and `gap` sums how far the model's
+// actions were from its labels (in units of action.scale).
+class Handover final : public Policy {
+ public:
+  Handover(Expert& expert, const DiceEnv& env, const Model& model, int k)
+      : expert_(expert, env), model_(model), k_(k), scale_(env.config().action.scale) {}
+  void attach(const DiceEnv& env) override { expert_.attach(env); }
+  void reset(std::uint64_t seed) override { expert_.reset(seed); }
+  Action act(const History& h) override {
+    const Action label = expert_.act(h);
+    if (static_cast<int>(h.t()) >= k_) return label;
+    const Action a = model_.act(h);
+    for (std::size_t j = 0; j < kActionDim; ++j) gap += std::abs(a[j] - label[j]) / scale_[j];
+    ++steps;
+    return a;
+  }
+  std::string name() const override { return "handover"; }
+
+  double gap = 0.0;
+  long steps = 0;
+
+ private:
+  ExpertPolicy expert_;
+  const Model& model_;
+  int k_;
+  Action scale_;
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -64,25 +98,13 @@ int main(int argc, char** argv) {
       parallel_for(success.size(), 0, [&](std::size_t i, int) {
         DiceEnv env(world);
         auto expert = make_expert(expert_name, config);
+        Handover policy(*expert, env, *model, k);
         const std::uint64_t s = evaluation_start_seed(seed, i);
-        std::vector<State> states{env.reset_to(random_start_state(world, s), s)};
-        std::vector<Action> applied;
-        expert->reset(s);
-        while (true) {
-          const Action label = expert->act(env);
-          Action a = label;
-          if (static_cast<int>(applied.size()) < k) {
-            a = model->act(History{states, applied});
-            for (std::size_t j = 0; j < kActionDim; ++j) gap[i] += std::abs(a[j] - label[j]) / world.action.scale[j];
-            ++steps[i];
-          }
-          const StepResult r = env.step(a);
-          applied.push_back(r.applied);
-          if (r.terminated || r.truncated) break;
-          states.push_back(r.observation);
-        }
-        success[i] = env.outcome().realistic_success();
-        walls[i] = env.outcome().wall_contact;
+        const Episode e = rollout(env, policy, random_start_state(world, s), s, StepSource::policy);
+        success[i] = e.outcome.realistic_success();
+        walls[i] = e.outcome.wall_contact;
+        gap[i] = policy.gap;
+        steps[i] = policy.steps;
       });
       double g = 0.0;
       long n = 0, ok = 0, wall = 0;

@@ -10,6 +10,8 @@
 #include <dicestack/core/hash.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/render.hpp>
+#include <dicestack/core/rng.hpp>
+#include <dicestack/learners/evaluate.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -27,25 +29,40 @@ struct RolloutOptions {
   bool json = false;
 };
 
+// Uniform random actions in the optimisers' range (action.scale), from their own stream, or none.
+class BuiltinController final : public Policy {
+ public:
+  BuiltinController(bool random, const Action& scale, std::uint64_t seed) : random_(random), scale_(scale), rng_(seed) {}
+  Action act(const History&) override {
+    Action a{0.0, 0.0, 0.0};
+    if (random_)
+      for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng_.uniform(-1.0, 1.0) * scale_[k];
+    return a;
+  }
+  std::string name() const override { return random_ ? "random actions" : "still"; }
+
+ private:
+  bool random_;
+  Action scale_;
+  Rng rng_;
+};
+
 int run_rollout(const RolloutOptions& opt) {
   const WorldConfig config = opt.world.load();
   DiceEnv env(config);
-  State s = opt.start == "paper" ? env.reset_to(paper_start_state(config), opt.seed) : env.reset(opt.seed);
-  Rng rng(derive_seed(opt.seed, 2));
-  const int steps = opt.steps > 0 ? opt.steps : config.episode.max_steps;
-  std::uint64_t hash = hash_state(s);
-  double total_reward = 0.0;
-  StepResult r;
+  // As DiceEnv::reset(seed) starts: the random start of the seed, the noise from its stream 1.
+  const State start = opt.start == "paper" ? paper_start_state(config) : random_start_state(config, opt.seed);
+  const std::uint64_t noise_seed = opt.start == "paper" ? opt.seed : derive_seed(opt.seed, 1);
+  BuiltinController controller(opt.actions == "random", config.action.scale, derive_seed(opt.seed, 2));
+  dicestack::RolloutOptions options;
+  options.max_steps = static_cast<std::size_t>(opt.steps > 0 ? opt.steps : config.episode.max_steps);
   const auto t0 = std::chrono::steady_clock::now();
-  for (int t = 0; t < steps; ++t) {
-    Action a{0.0, 0.0, 0.0};
-    if (opt.actions == "random")
-      for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng.uniform(-1.0, 1.0) * config.action.scale[k];
-    r = env.step(a);
-    hash = hash_state(r.observation, hash);
-    total_reward += r.reward;
-    if (r.terminated) break;
-  }
+  const Episode e = rollout(env, controller, start, noise_seed, StepSource::policy, options);
+  std::uint64_t hash = hash_state(e.states.front());
+  for (std::size_t t = 1; t < e.states.size(); ++t) hash = hash_state(e.states[t], hash);
+  hash = hash_state(*e.final_state, hash);
+  double total_reward = 0.0;
+  for (double r : e.rewards) total_reward += r;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Outcome& o = env.outcome();
   if (!opt.png.empty())
@@ -87,7 +104,7 @@ void add_rollout_command(CLI::App& app) {
   cmd->add_option("--actions", opt->actions, "Actions: random (uniform in the optimisers' scale) or still (zero)")
       ->check(CLI::IsMember({"random", "still"}))
       ->capture_default_str();
-  cmd->add_option("--steps", opt->steps, "Control steps (default: the world's episode.max_steps)")
+  cmd->add_option("--steps", opt->steps, "Control steps (default and most: the world's episode.max_steps, where the episode is truncated)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--png", opt->png, "Render the last frame to this PNG");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
