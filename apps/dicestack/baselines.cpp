@@ -3,6 +3,8 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/policy.hpp>
 
 namespace dicestack::cli {
 
@@ -30,26 +32,19 @@ void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt) {
 }
 
 Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin) {
-  DiceEnv env(world);
   Episode e;
+  if (!actions.empty()) {  // the one rollout loop, playing the actions from the paper's start
+    DiceEnv env(world);
+    Episode played;
+    played.actions = actions;
+    PlaybackPolicy playback(played);
+    RolloutOptions options;
+    options.max_steps = actions.size();
+    e = rollout(env, playback, paper_start_state(world), seed, StepSource::policy, options);
+  }
   e.name = "episode_0000";
   e.origin = origin;
   e.seed = seed;
-  State s = env.reset_to(paper_start_state(world), e.seed);
-  for (const Action& a : actions) {
-    e.states.push_back(s);
-    e.actions.push_back(a);
-    e.sources.push_back(StepSource::policy);
-    const StepResult r = env.step(a);
-    s = r.observation;
-    e.rewards.push_back(r.reward);
-    e.terminated = r.terminated;
-  }
-  if (!e.states.empty()) {
-    e.final_state = s;
-    e.truncated = !e.terminated;
-  }
-  e.outcome = env.outcome();
   return e;
 }
 

@@ -33,7 +33,8 @@ WorldConfig open_loop_world(const OptimiseCommandOptions& opt);
 /// --world, --steps, --gravity-scale, --noise, --repeats, --discount, --threads.
 void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt);
 
-/// A baseline's action sequence played once from the paper's start, as an episode.
+/// A baseline's action sequence played once from the paper's start through rollout(), as an
+/// episode (it ends after the last action, or at a held success).
 Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin);
 
 /// Writes one episode as a demonstration set at `out` (ours or new only).
