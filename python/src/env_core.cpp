@@ -56,7 +56,7 @@ State EnvCore::reset(std::optional<std::uint64_t> seed, const Perturbation* pert
 }
 
 State EnvCore::reset_to(const State& state, std::optional<std::uint64_t> seed, const Perturbation* perturbation) {
-  require_finite(state, "reset state");
+  check_state_in_world(state, world_, "reset state");
   if (perturbation) validate(*perturbation, world_);
   episode_seed_ = seeds_.next(seed);
   ++episodes_;

@@ -36,6 +36,26 @@ TEST(World, StartStateIsThePapers) {
   EXPECT_NEAR(s[si::die(1) + 1], 1.25, 1e-6);
 }
 
+TEST(World, StatesOutsideTheWorldAreRefusedNamingTheBody) {
+  namespace si = state_index;
+  const WorldConfig c;
+  const State start = paper_start_state(c);
+  EXPECT_NO_THROW(check_state_in_world(start, c, "s"));
+  EXPECT_NO_THROW(check_state_in_world(random_start_state(c, 4), c, "s"));
+  auto error = [&](std::size_t at, double value) {
+    State s = start;
+    s[at] = value;
+    return test::error_of([&] { check_state_in_world(s, c, "reset state"); });
+  };
+  EXPECT_THAT(error(si::die(0), 1e9), ::testing::HasSubstr("reset state: die 0 is beyond the walls (x = 1e+09 m"));
+  EXPECT_THAT(error(si::kCupX, -3.0), ::testing::HasSubstr("the cup is beyond the walls"));
+  EXPECT_THAT(error(si::die(2) + 1, 0.5), ::testing::HasSubstr("die 2 is under the table (y = 0.5 m; its surface is at 1.00 m)"));
+  EXPECT_THAT(error(si::die(1) + 1, 1e9), ::testing::HasSubstr("die 1 is above the ceiling"));
+  EXPECT_THAT(error(si::die(1), start[si::die(0)] + 0.05), ::testing::AllOf(::testing::HasSubstr("die 0"), ::testing::HasSubstr("die 1"),
+                                                                           ::testing::HasSubstr("overlap by")));
+  EXPECT_THAT(error(si::kCupAngle, std::nan("")), ::testing::HasSubstr("reset state"));
+}
+
 TEST(World, DieFallsWithGravityUntilContact) {
   const WorldConfig c;
   State s = paper_start_state(c);

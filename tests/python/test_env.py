@@ -101,6 +101,18 @@ def test_reset_from_a_given_state(env, rng):
         env.reset(options={"start": "paper"})
 
 
+def test_a_state_outside_the_world_is_refused_naming_the_body(env):
+    start, _ = env.reset(seed=3)
+    far = np.array(start)
+    far[:] = 1e9
+    with pytest.raises(ValueError, match="the cup is beyond the walls"):
+        env.reset(options={"state": far})
+    inside = np.array(start)
+    inside[9:12] = inside[3:6]  # die 1 where die 0 is
+    with pytest.raises(ValueError, match="die 0 and die 1 overlap|die 1 and die 0 overlap"):
+        env.reset(options={"state": inside})
+
+
 def test_time_limit_truncates():
     env = dicestack.DiceStackEnv(world=short_world(5))
     env.reset(seed=0)

@@ -1,9 +1,13 @@
 #include <dicestack/core/world.hpp>
 
+#include <algorithm>
+#include <cstdio>
 #include <vector>
 
 #include "scene.hpp"
 #include "world_impl.hpp"
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/geometry.hpp>
 #include <dicestack/core/initial_state.hpp>
 
 namespace dicestack {
@@ -78,6 +82,31 @@ bool World::touching_walls() {
   return impl_->touches_wall();
 }
 
+std::string World::first_overlap(double tolerance) {
+  Scene& sc = *impl_->scene;
+  sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
+  auto name = [&](const b2Body* b) -> std::string {
+    for (std::size_t i = 0; i < sc.bodies.size(); ++i)
+      if (sc.bodies[i] == b) return i == 0 ? "the cup" : "die " + std::to_string(i - 1);
+    return "the walls";
+  };
+  for (b2Contact* c = sc.world->GetContactList(); c; c = c->GetNext()) {
+    if (!c->IsTouching()) continue;
+    b2WorldManifold wm;
+    c->GetWorldManifold(&wm);
+    float deepest = 0.0f;
+    for (int32 i = 0; i < c->GetManifold()->pointCount; ++i) deepest = std::min(deepest, wm.separations[i]);
+    const double depth = -static_cast<double>(deepest) / sc.u;
+    if (depth > tolerance) {
+      char text[160];
+      std::snprintf(text, sizeof text, "%s and %s overlap by %.3f m", name(c->GetFixtureA()->GetBody()).c_str(),
+                    name(c->GetFixtureB()->GetBody()).c_str(), depth);
+      return text;
+    }
+  }
+  return {};
+}
+
 bool World::has_overlaps(double tolerance) {
   Scene& sc = *impl_->scene;
   sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
@@ -90,6 +119,33 @@ bool World::has_overlaps(double tolerance) {
       if (wm.separations[i] < limit) return true;
   }
   return false;
+}
+
+void check_state_in_world(const State& state, const WorldConfig& config, std::string_view what) {
+  require_finite(state, what);
+  const auto& w = config.walls;
+  const double left = w.left_x + w.radius, right = w.right_x - w.radius, table = table_height(w),
+               ceiling = w.ceiling_y - w.radius;
+  for (std::size_t b = 0; b <= kDiceCount; ++b) {
+    const std::size_t at = b == 0 ? state_index::kCupX : state_index::die(b - 1);
+    const std::string body = b == 0 ? "the cup" : "die " + std::to_string(b - 1);
+    const double x = state[at], y = state[at + 1];
+    char text[200];
+    if (x <= left || x >= right)
+      std::snprintf(text, sizeof text, ": %s is beyond the walls (x = %g m; the inside is %.2f to %.2f m)", body.c_str(), x,
+                    left, right);
+    else if (y <= table)
+      std::snprintf(text, sizeof text, ": %s is under the table (y = %g m; its surface is at %.2f m)", body.c_str(), y, table);
+    else if (y >= ceiling)
+      std::snprintf(text, sizeof text, ": %s is above the ceiling (y = %g m; it is at %.2f m)", body.c_str(), y, ceiling);
+    else
+      continue;
+    throw InputError(std::string(what) + text);
+  }
+  World probe(config);
+  probe.set_state(state);
+  const std::string overlap = probe.first_overlap();
+  if (!overlap.empty()) throw InputError(std::string(what) + ": " + overlap + " (a body inside another)");
 }
 
 }  // namespace dicestack

@@ -6,6 +6,7 @@
 // The environment clips every action to the world's limits.
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <dicestack/core/env.hpp>
@@ -86,7 +87,10 @@ class OwnedExpertPolicy final : public Policy {
   explicit OwnedExpertPolicy(std::unique_ptr<Expert> expert) : expert_(std::move(expert)) {}
   void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_->reset(seed); }
-  Action act(const History&) override { return expert_->act(*env_); }
+  Action act(const History&) override {
+    if (!env_) throw std::logic_error("expert " + expert_->name() + ": no environment attached (roll it out with rollout())");
+    return expert_->act(*env_);
+  }
   std::string name() const override { return "expert " + expert_->name(); }
 
  private:

@@ -99,6 +99,9 @@ class World {
   /// probe worlds to reject random initial states: it builds the contacts without moving
   /// anything, which a run that continues from here would do in its first step anyway.
   bool has_overlaps(double tolerance = 0.005);
+  /// The first overlap deeper than `tolerance`, named ("die 1 and die 2 overlap by 0.150 m",
+  /// "the cup and the walls ..."), or empty. Like has_overlaps, for probe worlds.
+  std::string first_overlap(double tolerance = 0.005);
 
   /// True if the cup or a die is within judge.wall_contact_distance of a side wall or the
   /// ceiling now. Like has_overlaps, for probe worlds (e.g. judging recorded states).
@@ -108,5 +111,10 @@ class World {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Throws InputError naming the body unless `state` is one a world can hold: every body's centre
+/// inside the walls and above the table, and no two shapes (cup, dice, walls) overlapping by more
+/// than 5 mm. For states a user starts from (reset to a given state); `what` prefixes the message.
+void check_state_in_world(const State& state, const WorldConfig& config, std::string_view what);
 
 }  // namespace dicestack
