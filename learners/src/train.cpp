@@ -17,7 +17,9 @@ std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const 
 
 TrainReport train_model(const TrainRequest& request) {
   const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
-  RegressorRegistry::global().info(request.regressor);  // unknown names fail before any work
+  // An unknown regressor or a bad --set value (issue 27: it used to surface only at the first fit,
+  // after DART had recorded its episodes) fails here, before any work.
+  RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(
       request.features.empty() ? LearnerRegistry::global().info(request.learner).default_features : request.features);
   if (request.split != "episodes" && request.split != "none")

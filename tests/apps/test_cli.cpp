@@ -566,6 +566,16 @@ std::map<std::string, std::string> tree_bytes(const std::filesystem::path& root)
   return out;
 }
 
+TEST(CliLearning, ABadRegressorSettingIsRefusedBeforeTheLearnerRecordsAnything) {
+  // A million DART episodes would take hours: only a check before any work lets this return.
+  const auto model = test::scratch_path("dicestack_cli_bad_set.dsm");
+  const Process p = run("train --regressor gbt --set max_depth=abc --learner dart --option episodes=1000000 --out " +
+                        model.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("gbt: parameter \"max_depth\" expects an integer, got \"abc\""));
+  EXPECT_FALSE(std::filesystem::exists(model));
+}
+
 TEST(CliPerturb, NoneChangesNoByteAndBadPerturbationsAreRefusedBeforeAnyWork) {
   const auto model = test::scratch_path("dicestack_cli_perturb.dsm");
   const auto world = test::scratch_path("dicestack_cli_perturb_world.json");
