@@ -9,6 +9,7 @@
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/datasets/episode_bytes.hpp>
@@ -161,6 +162,8 @@ Episode unpack_one(std::string_view bytes) { return episode_from_bytes(bytes); }
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,
                    Cluster& cluster) {
   validate(request.perturbation, world);
+  require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),
+                 episode_memory_bound(world.episode.max_steps), "rollouts");
   RolloutOptions options;
   options.push = request.push;
   options.max_steps = request.max_steps;

@@ -6,6 +6,7 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/episode_bytes.hpp>
@@ -18,6 +19,8 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
                                    const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
   validate(request.perturbation, world);
+  require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
+                 episode_memory_bound(world.episode.max_steps), "episodes");
   RolloutOptions options;
   for (std::size_t k = 0; k < kActionDim; ++k) {
     const double noise = request.noise[k];

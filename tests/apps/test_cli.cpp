@@ -576,6 +576,21 @@ TEST(CliLearning, ABadRegressorSettingIsRefusedBeforeTheLearnerRecordsAnything) 
   EXPECT_FALSE(std::filesystem::exists(model));
 }
 
+TEST(CliLearning, HugeCountsAreRefusedSayingWhatTheyWouldNeed) {
+  const auto out = test::scratch_path("dicestack_cli_huge");
+  Process p = run("record --expert mpc --episodes 1000000000 --out " + out.string());
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("recording: 1000000000 episodes would need up to"));
+  EXPECT_THAT(p.output, HasSubstr("this machine has"));
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const auto model = test::scratch_path("dicestack_cli_huge.dsm");
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --split none --out " + model.string()).status, 0);
+  p = run("evaluate --model " + model.string() + " --episodes 2000000000");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("evaluate: 2000000000 rollouts would need up to"));
+  std::filesystem::remove(model);
+}
+
 TEST(CliPerturb, NoneChangesNoByteAndBadPerturbationsAreRefusedBeforeAnyWork) {
   const auto model = test::scratch_path("dicestack_cli_perturb.dsm");
   const auto world = test::scratch_path("dicestack_cli_perturb_world.json");

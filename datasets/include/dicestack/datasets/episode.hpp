@@ -48,6 +48,14 @@ struct Episode {
   void clear_transitions();
 };
 
+/// An upper bound of the memory an episode of `steps` steps holds while a run keeps it (states,
+/// actions, sources, rewards, and a packed copy on its way between ranks): for refusing counts
+/// that cannot fit (require_memory) before any work.
+inline double episode_memory_bound(int steps) {
+  return 2.0 * (steps + 1.0) * static_cast<double>(sizeof(State) + sizeof(Action) + sizeof(StepSource) + sizeof(double)) +
+         1024.0;
+}
+
 /// Throws InputError naming the episode unless states, actions and sources have one equal,
 /// non-zero length and every value is finite; with a final state, rewards has that length too,
 /// the final state and rewards are finite and at most one of terminated and truncated is set;
