@@ -85,6 +85,7 @@ bool World::touching_walls() {
 std::string World::first_overlap(double tolerance) {
   Scene& sc = *impl_->scene;
   sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
+  const float limit = static_cast<float>(-tolerance * sc.u);
   auto name = [&](const b2Body* b) -> std::string {
     for (std::size_t i = 0; i < sc.bodies.size(); ++i)
       if (sc.bodies[i] == b) return i == 0 ? "the cup" : "die " + std::to_string(i - 1);
@@ -96,30 +97,17 @@ std::string World::first_overlap(double tolerance) {
     c->GetWorldManifold(&wm);
     float deepest = 0.0f;
     for (int32 i = 0; i < c->GetManifold()->pointCount; ++i) deepest = std::min(deepest, wm.separations[i]);
-    const double depth = -static_cast<double>(deepest) / sc.u;
-    if (depth > tolerance) {
+    if (deepest < limit) {
       char text[160];
       std::snprintf(text, sizeof text, "%s and %s overlap by %.3f m", name(c->GetFixtureA()->GetBody()).c_str(),
-                    name(c->GetFixtureB()->GetBody()).c_str(), depth);
+                    name(c->GetFixtureB()->GetBody()).c_str(), -static_cast<double>(deepest) / sc.u);
       return text;
     }
   }
   return {};
 }
 
-bool World::has_overlaps(double tolerance) {
-  Scene& sc = *impl_->scene;
-  sc.world->Step(0.0f, 1, 1);  // finds contacts and their manifolds; dt = 0 moves nothing
-  const float limit = static_cast<float>(-tolerance * sc.u);
-  for (b2Contact* c = sc.world->GetContactList(); c; c = c->GetNext()) {
-    if (!c->IsTouching()) continue;
-    b2WorldManifold wm;
-    c->GetWorldManifold(&wm);
-    for (int32 i = 0; i < c->GetManifold()->pointCount; ++i)
-      if (wm.separations[i] < limit) return true;
-  }
-  return false;
-}
+bool World::has_overlaps(double tolerance) { return !first_overlap(tolerance).empty(); }
 
 void check_state_in_world(const State& state, const WorldConfig& config, std::string_view what) {
   require_finite(state, what);
