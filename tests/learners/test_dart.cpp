@@ -128,6 +128,17 @@ TEST(Dart, TrainsUnderRandomisedWorldsOnAnyThreadCount) {
   const auto nominal = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false"})->learn(c);
   EXPECT_NE(nominal.model->regressor().save_payload(), one.model->regressor().save_payload());
   EXPECT_FALSE(nominal.model->record.contains("perturb"));
+  // DAgger's mixture rollouts take the option too.
+  const std::vector<std::string> dagger{"expert=scripted", "iterations=1", "rollouts=2", "include_demos=false", "perturb=hard"};
+  c.threads = 1;
+  const LearnResult d1 = LearnerRegistry::global().create("dagger", dagger)->learn(c);
+  c.threads = 2;
+  const LearnResult d2 = LearnerRegistry::global().create("dagger", dagger)->learn(c);
+  const LearnResult d0 =
+      LearnerRegistry::global().create("dagger", {"expert=scripted", "iterations=1", "rollouts=2", "include_demos=false"})->learn(c);
+  EXPECT_EQ(d1.model->regressor().save_payload(), d2.model->regressor().save_payload());
+  EXPECT_NE(d0.model->regressor().save_payload(), d1.model->regressor().save_payload());
+  EXPECT_EQ(d1.model->record.at("perturb"), "hard");
   // A bad perturbation is refused before any episode, naming the option.
   for (const char* learner_name : {"dart", "dagger"})
     EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create(learner_name, {"perturb=extreme"})->learn(c); }),

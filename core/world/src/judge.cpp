@@ -42,16 +42,29 @@ int count_dice_in_cup(const State& s, const WorldConfig& config) {
   return count;
 }
 
-bool is_stacked(const State& s, const WorldConfig& config) {
-  const auto& j = config.judge;
+namespace {
+
+// The dice from the lowest to the highest.
+std::array<std::size_t, kDiceCount> dice_bottom_up(const State& s) {
   std::array<std::size_t, kDiceCount> order{0, 1, 2};
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return s[si::die(a) + 1] < s[si::die(b) + 1]; });
-  const double side = 2.0 * config.dice.half_size;
-  const double bottom = table_height(config.walls) + config.dice.half_size;
+  return order;
+}
+
+// The centre height of the k-th die of a stack on the table (0: the bottom one).
+double stacked_height(const WorldConfig& config, std::size_t k) {
+  return table_height(config.walls) + config.dice.half_size + 2.0 * config.dice.half_size * static_cast<double>(k);
+}
+
+}  // namespace
+
+bool is_stacked(const State& s, const WorldConfig& config) {
+  const auto& j = config.judge;
+  const auto order = dice_bottom_up(s);
   for (std::size_t k = 0; k < kDiceCount; ++k) {
     const std::size_t d = si::die(order[k]);
-    const double expected_y = bottom + side * static_cast<double>(k);
+    const double expected_y = stacked_height(config, k);
     if (std::abs(s[d + 1] - expected_y) > j.gap_tolerance * static_cast<double>(k + 1)) return false;
     if (k > 0 && std::abs(s[d] - s[si::die(order[k - 1])]) > j.column_tolerance) return false;
     if (off_quarter_turn(s[d + 2]) > j.angle_tolerance) return false;
@@ -63,15 +76,11 @@ bool is_stacked(const State& s, const WorldConfig& config) {
 
 double stack_shortfall(const State& s, const WorldConfig& config) {
   const auto& j = config.judge;
-  std::array<std::size_t, kDiceCount> order{0, 1, 2};
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return s[si::die(a) + 1] < s[si::die(b) + 1]; });
-  const double side = 2.0 * config.dice.half_size;
-  const double bottom = table_height(config.walls) + config.dice.half_size;
+  const auto order = dice_bottom_up(s);
   double sum = 0.0;
   for (std::size_t k = 0; k < kDiceCount; ++k) {
     const std::size_t d = si::die(order[k]);
-    const double expected_y = bottom + side * static_cast<double>(k);
+    const double expected_y = stacked_height(config, k);
     sum += std::abs(s[d + 1] - expected_y) / (j.gap_tolerance * static_cast<double>(k + 1));
     if (k > 0) sum += std::abs(s[d] - s[si::die(order[k - 1])]) / j.column_tolerance;
     sum += off_quarter_turn(s[d + 2]) / j.angle_tolerance;
