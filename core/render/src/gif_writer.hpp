@@ -2,6 +2,7 @@
 // Animated GIF output for write_frames (giflib: OpenCV 4.6 writes no GIF). Private to core/render:
 // giflib stays behind it.
 #include <filesystem>
+#include <vector>
 
 #include <dicestack/core/render.hpp>
 
@@ -10,8 +11,8 @@ struct GifFileType;
 namespace dicestack {
 
 /// Writes frames of one size into a looping GIF. Colours map to a fixed 6 x 7 x 6 cube: the
-/// renders are flat colours, and a fixed palette keeps frames independent and the output
-/// deterministic. Throws InputError naming the file on any failure.
+/// renders are flat colours, and a fixed palette keeps the output deterministic. Frames after
+/// the first store only what changed. Throws InputError naming the file on any failure.
 class GifWriter {
  public:
   GifWriter(const std::filesystem::path& path, int width, int height);
@@ -30,6 +31,7 @@ class GifWriter {
   std::filesystem::path path_;
   GifFileType* gif_ = nullptr;
   int width_, height_;
+  std::vector<unsigned char> previous_;  ///< the last frame's palette indices (empty before the first)
 };
 
 }  // namespace dicestack
