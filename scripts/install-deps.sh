@@ -29,6 +29,7 @@ packages=(
   libhdf5-dev             # robomimic and Minari HDF5 export/import (dicestack_interop)
   python3-h5py            # the tests that read the exported HDF5 files
   libopenmpi-dev openmpi-bin  # running on MPI ranks (docs/scaling.md); without them the tool runs alone
+  chromium chromium-driver python3-selenium  # the results pages' tests in a headless browser
 )
 
 if [ "${1:-}" = "--python" ]; then

@@ -8,6 +8,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/report.hpp>
+#include <dicestack/learners/results_page.hpp>
 #include <dicestack/learners/train.hpp>
 
 #include "cli.hpp"
@@ -18,7 +19,7 @@ namespace {
 
 struct EvaluateOptions {
   WorldOption world;
-  std::filesystem::path model, demos, save_rollouts, video_dir;
+  std::filesystem::path model, demos, save_rollouts, video_dir, report;
   std::string video_format = "mp4";
   int episodes = 20;
   std::uint64_t seed = 0;
@@ -33,13 +34,15 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   auto model = std::make_shared<const Model>(load_model(opt.model));
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
+  if (!opt.report.empty()) check_report_replaceable(opt.report);
   if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))
     throw InputError(opt.video_dir.string() + ": --video-dir exists and is not a folder");
   std::optional<Score> errors;  // before the rollouts, so that a bad set fails at once; the root prints them
   if (!opt.demos.empty() && cluster.is_root())
     errors = score(*model, DemoSplit(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, "episodes"));
-  const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty();
+  const bool keep = !opt.save_rollouts.empty() || !opt.video_dir.empty() || !opt.report.empty();
   std::vector<Episode> rollouts;
+  std::vector<EpisodeResult> results;
   EvalRequest request;
   request.episodes = opt.episodes;
   request.seed = opt.seed;
@@ -47,8 +50,12 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   request.push = initial_push_from(opt.push);
   request.perturbation = perturbation;
   request.rollouts = keep ? &rollouts : nullptr;
+  request.results = &results;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
+  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb};
+  if (!opt.report.empty())
+    write_report_folder(evaluation_board(run, *model, s, results, rollouts, world, errors ? &*errors : nullptr), opt.report);
   if (!opt.video_dir.empty()) {
     // One video per rollout, named as --save-rollouts names its episodes (as robomimic's
     // run_trained_agent writes one per rollout).
@@ -74,8 +81,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     write_demo_set(set, opt.save_rollouts);
   }
   if (opt.json) {
-    print_line(evaluation_json({opt.model.string(), opt.seed, opt.push, opt.perturb}, *model, s,
-                               errors ? &*errors : nullptr));
+    print_line(evaluation_json(run, *model, s, errors ? &*errors : nullptr));
     return 0;
   }
   char line[512];
@@ -123,6 +129,9 @@ void add_evaluate_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--video-format", opt->video_format, "mp4, avi or gif")
       ->check(CLI::IsMember({"mp4", "avi", "gif"}))
       ->capture_default_str();
+  cmd->add_option("--report", opt->report,
+                  "Also write a results page into this folder: index.html (table, previews of a successful and a failed "
+                  "rollout) and index_files/ (per-episode results as LeRobot's eval_info.json); docs/results-pages.md");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt, &cluster] { run_evaluate(*opt, cluster); });
 }

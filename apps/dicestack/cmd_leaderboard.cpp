@@ -30,12 +30,13 @@ int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
     if (p.milestone) print_progress(p.text);
   });
   if (!cluster.is_root()) return 0;  // the root writes and prints
-  const std::string table = render_leaderboard(board, request.format);
   if (request.out.empty()) {
-    std::cout << table << std::flush;
+    std::cout << render_leaderboard(board, request.format) << std::flush;
   } else {
     write_leaderboard(board, request.format, request.out);
-    std::cout << table << "wrote " << request.out.string() << '\n' << std::flush;
+    const std::string& echo = leaderboard_format(request.format).echo;
+    std::cout << render_leaderboard(board, echo.empty() ? request.format : echo) << "wrote " << request.out.string() << '\n'
+              << std::flush;
   }
   return 0;
 }
@@ -58,6 +59,15 @@ std::string profiles_help() {
   for (const auto& name : leaderboard_profile_names())
     out += (out.empty() ? "" : ", ") + name + " (" + std::to_string(leaderboard_profile(name).rollouts) + " rollouts)";
   return out;
+}
+
+std::vector<std::string> format_names(std::string* help) {
+  std::vector<std::string> names;
+  for (const LeaderboardFormat& f : leaderboard_formats()) {
+    names.push_back(f.name);
+    *help += (help->empty() ? "" : "; ") + f.name + ": " + f.description;
+  }
+  return names;
 }
 
 }  // namespace
@@ -86,7 +96,9 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--split", r.split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25% of rows)")
       ->check(CLI::IsMember({"episodes", "rows"}))
       ->capture_default_str();
-  cmd->add_option("--format", r.format, "md, csv, latex or json")->check(CLI::IsMember({"md", "csv", "latex", "json"}))->capture_default_str();
+  std::string formats_help;
+  const std::vector<std::string> formats = format_names(&formats_help);
+  cmd->add_option("--format", r.format, formats_help)->check(CLI::IsMember(formats))->capture_default_str();
   cmd->add_option("--out", r.out, "Also write the table to this file (atomically)");
   cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   cmd->add_option("--perturb", r.perturb,

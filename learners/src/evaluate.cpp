@@ -137,12 +137,13 @@ namespace {
 struct Timed {
   Episode episode;
   double policy_seconds = 0.0;
+  int wall_step = -1;
 };
 
 std::string pack_timed(const Timed& t) {
   Packer p;
   pack_episode(p, t.episode);
-  p.put(t.policy_seconds);
+  p.put(t.policy_seconds).put(t.wall_step);
   return p.take();
 }
 
@@ -151,6 +152,7 @@ Timed unpack_timed(std::string_view bytes) {
   Timed t;
   t.episode = unpack_episode(u);
   t.policy_seconds = u.get<double>();
+  t.wall_step = u.get<int>();
   return t;
 }
 
@@ -188,15 +190,35 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, c
         std::optional<DiceEnv> own;
         DiceEnv& env = episode_env(draw, envs.at(w), own);
         const State start = random_start_state(draw.world, episode_seed);
+        // Before step k the outcome covers steps 0..k-1: the first k that sees a wall names step k-1.
+        episode_options.before_step = [&t](const DiceEnv& e, std::size_t k) {
+          if (t.wall_step < 0 && e.outcome().wall_contact) t.wall_step = static_cast<int>(k) - 1;
+        };
         t.episode = rollout(env, timed, start, episode_seed, StepSource::policy, episode_options);
+        if (t.wall_step < 0 && t.episode.outcome.wall_contact) t.wall_step = static_cast<int>(t.episode.size()) - 1;
         if (request.progress) request.progress(std::min(episodes, ++finished * ranks), episodes);
         return t;
       },
       pack_timed, unpack_timed);
   std::vector<Episode> eps(done.size());
   double total_policy = 0.0;
+  if (request.results) request.results->clear();
   for (std::size_t i = 0; i < done.size(); ++i) {
     total_policy += done[i].policy_seconds;
+    if (request.results) {
+      const Episode& e = done[i].episode;
+      EpisodeResult r;
+      r.index = static_cast<int>(i);
+      r.seed = e.seed;
+      r.success = e.outcome.realistic_success();
+      r.stacked = e.outcome.stacked;
+      r.wall_contact = e.outcome.wall_contact;
+      r.dice_in_cup = e.outcome.dice_in_cup;
+      r.wall_step = done[i].wall_step;
+      r.length = static_cast<int>(e.size());
+      for (double x : e.rewards) r.reward += x;
+      request.results->push_back(r);
+    }
     eps[i] = std::move(done[i].episode);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

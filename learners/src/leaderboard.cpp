@@ -23,6 +23,8 @@
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/version.hpp>
 
+#include <dicestack/learners/results_page.hpp>
+
 #include "leaderboard_rows.hpp"
 
 namespace dicestack {
@@ -42,6 +44,30 @@ json row_json(const LeaderboardRow& r) {
           {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
 }
 
+// A row as the progress file keeps it: the table's row, its rollouts' results, and its
+// previews when the run keeps them (html).
+json partial_row_json(const LeaderboardRow& r) {
+  json j = row_json(r);
+  json rollouts = json::array();
+  for (const RowRollout& o : r.rollouts) {
+    const EpisodeResult& e = o.result;
+    rollouts.push_back({o.training_seed, e.index, e.seed, e.success, e.stacked, e.wall_contact, e.dice_in_cup, e.wall_step,
+                        e.length, e.reward});
+  }
+  j["rollouts"] = std::move(rollouts);
+  auto previews = [](const std::vector<RowPreview>& v) {
+    json out = json::array();
+    for (const RowPreview& p : v) out.push_back({{"training_seed", p.training_seed}, {"index", p.index}, {"seed", p.seed}, {"states", p.states}});
+    return out;
+  };
+  if (!r.success_preview.empty() || !r.failure_preview.empty()) {
+    j["success_preview"] = previews(r.success_preview);
+    j["failure_preview"] = previews(r.failure_preview);
+  }
+  return j;
+}
+
+// Throws for a row the progress file does not hold whole (it is then measured again).
 LeaderboardRow row_from(const json& j) {
   LeaderboardRow r;
   r.regressor = j.at("regressor");
@@ -56,6 +82,30 @@ LeaderboardRow row_from(const json& j) {
   r.success = j.at("realistic_success");
   r.fit_s = j.at("fit_s");
   r.us_per_step = j.at("us_per_step");
+  for (const json& o : j.value("rollouts", json::array())) {
+    RowRollout x;
+    x.training_seed = o.at(0);
+    EpisodeResult& e = x.result;
+    e.index = o.at(1);
+    e.seed = o.at(2);
+    e.success = o.at(3);
+    e.stacked = o.at(4);
+    e.wall_contact = o.at(5);
+    e.dice_in_cup = o.at(6);
+    e.wall_step = o.at(7);
+    e.length = o.at(8);
+    e.reward = o.at(9);
+    r.rollouts.push_back(x);
+  }
+  auto previews = [&](const char* key) {
+    std::vector<RowPreview> out;
+    for (const json& p : j.value(key, json::array()))
+      out.push_back({p.at("training_seed"), p.at("index"), p.at("seed"), p.at("states").get<std::vector<State>>()});
+    if (out.size() > 1) throw Error(std::string("more than one ") + key);
+    return out;
+  };
+  r.success_preview = previews("success_preview");
+  r.failure_preview = previews("failure_preview");
   return r;
 }
 
@@ -116,20 +166,9 @@ constexpr const char* kCsvHeaderV1 =
     "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
     "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
 
-// The first line a written table starts with (md and latex get a marker comment), and which
-// existing files --out may replace: tables of the same format that dicestack wrote.
-std::string file_marker(const std::string& format) {
-  if (format == "md") return "<!-- dicestack leaderboard -->\n";
-  if (format == "latex") return "% dicestack leaderboard\n";
-  return "";
-}
-
-Ownership table_ownership(const std::string& format) {
-  if (format == "json") return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"});
-  if (format == "csv") return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1});
-  // md and latex: our marker line, or the header line tables had before the marker.
-  const std::string marker = file_marker(format), what = "dicestack leaderboard (" + format + ")";
-  return {what, [marker = marker.substr(0, marker.size() - 1), format](const std::filesystem::path& p) {
+Ownership md_ownership(const std::string& format, const std::string& marker) {
+  // Our marker line, or the header line tables had before the marker.
+  return {"dicestack leaderboard (" + format + ")", [marker, format](const std::filesystem::path& p) {
             std::ifstream in(p, std::ios::binary);
             std::string first;
             std::getline(in, first);
@@ -142,53 +181,63 @@ Ownership partial_ownership() {
   return Ownership::json_object("dicestack leaderboard progress file", kPartialFormat, {"meta", "rows"});
 }
 
-std::string render(const std::vector<LeaderboardRow>& rows, const std::string& format, const std::string& header, const json& meta) {
+const std::vector<std::string> kColumns{"regressor", "learner", "features", "train error", "test error", "dice in cup",
+                                        "stacked", "wall contact", "realistic success", "fit s", "us/step"};
+
+std::vector<std::string> cells(const LeaderboardRow& r) {
+  return {r.regressor, r.learner, r.features, fixed(r.train_error, 3), fixed(r.test_error, 3),
+          fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
+          pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
+}
+
+std::string render_json(const Leaderboard& board) {
+  json j = json::parse(board.meta_json);
+  j["format"] = kLeaderboardFormat;
+  j["version"] = 1;
+  j["rows"] = json::array();
+  for (const auto& r : board.rows) j["rows"].push_back(row_json(r));
+  return j.dump(2) + '\n';
+}
+
+std::string render_csv(const Leaderboard& board) {
   std::ostringstream os;
-  const std::vector<std::string> cols{"regressor", "learner", "features", "train error", "test error", "dice in cup",
-                                      "stacked", "wall contact", "realistic success", "fit s", "us/step"};
-  auto cells = [](const LeaderboardRow& r) {
-    return std::vector<std::string>{r.regressor, r.learner, r.features, fixed(r.train_error, 3), fixed(r.test_error, 3),
-                                    fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
-                                    pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
-  };
-  if (format == "json") {
-    json j = meta;
-    j["format"] = kLeaderboardFormat;
-    j["version"] = 1;
-    j["rows"] = json::array();
-    for (const auto& r : rows) j["rows"].push_back(row_json(r));
-    os << j.dump(2) << '\n';
-  } else if (format == "csv") {
-    os << kCsvHeader << '\n';
-    for (const auto& r : rows) {
-      const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
-      os << r.regressor << ',' << r.learner << ',' << r.features << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
-         << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
-         << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
+  os << kCsvHeader << '\n';
+  for (const auto& r : board.rows) {
+    const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
+    os << r.regressor << ',' << r.learner << ',' << r.features << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
+       << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
+       << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
+  }
+  return os.str();
+}
+
+std::string render_latex(const Leaderboard& board) {
+  std::ostringstream os;
+  os << "% " << board.header << "\n\\begin{tabular}{lllrrrrrrrr}\n\\hline\n";
+  for (std::size_t c = 0; c < kColumns.size(); ++c) os << kColumns[c] << (c + 1 < kColumns.size() ? " & " : " \\\\\n\\hline\n");
+  for (const auto& r : board.rows) {
+    const auto v = cells(r);
+    for (std::size_t c = 0; c < v.size(); ++c) {
+      std::string cell = v[c];
+      for (std::size_t p = 0; (p = cell.find_first_of("%_", p)) != std::string::npos; p += 2) cell.insert(p, "\\");
+      os << cell << (c + 1 < v.size() ? " & " : " \\\\\n");
     }
-  } else if (format == "latex") {
-    os << "% " << header << "\n\\begin{tabular}{lllrrrrrrrr}\n\\hline\n";
-    for (std::size_t c = 0; c < cols.size(); ++c) os << cols[c] << (c + 1 < cols.size() ? " & " : " \\\\\n\\hline\n");
-    for (const auto& r : rows) {
-      const auto v = cells(r);
-      for (std::size_t c = 0; c < v.size(); ++c) {
-        std::string cell = v[c];
-        for (std::size_t p = 0; (p = cell.find_first_of("%_", p)) != std::string::npos; p += 2) cell.insert(p, "\\");
-        os << cell << (c + 1 < v.size() ? " & " : " \\\\\n");
-      }
-    }
-    os << "\\hline\n\\end{tabular}\n";
-  } else {
-    os << header << "\n\n|";
-    for (const auto& c : cols) os << ' ' << c << " |";
-    os << "\n|";
-    for (std::size_t c = 0; c < cols.size(); ++c) os << (c < 3 ? "---|" : "---:|");
+  }
+  os << "\\hline\n\\end{tabular}\n";
+  return os.str();
+}
+
+std::string render_md(const Leaderboard& board) {
+  std::ostringstream os;
+  os << board.header << "\n\n|";
+  for (const auto& c : kColumns) os << ' ' << c << " |";
+  os << "\n|";
+  for (std::size_t c = 0; c < kColumns.size(); ++c) os << (c < 3 ? "---|" : "---:|");
+  os << '\n';
+  for (const auto& r : board.rows) {
+    os << '|';
+    for (const auto& v : cells(r)) os << ' ' << v << " |";
     os << '\n';
-    for (const auto& r : rows) {
-      os << '|';
-      for (const auto& v : cells(r)) os << ' ' << v << " |";
-      os << '\n';
-    }
   }
   return os.str();
 }
@@ -202,11 +251,48 @@ void check_one_of(const std::string& what, const std::string& value, const std::
 
 }  // namespace
 
+const std::vector<LeaderboardFormat>& leaderboard_formats() {
+  static const std::vector<LeaderboardFormat> formats = [] {
+    using Path = const std::filesystem::path&;
+    auto text = [](std::string (*render)(const Leaderboard&)) { return [render](const Leaderboard& b, Path) { return render(b); }; };
+    std::vector<LeaderboardFormat> f;
+    f.push_back({"md", ".md", "the header line, then a Markdown table", text(render_md),
+                 [] { return md_ownership("md", "<!-- dicestack leaderboard -->"); }, "<!-- dicestack leaderboard -->\n"});
+    f.push_back({"csv", ".csv", "a row per line, rates with their intervals", text(render_csv),
+                 [] { return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1}); }, ""});
+    f.push_back({"latex", ".tex", "a tabular, the header line as a comment", text(render_latex),
+                 [] { return md_ownership("latex", "% dicestack leaderboard"); }, "% dicestack leaderboard\n"});
+    f.push_back({"json", ".json", "the settings and a \"rows\" array", text(render_json),
+                 [] { return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"}); },
+                 ""});
+    LeaderboardFormat html{"html", ".html",
+                           "a page for a browser: sortable table, previews, per-episode results in <page>_files/ (docs/results-pages.md)",
+                           [](const Leaderboard& b, Path out) { return results_page_html(b, out.empty() ? "" : page_media_folder(out).filename().string()); },
+                           [] { return results_page_ownership(); }, std::string(kResultsPageMarker) + "\n"};
+    html.write_beside = [](const Leaderboard& b, Path out) { write_page_media(b, page_media_folder(out)); };
+    html.check_beside = [](Path out) { check_page_media_replaceable(page_media_folder(out)); };
+    html.echo = "md";
+    f.push_back(std::move(html));
+    return f;
+  }();
+  return formats;
+}
+
+const LeaderboardFormat& leaderboard_format(const std::string& name) {
+  std::vector<std::string> names;
+  for (const LeaderboardFormat& f : leaderboard_formats()) {
+    if (f.name == name) return f;
+    names.push_back(f.name);
+  }
+  check_one_of("format", name, names);
+  throw std::logic_error("unreachable");
+}
+
 Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
   LeaderboardRequest opt = request;
   const Profile& profile = leaderboard_profile(opt.profile);
   check_one_of("split", opt.split, {"episodes", "rows"});
-  check_one_of("format", opt.format, {"md", "csv", "latex", "json"});
+  const LeaderboardFormat& format = leaderboard_format(opt.format);
   if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
   if (opt.seeds < 1) throw ConfigError("leaderboard: seeds must be at least 1, got " + std::to_string(opt.seeds));
   Cluster& cluster = *opt.cluster;
@@ -314,8 +400,9 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   // alone writes the file; the other ranks get its reading).
   const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
   if (!opt.out.empty()) {  // refuse a user's files before any work
-    check_replaceable(opt.out, table_ownership(opt.format));
+    check_replaceable(opt.out, format.ownership());
     check_replaceable(partial, partial_ownership());
+    if (format.check_beside) format.check_beside(opt.out);
   }
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
   if (!perturbation.nominal()) meta["perturb"] = json::parse(perturbation_to_json(perturbation));
@@ -326,6 +413,15 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
         json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
         // Rows of another version or other settings are not reused.
         if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) rows_done = p.value("rows", json::object());
+        if (!rows_done.is_object()) rows_done = json::object();
+        for (auto it = rows_done.begin(); it != rows_done.end();) {  // a row not held whole is measured again
+          try {
+            row_from(*it);
+            ++it;
+          } catch (const std::exception&) {
+            it = rows_done.erase(it);
+          }
+        }
       } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
       }
     }
@@ -365,6 +461,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   settings.seed = opt.seed;
   settings.threads = opt.threads;
   settings.perturbation = perturbation;
+  settings.previews = opt.format == "html";
   settings.learner_options = options_for;
   const RowRunner runner(settings, report);
 
@@ -375,7 +472,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   std::size_t finished_jobs = 0;
   auto keep_row = [&](std::size_t j, LeaderboardRow row) {
     if (!jobs[j].key.empty() && !partial.empty() && cluster.is_root()) {
-      done[jobs[j].key] = row_json(row);
+      done[jobs[j].key] = partial_row_json(row);
       AtomicFile f(partial, partial_ownership());
       f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
       f.commit();
@@ -535,20 +632,24 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   board.rows = std::move(rows);
   board.header = header.str();
   board.meta_json = meta.dump();
+  board.world = world;
+  board.demos_description = set.description;
   return board;
 }
 
 std::string render_leaderboard(const Leaderboard& board, const std::string& format) {
-  check_one_of("format", format, {"md", "csv", "latex", "json"});
-  return render(board.rows, format, board.header, json::parse(board.meta_json));
+  return leaderboard_format(format).render(board, {});
 }
 
 std::string leaderboard_row_json(const LeaderboardRow& row) { return row_json(row).dump(); }
 
-void write_leaderboard(const Leaderboard& board, const std::string& format, const std::filesystem::path& out) {
-  const std::string table = render_leaderboard(board, format);
-  AtomicFile f(out, table_ownership(format));
-  f.stream() << file_marker(format) << table;
+void write_leaderboard(const Leaderboard& board, const std::string& format_name, const std::filesystem::path& out) {
+  const LeaderboardFormat& format = leaderboard_format(format_name);
+  const std::string table = format.render(board, out);
+  check_replaceable(out, format.ownership());  // before anything beside it is written
+  if (format.write_beside) format.write_beside(board, out);
+  AtomicFile f(out, format.ownership());
+  f.stream() << format.marker << table;
   f.commit();
   const std::filesystem::path partial = out.string() + ".partial.json";
   if (partial_ownership().recognises(partial)) std::filesystem::remove(partial);

@@ -4,14 +4,43 @@
 #include <cmath>
 #include <memory>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/learners/baseline.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/regressors/score.hpp>
 
 namespace dicestack {
 
+namespace {
+
+void pack_previews(Packer& p, const std::vector<RowPreview>& previews) {
+  p.put<std::uint64_t>(previews.size());
+  for (const RowPreview& v : previews) p.put(v.training_seed).put(v.index).put(v.seed).put_vector(v.states);
+}
+
+std::vector<RowPreview> unpack_previews(Unpacker& u) {
+  const auto n = u.get<std::uint64_t>();
+  if (n > 1) throw Error("leaderboard row: " + std::to_string(n) + " previews of one kind (at most 1)");
+  std::vector<RowPreview> out(static_cast<std::size_t>(n));
+  for (RowPreview& v : out) {
+    v.training_seed = u.get<std::uint64_t>();
+    v.index = u.get<int>();
+    v.seed = u.get<std::uint64_t>();
+    v.states = u.get_vector<State>();
+  }
+  return out;
+}
+
+void pack_rollouts(Packer& p, const std::vector<RowRollout>& rollouts) { p.put_vector(rollouts); }
+
+}  // namespace
+
 std::string pack_seed_result(const SeedResult& r) {
-  return Packer().put(r.fit_s).put(r.train_error).put(r.test_error).put<std::uint8_t>(r.has_test).put(r.stats).take();
+  Packer p;
+  p.put(r.fit_s).put(r.train_error).put(r.test_error).put<std::uint8_t>(r.has_test).put(r.stats).put_vector(r.results);
+  pack_previews(p, r.success_preview);
+  pack_previews(p, r.failure_preview);
+  return p.take();
 }
 
 SeedResult unpack_seed_result(std::string_view bytes) {
@@ -22,6 +51,9 @@ SeedResult unpack_seed_result(std::string_view bytes) {
   r.test_error = u.get<double>();
   r.has_test = u.get<std::uint8_t>() != 0;
   r.stats = u.get<EvalStats>();
+  r.results = u.get_vector<EpisodeResult>();
+  r.success_preview = unpack_previews(u);
+  r.failure_preview = unpack_previews(u);
   return r;
 }
 
@@ -29,6 +61,9 @@ void pack_row(Packer& p, const LeaderboardRow& r) {
   p.put_string(r.regressor).put_string(r.learner).put_string(r.features);
   p.put(r.train_error).put(r.test_error).put(r.fit_s).put(r.us_per_step).put(r.dice_in_cup);
   p.put(r.episodes).put(r.stacked).put(r.walls).put(r.success);
+  pack_rollouts(p, r.rollouts);
+  pack_previews(p, r.success_preview);
+  pack_previews(p, r.failure_preview);
 }
 
 LeaderboardRow unpack_row(Unpacker& u) {
@@ -45,6 +80,9 @@ LeaderboardRow unpack_row(Unpacker& u) {
   r.stacked = u.get<int>();
   r.walls = u.get<int>();
   r.success = u.get<int>();
+  r.rollouts = u.get_vector<RowRollout>();
+  r.success_preview = unpack_previews(u);
+  r.failure_preview = unpack_previews(u);
   return r;
 }
 
@@ -56,6 +94,30 @@ void add_outcomes(LeaderboardRow& row, const EvalStats& st, int seeds) {
   row.success += n.realistic_success;
   row.dice_in_cup += st.dice_in_cup_mean / seeds;
   row.us_per_step += st.policy_us_per_step / seeds;
+}
+
+void add_rollouts(LeaderboardRow& row, std::uint64_t training_seed, const std::vector<EpisodeResult>& results,
+                  const std::vector<RowPreview>& success, const std::vector<RowPreview>& failure) {
+  for (const EpisodeResult& r : results) row.rollouts.push_back({training_seed, r});
+  if (row.success_preview.empty()) row.success_preview = success;
+  if (row.failure_preview.empty()) row.failure_preview = failure;
+}
+
+void keep_rollouts(EvalRequest& request, bool previews, std::vector<EpisodeResult>& results, std::vector<Episode>& episodes) {
+  request.results = &results;
+  request.rollouts = previews ? &episodes : nullptr;
+}
+
+void pick_previews(const std::vector<Episode>& episodes, std::uint64_t training_seed, std::vector<RowPreview>& success,
+                   std::vector<RowPreview>& failure) {
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    const Episode& e = episodes[i];
+    std::vector<RowPreview>& into = e.outcome.realistic_success() ? success : failure;
+    if (!into.empty()) continue;
+    RowPreview v{training_seed, static_cast<int>(i), e.seed, e.states};
+    if (e.final_state) v.states.push_back(*e.final_state);
+    into.push_back(std::move(v));
+  }
 }
 
 SeedResult RowRunner::learner_seed(const std::string& learner, const std::string& features, const std::string& regressor,
@@ -100,7 +162,10 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   request.threads = s_.threads;
   request.perturbation = s_.perturbation;
   request.progress = [&](int finished, int of) { report_(rollouts_text, at(0.5 + 0.5 * finished / of), false); };
+  std::vector<Episode> episodes;
+  keep_rollouts(request, s_.previews, r.results, episodes);
   r.stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, s_.world, request, inner);
+  pick_previews(episodes, seed, r.success_preview, r.failure_preview);
   return r;
 }
 
@@ -120,8 +185,14 @@ LeaderboardRow RowRunner::baseline_row(const std::string& name, Cluster& inner, 
     request.progress = [&](int finished, int of) {
       report_("baseline " + name, from + span * (k + static_cast<double>(finished) / of) / s_.seeds, false);
     };
+    std::vector<EpisodeResult> results;
+    std::vector<Episode> episodes;
+    keep_rollouts(request, s_.previews, results, episodes);
     const EvalStats st = evaluate(policy, s_.world, request, inner);
     add_outcomes(row, st, s_.seeds);
+    std::vector<RowPreview> success, failure;
+    pick_previews(episodes, request.seed, success, failure);
+    add_rollouts(row, request.seed, results, success, failure);
   }
   return row;
 }
@@ -129,7 +200,9 @@ LeaderboardRow RowRunner::baseline_row(const std::string& name, Cluster& inner, 
 LeaderboardRow RowRunner::combine(const std::string& learner, const std::string& features, const std::string& regressor,
                                   const std::vector<SeedResult>& seeds) const {
   LeaderboardRow row{regressor, learner, features};
-  for (const SeedResult& r : seeds) {
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    const SeedResult& r = seeds[k];
+    add_rollouts(row, s_.seed + k, r.results, r.success_preview, r.failure_preview);
     row.fit_s += r.fit_s / s_.seeds;
     row.train_error += r.train_error / s_.seeds;
     if (!r.has_test)

@@ -27,6 +27,7 @@ struct RowSettings {
   std::uint64_t seed = 0;            ///< the first training seed, and the rollouts' starts
   int threads = 0;
   Perturbation perturbation;  ///< the rollouts' worlds, drawn per episode
+  bool previews = false;      ///< keep each row's first successful and first failed rollout whole
   /// The options a learner runs with (the profile's, then the user's).
   std::function<std::vector<std::string>(const std::string& learner)> learner_options;
 };
@@ -39,6 +40,8 @@ struct SeedResult {
   double fit_s = 0.0, train_error = 0.0, test_error = 0.0;
   bool has_test = false;
   EvalStats stats;
+  std::vector<EpisodeResult> results;  ///< each rollout's, in index order
+  std::vector<RowPreview> success_preview, failure_preview;  ///< when RowSettings::previews
 };
 std::string pack_seed_result(const SeedResult& r);
 SeedResult unpack_seed_result(std::string_view bytes);
@@ -47,6 +50,18 @@ LeaderboardRow unpack_row(Unpacker& u);
 
 /// Adds rollouts' outcomes to a row: counts summed, means divided by the row's `seeds`.
 void add_outcomes(LeaderboardRow& row, const EvalStats& stats, int seeds);
+
+/// Adds one training seed's rollouts to a row: their results, and its previews where the row
+/// has none yet.
+void add_rollouts(LeaderboardRow& row, std::uint64_t training_seed, const std::vector<EpisodeResult>& results,
+                  const std::vector<RowPreview>& success, const std::vector<RowPreview>& failure);
+
+/// An evaluation request's outputs for a row's seed: `results` always, `episodes` when previews are kept.
+void keep_rollouts(EvalRequest& request, bool previews, std::vector<EpisodeResult>& results, std::vector<Episode>& episodes);
+
+/// The first successful and the first failed of `episodes` (rolled out by `training_seed`), whole.
+void pick_previews(const std::vector<Episode>& episodes, std::uint64_t training_seed, std::vector<RowPreview>& success,
+                   std::vector<RowPreview>& failure);
 
 class RowRunner {
  public:

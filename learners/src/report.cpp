@@ -2,6 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/version.hpp>
+
+#include "leaderboard_rows.hpp"
 
 namespace dicestack {
 namespace {
@@ -35,6 +38,33 @@ std::string evaluation_json(const EvaluationRun& run, const Model& model, const 
     j["split"] = errors->split;
   }
   return j.dump();
+}
+
+Leaderboard evaluation_board(const EvaluationRun& run, const Model& model, const EvalStats& stats,
+                             const std::vector<EpisodeResult>& results, const std::vector<Episode>& rollouts,
+                             const WorldConfig& world, const Score* errors) {
+  const auto learner = model.record.find("learner");
+  LeaderboardRow row{model.regressor().name(), learner == model.record.end() ? "-" : learner->second, model.features().name()};
+  row.train_error = errors ? errors->train_error : -1;
+  row.test_error = errors && errors->test_error ? *errors->test_error : -1;
+  row.fit_s = -1;
+  add_outcomes(row, stats, 1);
+  std::vector<RowPreview> success, failure;
+  pick_previews(rollouts, run.seed, success, failure);
+  add_rollouts(row, run.seed, results, success, failure);
+  Leaderboard board;
+  board.rows.push_back(std::move(row));
+  board.world = world;
+  board.header = "dicestack " DICESTACK_VERSION " evaluation of " + run.model + ": " + std::to_string(stats.episodes) +
+                 " rollouts from random starts (seed " + std::to_string(run.seed) + "); rates with 95% Wilson intervals";
+  nlohmann::json meta{{"model", run.model},        {"dicestack_version", DICESTACK_VERSION},
+                      {"regressor", model.regressor().name()}, {"features", model.features().name()},
+                      {"episodes", stats.episodes}, {"seed", run.seed},
+                      {"initial_push", run.initial_push}};
+  if (run.perturb != "none") meta["perturb"] = run.perturb;
+  for (const auto& [key, value] : model.record) meta["training " + key] = value;
+  board.meta_json = meta.dump();
+  return board;
 }
 
 }  // namespace dicestack

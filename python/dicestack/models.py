@@ -120,7 +120,7 @@ def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None
     )
 
 
-_FORMATS = {".md": "md", ".csv": "csv", ".tex": "latex", ".json": "json"}
+_FORMATS = dict(_dicestack.leaderboard_formats())  # file suffix -> format, from the library's table
 
 
 def _names(values, what):
@@ -153,8 +153,9 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
     nominal; docs/robustness.md).
 
-    out: also write the table there, in `format` (md, csv, latex or json; None: from the file's
-    suffix, .md .csv .tex .json, else md), atomically and never over a file that is not a
+    out: also write the table there, in `format` (md, csv, latex, json or html; None: from the
+    file's suffix, .md .csv .tex .json .html, else md; html is a results page with its media in
+    <stem>_files/ beside it, docs/results-pages.md), atomically and never over a file that is not a
     dicestack leaderboard; finished rows are kept in OUT.partial.json, so an interrupted run
     (Ctrl-C: KeyboardInterrupt) resumes where it stopped when called again with the same settings.
     progress: a progress bar on stderr (None: when stderr is a terminal).

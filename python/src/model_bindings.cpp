@@ -283,6 +283,14 @@ void bind_models(py::module_& m) {
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
         py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"),
         py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none");
+  m.def(
+      "leaderboard_formats",
+      [] {
+        std::vector<std::pair<std::string, std::string>> out;  // (suffix, name), in --format's order
+        for (const LeaderboardFormat& f : leaderboard_formats()) out.emplace_back(f.suffix, f.name);
+        return out;
+      },
+      "The leaderboard's formats as (file suffix, format name) pairs");
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),

@@ -141,6 +141,15 @@ case "$mode" in
     grep -q '"learner": "dagger"' "$work/lb-1.txt" || fail "no dagger row"
     same "$work/lb-1.txt" "$work/lb-2.txt"
     same "$work/lb-1.txt" "$work/lb-3.txt"
+    # The results page: every row's per-episode results and previews travel between ranks.
+    for n in 1 3; do
+      mkdir -p "$work/page-$n"
+      ranks "$n" leaderboard --demos "$work/demos" --regressors knn --learners bc,dagger --option expert=scripted \
+        --episodes 4 --seeds 2 --threads 1 --format html --out "$work/page-$n/board.html" "${world[@]}" > /dev/null
+    done
+    ls "$work/page-1/board_files/previews/"*.gif > /dev/null || fail "no previews"
+    [ "$(ls "$work/page-1/board_files/eval_info" | wc -l)" = 2 ] || fail "expected the per-episode results of 2 rows"
+    same "$work/page-1/board_files" "$work/page-3/board_files"
     # Resume: a progress file with one finished row is reused under mpirun, not recomputed.
     python3 - "$work/lb-1.json" "$work/lb-r.json.partial.json" <<'PY'
 import json, sys

@@ -78,6 +78,20 @@ struct OutcomeCounts {
 };
 OutcomeCounts outcome_counts(const EvalStats& stats);
 
+/// One rollout of an evaluation, in the shape of the per-episode entries of LeRobot's
+/// eval_info.json (episode index, seed, success, reward), with the judge's details.
+struct EpisodeResult {
+  int index = 0;               ///< the rollout's place in the evaluation
+  std::uint64_t seed = 0;      ///< its start: evaluation_start_seed(request seed, index)
+  bool success = false;        ///< realistic success: stacked, no wall touched
+  bool stacked = false;
+  bool wall_contact = false;
+  int dice_in_cup = 0;         ///< most dice held at once
+  int wall_step = -1;          ///< the step (0-based action) of the first wall contact; -1: none
+  int length = 0;              ///< control steps
+  double reward = 0.0;         ///< the environment's rewards summed
+};
+
 /// Makes one policy per worker thread (policies may keep per-episode state).
 using PolicyFactory = std::function<std::unique_ptr<Policy>()>;
 
@@ -96,6 +110,7 @@ struct EvalRequest {
   Perturbation perturbation;
   std::size_t max_steps = 0;  ///< 0: the world's time limit
   std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
+  std::vector<EpisodeResult>* results = nullptr;  ///< if set, receives every rollout's results in index order
   RolloutProgress progress;
 };
 

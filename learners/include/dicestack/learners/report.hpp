@@ -1,6 +1,6 @@
 #pragma once
-// What `dicestack evaluate --json` reports, built in one place for the command line and the
-// Python package (whose evaluate() returns the same keys).
+// What `dicestack evaluate --json` and `--report` report, built in one place for the command
+// line and the Python package (whose evaluate() returns the same keys).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -9,6 +9,7 @@
 
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/leaderboard.hpp>
 #include <dicestack/regressors/model.hpp>
 #include <dicestack/regressors/score.hpp>
 
@@ -29,5 +30,12 @@ struct EvaluationRun {
 /// is given.
 std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& stats,
                             const Score* errors = nullptr);
+
+/// One model's evaluation as a one-row leaderboard, for its results page (results_page.hpp):
+/// the row (learner from the model's training record), its rollouts' `results` and the first
+/// successful and first failed of `rollouts` as previews; the header facts are the run's.
+Leaderboard evaluation_board(const EvaluationRun& run, const Model& model, const EvalStats& stats,
+                             const std::vector<EpisodeResult>& results, const std::vector<Episode>& rollouts,
+                             const WorldConfig& world, const Score* errors = nullptr);
 
 }  // namespace dicestack

@@ -1,0 +1,44 @@
+#pragma once
+// Results pages (issue 26): a leaderboard (or one model's evaluation) as one self-contained HTML
+// page that works from file:// with no network, and its media folder beside it: each row's
+// per-episode results in the shape of LeRobot's eval_info.json, and a looping GIF of one
+// successful and one failed rollout. docs/results-pages.md shows one.
+#include <filesystem>
+#include <string>
+
+#include <dicestack/core/atomic_file.hpp>
+#include <dicestack/learners/leaderboard.hpp>
+
+namespace dicestack {
+
+/// The first line of a page dicestack wrote (the ownership test of --out).
+inline constexpr const char* kResultsPageMarker = "<!-- dicestack results page -->";
+
+/// The page: the header facts, the table (sortable by any column, rates with their intervals)
+/// and, per row, its previews and a link to its per-episode results, all under `media` (the
+/// media folder as the page refers to it; empty: a page without media). Its data is inlined as
+/// JSON and every text from the run (names, paths, options) is shown as text, never as markup.
+std::string results_page_html(const Leaderboard& board, const std::string& media);
+
+/// The media folder of the page at `page`: "<stem>_files" beside it.
+std::filesystem::path page_media_folder(const std::filesystem::path& page);
+
+/// Which existing pages --out may replace: those that start with kResultsPageMarker.
+Ownership results_page_ownership();
+
+/// Throws InputError unless nothing exists at `folder` or it is a media folder dicestack wrote.
+void check_page_media_replaceable(const std::filesystem::path& folder);
+
+/// Writes the media folder whole (replacing only one of ours): eval_info/row-NN.json per row
+/// with rollouts, previews/row-NN-success.gif and -failure.gif per row with previews, and the
+/// marker file dicestack-page.json. Throws InputError.
+void write_page_media(const Leaderboard& board, const std::filesystem::path& folder);
+
+/// Throws InputError unless nothing exists at `dir` or it is a report dicestack wrote.
+void check_report_replaceable(const std::filesystem::path& dir);
+
+/// `dicestack evaluate --report DIR`: DIR holds index.html and its media folder index_files/,
+/// written whole; an existing DIR is replaced only if it is a report dicestack wrote.
+void write_report_folder(const Leaderboard& board, const std::filesystem::path& dir);
+
+}  // namespace dicestack

@@ -1,0 +1,217 @@
+"""Results pages (issue 26) loaded in headless Chromium as a person would open them, from
+file:// with no network: the rows shown are the rows of the JSON, sorting works, a preview
+loads, text from the demonstrations shows as text, and the console has no errors.
+
+With DICESTACK_SCREENSHOTS=DIR set, each page's screenshot is saved there (docs/images/)."""
+import json
+import os
+import shutil
+import subprocess
+
+import pytest
+
+import dicestack
+
+webdriver = pytest.importorskip("selenium.webdriver")
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
+
+CHROMIUM = shutil.which("chromium")
+CHROMEDRIVER = shutil.which("chromedriver")
+pytestmark = pytest.mark.skipif(not (CHROMIUM and CHROMEDRIVER), reason="chromium and chromium-driver are not installed")
+
+HOSTILE = "<script>window.pwned = 1</script><b>bold?</b>"
+
+
+@pytest.fixture(scope="module")
+def browser():
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1600,1000",
+                "--allow-file-access-from-files"):
+        options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    # The sanitizer build preloads the ASan runtime into Python; the browser must not inherit it.
+    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "ASAN_OPTIONS", "UBSAN_OPTIONS", "LSAN_OPTIONS")}
+    service = webdriver.ChromeService(CHROMEDRIVER, env=env) if hasattr(webdriver, "ChromeService") else None
+    if service is None:
+        from selenium.webdriver.chrome.service import Service
+        service = Service(CHROMEDRIVER, env=env)
+    driver = webdriver.Chrome(service=service, options=options)
+    yield driver
+    driver.quit()
+
+
+def open_page(driver, path):
+    driver.get(path.resolve().as_uri())
+    WebDriverWait(driver, 20).until(lambda d: d.execute_script("return document.body.dataset.ready === 'true'"))
+    driver.get_log("browser")  # what loading said is checked by no_console_errors
+
+
+def no_console_errors(driver):
+    return [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
+
+
+def shown_rows(driver):
+    """Each table row as {column key: (text, data-value or None)}."""
+    return driver.execute_script("""
+        return [...document.querySelectorAll('#board tbody tr')].map(tr => {
+          const row = {};
+          for (const td of tr.querySelectorAll('td[data-key]'))
+            row[td.dataset.key] = [td.textContent, td.dataset.value === undefined ? null : Number(td.dataset.value)];
+          return row;
+        });""")
+
+
+def assert_rows_equal(shown, rows):
+    assert len(shown) == len(rows)
+    for s, r in zip(shown, rows):
+        for key in ("regressor", "learner", "features"):
+            assert s[key][0] == r[key]
+        for key in ("train_error", "test_error", "dice_in_cup_mean", "stacked_rate", "wall_contact_rate",
+                    "realistic_success_rate", "episodes", "fit_s", "us_per_step"):
+            assert s[key][1] == pytest.approx(r[key], rel=1e-12, abs=1e-12), key
+
+
+def preview_loads(driver, selector):
+    img = driver.find_element(By.CSS_SELECTOR, selector)
+    driver.execute_script("arguments[0].scrollIntoView()", img)
+    WebDriverWait(driver, 20).until(lambda d: d.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth > 0", img))
+    return img
+
+
+def screenshot(driver, name):
+    folder = os.environ.get("DICESTACK_SCREENSHOTS")
+    if folder:
+        driver.execute_script("window.scrollTo(0, 0)")
+        driver.save_screenshot(os.path.join(folder, name))
+
+
+@pytest.fixture(scope="module")
+def demos(builtin_episodes, tmp_path_factory):
+    path = tmp_path_factory.mktemp("pages") / "set <b>x</b>"
+    dicestack.save_demos(builtin_episodes[:10], path, description=HOSTILE)
+    return path
+
+
+@pytest.fixture(scope="module")
+def board(demos, tmp_path_factory):
+    page = tmp_path_factory.mktemp("board") / "board.html"
+    rows = dicestack.leaderboard(["knn", "linear_svr"], ["bc"], demos, episodes=4, seed=1, out=page, progress=False)
+    return page, rows
+
+
+def test_the_leaderboard_page_shows_the_json_rows_and_sorts(browser, board):
+    page, rows = board
+    open_page(browser, page)
+    assert_rows_equal(shown_rows(browser), rows)
+    # Sorting by realistic success: ascending, then descending on a second click; "-" stays last.
+    header = browser.find_element(By.CSS_SELECTOR, "th[data-key='test_error'] button")
+    header.click()
+    values = [r["test_error"][1] for r in shown_rows(browser)]
+    present = [v for v in values if v >= 0]
+    assert present == sorted(present) and values[len(present):] == [-1] * (len(values) - len(present))
+    header.click()
+    values = [r["test_error"][1] for r in shown_rows(browser)]
+    assert [v for v in values if v >= 0] == sorted(present, reverse=True)
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='regressor'] button").click()
+    names = [r["regressor"][0] for r in shown_rows(browser)]
+    assert names == sorted(names, key=str.lower) or names == sorted(names)
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='rank'] button").click()
+    assert_rows_equal(shown_rows(browser), rows)  # back in table order
+    assert no_console_errors(browser) == []
+
+
+def test_a_preview_loads_and_each_learned_row_links_its_per_episode_results(browser, board):
+    page, rows = board
+    open_page(browser, page)
+    img = preview_loads(browser, "img.preview")
+    assert img.get_attribute("loading") == "lazy"
+    links = browser.find_elements(By.CSS_SELECTOR, "#board tbody a")
+    learned = [r for r in rows if r["learner"] != "playback"]
+    assert len(links) == len(learned)
+    for link, row in zip(links, learned):
+        info = json.loads((page.parent / link.get_attribute("href").split(page.parent.as_uri() + "/")[1]).read_text())
+        # LeRobot's eval_info.json: per_episode entries and the aggregate with its count.
+        assert info["row"] == {k: row[k] for k in ("regressor", "learner", "features")}
+        assert info["aggregated"]["n_episodes"] == row["episodes"] == len(info["per_episode"])
+        assert sum(e["success"] for e in info["per_episode"]) == row["realistic_success"]
+        assert sum(e["stacked"] for e in info["per_episode"]) == row["stacked"]
+        assert info["aggregated"]["pc_success"] == pytest.approx(100 * row["realistic_success_rate"])
+        for e in info["per_episode"]:
+            assert {"episode_ix", "seed", "success", "sum_reward", "dice_in_cup", "wall_step", "length"} <= e.keys()
+            assert (e["wall_step"] is None) == (not e["wall_contact"])
+            assert e["wall_step"] is None or 0 <= e["wall_step"] < e["length"]
+        for video in info["video_paths"]:
+            assert (page.parent / "board_files" / video).stat().st_size > 1000
+    screenshot(browser, "leaderboard-page.png")
+    assert no_console_errors(browser) == []
+
+
+def test_text_from_the_demonstrations_shows_as_text(browser, board, demos):
+    page, _ = board
+    open_page(browser, page)
+    facts = browser.find_element(By.ID, "facts").text
+    assert HOSTILE in facts
+    assert str(demos) in facts
+    assert browser.execute_script("return window.pwned") is None
+    assert len(browser.find_elements(By.CSS_SELECTOR, "#facts b, #facts script")) == 0
+    assert no_console_errors(browser) == []
+
+
+def test_the_page_needs_no_network(board):
+    page, _ = board
+    text = page.read_text()
+    assert text.startswith("<!-- dicestack results page -->\n<!doctype html>")
+    for remote in ("http://", "https://", "//cdn"):
+        assert remote not in text.replace("http://www.w3.org", "")
+
+
+def test_a_users_file_is_not_replaced_by_a_page(demos, tmp_path):
+    mine = tmp_path / "mine.html"
+    mine.write_text("<p>my notes</p>")
+    with pytest.raises(ValueError, match="refusing to replace"):
+        dicestack.leaderboard(["knn"], ["bc"], demos, episodes=1, out=mine, progress=False)
+    assert mine.read_text() == "<p>my notes</p>"
+    folder = tmp_path / "board_files"
+    folder.mkdir()
+    (folder / "keep.txt").write_text("mine")
+    with pytest.raises(ValueError, match="board_files"):
+        dicestack.leaderboard(["knn"], ["bc"], demos, episodes=1, out=tmp_path / "board.html", progress=False)
+    assert (folder / "keep.txt").read_text() == "mine"
+    assert not (tmp_path / "board.html").exists()
+
+
+@pytest.mark.skipif(not os.environ.get("DICESTACK_EXE"), reason="the command line is not built")
+def test_evaluate_report_is_a_page_of_one_model(browser, demos, tmp_path):
+    exe = os.environ["DICESTACK_EXE"]
+    model = tmp_path / "m.dsm"
+    subprocess.run([exe, "train", "--demos", str(demos), "--regressor", "knn", "--out", str(model)], check=True,
+                   capture_output=True)
+    report = tmp_path / "report"
+    done = subprocess.run([exe, "evaluate", "--model", str(model), "--episodes", "4", "--seed", "2", "--json",
+                           "--report", str(report)], check=True, capture_output=True, text=True)
+    stats = json.loads(done.stdout)
+    open_page(browser, report / "index.html")
+    shown = shown_rows(browser)
+    assert len(shown) == 1
+    assert shown[0]["regressor"][0] == "knn"
+    assert shown[0]["realistic_success_rate"][1] == pytest.approx(stats["realistic_success_rate"])
+    assert shown[0]["stacked_rate"][1] == pytest.approx(stats["stacked_rate"])
+    preview_loads(browser, "img.preview")
+    info = json.loads((report / "index_files" / "eval_info" / "row-01.json").read_text())
+    assert [e["index"] for e in info["per_episode"]] == [0, 1, 2, 3]
+    assert sum(e["success"] for e in info["per_episode"]) == round(4 * stats["realistic_success_rate"])
+    screenshot(browser, "evaluate-report.png")
+    assert no_console_errors(browser) == []
+    # Again over its own report: replaced; over a user's folder: refused.
+    subprocess.run([exe, "evaluate", "--model", str(model), "--episodes", "2", "--report", str(report)], check=True,
+                   capture_output=True)
+    assert len(json.loads((report / "index_files" / "eval_info" / "row-01.json").read_text())["per_episode"]) == 2
+    theirs = tmp_path / "theirs"
+    theirs.mkdir()
+    refused = subprocess.run([exe, "evaluate", "--model", str(model), "--episodes", "2", "--report", str(theirs)],
+                             capture_output=True, text=True)
+    assert refused.returncode != 0 and "refusing to replace" in refused.stderr
+    assert list(theirs.iterdir()) == []
