@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Time to first render of results pages in headless Chromium (issue 26): loads each page RUNS
-times from file:// and prints the median of the first contentful paint and of the moment the
-page's script has built its table (body[data-ready]), with the page's size without media.
+"""Time to first render of results pages and episode viewers in headless Chromium (issue 26):
+loads each page RUNS times from file:// and prints the median of the first contentful paint and
+of the moment the page's script has built it (body[data-ready]), with the page's size without media.
 
     /usr/bin/python3 bench/pages_bench.py PAGE.html [PAGE.html ...] [--runs 5]
 """

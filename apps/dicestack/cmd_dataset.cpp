@@ -1,5 +1,5 @@
-// `dicestack import cupdice` and `dicestack dataset info|validate`: getting demonstrations in,
-// and looking at them (robomimic and Minari: cmd_interop.cpp).
+// `dicestack import cupdice` and `dicestack dataset info|validate|view`: getting demonstrations
+// in, and looking at them (robomimic and Minari: cmd_interop.cpp).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +12,8 @@
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/results_page.hpp>
+#include <dicestack/learners/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"
@@ -28,6 +30,19 @@ struct DatasetOptions {
   std::filesystem::path dir;
   bool json = false;
 };
+
+struct ViewOptions {
+  WorldOption world;
+  std::filesystem::path set, out;
+};
+
+int run_view(const ViewOptions& opt) {
+  const DemoSet set = read_demo_set(resolve_demo_set(opt.set, opt.world.load()));
+  write_dataset_viewer(set, opt.set.string(), opt.out);
+  print_line("wrote " + opt.out.string() + " (" + std::to_string(set.episodes.size()) + " episodes; their data in " +
+             page_media_folder(opt.out).string() + ")");
+  return 0;
+}
 
 int run_import(const ImportOptions& opt) {
   const DemoSet set = import_cupdice(opt.src, opt.world.load());
@@ -186,6 +201,12 @@ void add_dataset_commands(CLI::App& app) {
   cmd = dataset->add_subcommand("validate", "Check every file of a set; exit 1 with the first problem");
   cmd->add_option("dir", check->dir, "Demonstration folder")->required();
   cmd->callback([check] { run_validate(*check); });
+  auto view = std::make_shared<ViewOptions>();
+  cmd = dataset->add_subcommand("view", "An episode browser: a page that plays each episode beside plots of its states and actions");
+  view->world.add_to(*cmd);
+  cmd->add_option("set", view->set, "Demonstration folder, builtin or human")->required();
+  cmd->add_option("--out", view->out, "The page, PAGE.html; the episodes' data go to PAGE_files/ beside it")->required();
+  cmd->callback([view] { run_view(*view); });
   add_interop_commands(*import, *dataset);
 }
 

@@ -13,9 +13,15 @@
 #include <dicestack/core/video.hpp>
 #include <dicestack/version.hpp>
 
+#include "page_files.hpp"
+
 namespace dicestack {
 namespace fs = std::filesystem;
 using nlohmann::json;
+using page::check_marked_folder;
+using page::is_marked_folder;
+using page::script_safe;
+using page::write_marker;
 
 namespace {
 
@@ -75,20 +81,6 @@ json eval_info(const LeaderboardRow& row, const std::vector<std::string>& videos
 
 std::string preview_file(std::size_t index, std::size_t rows, const char* kind) {
   return "previews/" + row_name(index, rows) + "-" + kind + ".gif";
-}
-
-// JSON that may sit inside <script>: no "<", ">" or "&" (only strings can hold them; \u escapes
-// read back the same).
-std::string script_safe(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    if (c == '<') out += "\\u003c";
-    else if (c == '>') out += "\\u003e";
-    else if (c == '&') out += "\\u0026";
-    else out += c;
-  }
-  return out;
 }
 
 // The page's script: builds the facts and the table from the inlined data (as text nodes), and
@@ -202,13 +194,21 @@ img.success { outline: 2px solid #2a8; } img.failure { outline: 2px solid #c44; 
 
 }  // namespace
 
-std::filesystem::path page_media_folder(const fs::path& page) {
-  return page.parent_path() / (page.stem().string() + "_files");
+namespace page {
+
+// JSON that may sit inside <script>: no "<", ">" or "&" (only strings can hold them; \u escapes
+// read back the same).
+std::string script_safe(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
+  }
+  return out;
 }
-
-Ownership results_page_ownership() { return Ownership::first_line("dicestack results page", {kResultsPageMarker}); }
-
-namespace {
 
 bool is_marked_folder(const fs::path& folder, const char* marker, const char* format) {
   std::error_code ec;
@@ -232,6 +232,16 @@ void write_marker(const fs::path& file, const char* format) {
   f.stream() << json{{"format", format}, {"version", 1}, {"dicestack_version", DICESTACK_VERSION}}.dump(2) << '\n';
   f.commit();
 }
+
+}  // namespace page
+
+std::filesystem::path page_media_folder(const fs::path& page) {
+  return page.parent_path() / (page.stem().string() + "_files");
+}
+
+Ownership results_page_ownership() { return Ownership::first_line("dicestack results page", {kResultsPageMarker}); }
+
+namespace {
 
 // The media into an empty folder.
 void fill_media(const Leaderboard& board, const fs::path& folder) {

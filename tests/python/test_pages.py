@@ -7,6 +7,7 @@ import json
 import os
 import shutil
 import subprocess
+import time
 
 import pytest
 
@@ -215,3 +216,43 @@ def test_evaluate_report_is_a_page_of_one_model(browser, demos, tmp_path):
                              capture_output=True, text=True)
     assert refused.returncode != 0 and "refusing to replace" in refused.stderr
     assert list(theirs.iterdir()) == []
+
+
+@pytest.mark.skipif(not os.environ.get("DICESTACK_EXE"), reason="the command line is not built")
+def test_the_episode_viewer_lists_the_set_and_its_cursor_follows_the_playback(browser, demos, builtin_episodes, tmp_path):
+    exe = os.environ["DICESTACK_EXE"]
+    page = tmp_path / "view.html"
+    subprocess.run([exe, "dataset", "view", str(demos), "--out", str(page)], check=True, capture_output=True)
+    open_page(browser, page)
+    listed = browser.execute_script("""
+        return [...document.querySelectorAll('#list tbody tr')].map(tr => [...tr.children].map(td => td.textContent));""")
+    episodes = builtin_episodes[:10]
+    assert [row[1] for row in listed] == [f"episode_{i:04d}" for i in range(10)]
+    assert [int(row[2]) for row in listed] == [len(e.states) for e in episodes]
+    assert [row[4] == "yes" for row in listed] == [bool(e.stacked) for e in episodes]
+    assert [row[3] == "yes" for row in listed] == [bool(e.realistic_success) for e in episodes]
+    assert HOSTILE in browser.find_element(By.ID, "facts").text
+    assert browser.execute_script("return window.pwned") is None
+    # Choose the third episode; its numbers load, the cursor starts at step 0 and moves while it plays.
+    browser.find_elements(By.CSS_SELECTOR, "#list tbody tr")[2].click()
+    WebDriverWait(browser, 10).until(lambda d: d.execute_script("return document.body.dataset.loaded === '2'"))
+    cursor = browser.find_element(By.ID, "cursor")
+    assert cursor.get_attribute("data-step") == "0"
+    start = browser.execute_script("return arguments[0].getBoundingClientRect().left", cursor)
+    browser.find_element(By.ID, "play").click()
+    WebDriverWait(browser, 10).until(lambda d: int(cursor.get_attribute("data-step")) >= 20)
+    moved = browser.execute_script("return arguments[0].getBoundingClientRect().left", cursor)
+    assert moved > start
+    browser.find_element(By.ID, "play").click()  # pause: the cursor stays
+    paused = cursor.get_attribute("data-step")
+    time.sleep(0.3)
+    assert cursor.get_attribute("data-step") == paused
+    screenshot(browser, "episode-viewer.png")
+    assert no_console_errors(browser) == []
+    # The page is ours to replace; a user's folder beside it is not.
+    subprocess.run([exe, "dataset", "view", str(demos), "--out", str(page)], check=True, capture_output=True)
+    other = tmp_path / "other.html"
+    (tmp_path / "other_files").mkdir()
+    refused = subprocess.run([exe, "dataset", "view", str(demos), "--out", str(other)], capture_output=True, text=True)
+    assert refused.returncode != 0 and "other_files" in refused.stderr
+    assert not other.exists()

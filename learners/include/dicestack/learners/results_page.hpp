@@ -7,6 +7,7 @@
 #include <string>
 
 #include <dicestack/core/atomic_file.hpp>
+#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/leaderboard.hpp>
 
 namespace dicestack {
@@ -40,5 +41,13 @@ void check_report_replaceable(const std::filesystem::path& dir);
 /// `dicestack evaluate --report DIR`: DIR holds index.html and its media folder index_files/,
 /// written whole; an existing DIR is replaced only if it is a report dicestack wrote.
 void write_report_folder(const Leaderboard& board, const std::filesystem::path& dir);
+
+/// `dicestack dataset view`: an episode browser for `set` (named `name` on the page). The page
+/// lists the episodes with their outcomes; the chosen one plays as an animation drawn from its
+/// recorded states, in step with plots of the cup's x, y and angle, the dice's heights and the
+/// three actions, a cursor following the playback. Each episode's numbers are a script in
+/// <page>_files/episodes/ that the page loads when it is chosen (a file:// page cannot fetch),
+/// so the page stays small for any number of episodes. Replaces only a page and folder of ours.
+void write_dataset_viewer(const DemoSet& set, const std::string& name, const std::filesystem::path& page);
 
 }  // namespace dicestack
