@@ -28,6 +28,7 @@ packages=(
   python3-pytest python3-sklearn python3-matplotlib  # its tests and examples
   libhdf5-dev             # robomimic and Minari HDF5 export/import (dicestack_interop)
   python3-h5py            # the tests that read the exported HDF5 files
+  python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` and its test
   libopenmpi-dev openmpi-bin  # running on MPI ranks (docs/scaling.md); without them the tool runs alone
   chromium chromium-driver python3-selenium  # the results pages' tests in a headless browser
 )

@@ -213,7 +213,7 @@ std::string viewer_html(const DemoSet& set, const std::string& name, const std::
                     {"wall_contact", e.outcome.wall_contact},
                     {"dice_in_cup", e.outcome.dice_in_cup},
                     {"origin", e.origin},
-                    {"script", media + "/" + episode_script(i)}});
+                    {"script", page::url_segment(media) + "/" + episode_script(i)}});
   }
   const auto& w = set.world.walls;
   const int width = 450, height = static_cast<int>(std::lround(width * (w.ceiling_y + w.left_x) / (w.right_x + w.left_x)));

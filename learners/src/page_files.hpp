@@ -10,6 +10,10 @@ namespace dicestack::page {
 /// <script> and read back the same.
 std::string script_safe(const std::string& text);
 
+/// `name` as one segment of a relative URL: every byte but letters, digits and "-._~" %-escaped
+/// (a page's folder may be named "my #1 board_files").
+std::string url_segment(const std::string& name);
+
 /// True when `folder` is a real folder (not a link) holding `marker`, a JSON object with
 /// "format": `format`.
 bool is_marked_folder(const std::filesystem::path& folder, const char* marker, const char* format);

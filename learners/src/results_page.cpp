@@ -1,6 +1,7 @@
 #include <dicestack/learners/results_page.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -210,6 +211,21 @@ std::string script_safe(const std::string& text) {
   return out;
 }
 
+std::string url_segment(const std::string& name) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : name) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
 bool is_marked_folder(const fs::path& folder, const char* marker, const char* format) {
   std::error_code ec;
   if (fs::symlink_status(folder, ec).type() != fs::file_type::directory) return false;
@@ -292,7 +308,7 @@ std::string results_page_html(const Leaderboard& board, const std::string& media
   const auto& w = board.world.walls;
   const double aspect = (w.ceiling_y + w.left_x) / (w.right_x + w.left_x);
   json rows = json::array();
-  const std::string prefix = media.empty() ? "" : media + "/";
+  const std::string prefix = media.empty() ? "" : page::url_segment(media) + "/";
   for (std::size_t i = 0; i < board.rows.size(); ++i) {
     const LeaderboardRow& r = board.rows[i];
     json row = json::parse(leaderboard_row_json(r));

@@ -121,6 +121,12 @@ TEST(ResultsPage, NoTextFromTheRunCanCloseItsScript) {
   EXPECT_EQ(data["rows"][0]["regressor"], "</script><script>alert(1)</script>");
 }
 
+TEST(ResultsPage, RefersToAMediaFolderWhateverItsName) {
+  const std::string page = results_page_html(small_board(), "my #1 b\xc3\xb6" "ard_files");
+  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/previews/row-01-success.gif\""), std::string::npos);
+  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/eval_info/row-01.json\""), std::string::npos);
+}
+
 TEST(ResultsPage, AUsersFolderBesideThePageIsRefusedBeforeAnythingIsWritten) {
   const fs::path dir = test::scratch_path("dicestack_page_refuse_test");
   fs::remove_all(dir);
