@@ -10,6 +10,8 @@
 #   --build-only  configure and build, run nothing
 #   CTEST_ARGS    passed to ctest, e.g. -- -R Cmaes
 #
+# A unity build (a few sources of a target compiled as one file: about half the build time);
+# DICESTACK_UNITY_BUILD=OFF builds file by file, for incremental rebuilds while fixing a finding.
 # Leak checking is on; scripts/lsan.supp suppresses only leaks allocated inside other projects'
 # libraries (today one: libdbus's, under SDL_Init), and the headless player draws with SDL's
 # software renderer here (tests/CMakeLists.txt says why). The pytest suites run with the ASan
@@ -48,7 +50,7 @@ if [ -x /usr/bin/python3 ]; then python_args=(-DPython3_EXECUTABLE=/usr/bin/pyth
 
 start=$(date +%s)
 mkdir -p "$build"
-cmake -S "$root" -B "$build" -DDICESTACK_SANITIZE=ON \
+cmake -S "$root" -B "$build" -DDICESTACK_SANITIZE=ON -DCMAKE_UNITY_BUILD="${DICESTACK_UNITY_BUILD:-ON}" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" "${python_args[@]}" \
   > "$build/configure.log" 2>&1 || { cat "$build/configure.log" >&2; die "configuring $build failed"; }
 grep -E 'dicestack:|Python tests are skipped|example tests are skipped|headless play test is skipped' \

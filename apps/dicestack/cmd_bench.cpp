@@ -37,10 +37,6 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Runs the benchmark's episodes through DiceEnv (the framework) on `threads` threads and
 // records each episode's outcome. Actions match bare_box2d_seconds draw for draw.
 double framework_seconds(const WorldConfig& config, const SimOptions& opt, int threads, std::vector<Outcome>* outcomes) {

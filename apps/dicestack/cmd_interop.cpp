@@ -90,21 +90,17 @@ int run_import_file(const ImportOptions& opt, const std::string& format) {
   return 0;
 }
 
-struct BenchOptions {
+struct InteropBenchOptions {
   WorldOption world;
   std::vector<std::string> demos{"builtin", "human"};
   int repeats = 3;
   bool json = false;
 };
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Export and import throughput (frames/s) of each set in both layouts: medians of `repeats` runs.
 // "export" and "import" include reading or writing our folder (what the commands cost); the
 // "hdf5" figures time the HDF5 side alone (a set in memory to the file, the file to a set).
-int run_bench_dataset(const BenchOptions& opt) {
+int run_bench_dataset(const InteropBenchOptions& opt) {
   const WorldConfig world = opt.world.load();
   const fs::path scratch = fs::temp_directory_path() / ("dicestack-bench-dataset-" + std::to_string(getpid()));
   fs::remove_all(scratch);
@@ -197,7 +193,7 @@ void add_interop_commands(CLI::App& import, CLI::App& dataset) {
 }
 
 void add_bench_dataset_command(CLI::App& bench) {
-  auto opt = std::make_shared<BenchOptions>();
+  auto opt = std::make_shared<InteropBenchOptions>();
   CLI::App* cmd = bench.add_subcommand("dataset", "Export and import throughput (frames/s) of the robomimic and Minari layouts");
   opt->world.add_to(*cmd);
   cmd->add_option("--demos", opt->demos, "Sets to measure (folders, builtin, human)")->capture_default_str();

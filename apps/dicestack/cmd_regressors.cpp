@@ -83,7 +83,7 @@ int run_list(const ListOptions& opt) {
   return 0;
 }
 
-struct BenchOptions {
+struct RegressorBenchOptions {
   WorldOption world;
   std::filesystem::path demos, export_dir;
   std::string split = "episodes";
@@ -93,10 +93,6 @@ struct BenchOptions {
   int calls = 2000;
   bool json = false;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Writes X and Y of one side of the split as CSV with a header (17 significant digits, so
 // another tool reads back exactly these doubles).
@@ -121,7 +117,7 @@ void export_split(const Split& split, const std::filesystem::path& dir) {
   write_matrix_csv(dir / "test_y.csv", split.test.y, action_names());
 }
 
-int run_bench(const BenchOptions& opt) {
+int run_bench(const RegressorBenchOptions& opt) {
   const WorldConfig world = opt.world.load();
   const auto dir = opt.demos.empty() ? human_demo_set(world) : opt.demos;
   const DemoSet set = read_demo_set(dir);
@@ -195,7 +191,7 @@ void add_learners_command(CLI::App& app) {
 }
 
 void add_bench_regressors_command(CLI::App& bench) {
-  auto opt = std::make_shared<BenchOptions>();
+  auto opt = std::make_shared<RegressorBenchOptions>();
   CLI::App* cmd = bench.add_subcommand("regressors", "Fit time, predict_row latency and eq. 9 errors of each regressor");
   opt->world.add_to(*cmd);
   cmd->add_option("--demos", opt->demos, "Demonstration folder (default: the paper's 68 recordings, converted)");

@@ -30,6 +30,11 @@ void print_line(const std::string& text);
 /// Prints progress on stderr (overwriting the line when stderr is a terminal).
 void print_progress(const std::string& text);
 
+/// Seconds since `t0` on the steady clock (the benchmarks' timings).
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 /// A progress bar on stderr: [#####-----] 50% text, elapsed and estimated time left. On a
 /// terminal it redraws one line; otherwise it prints at most one line per `quiet_seconds`.
 class ProgressBar {

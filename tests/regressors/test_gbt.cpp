@@ -27,7 +27,7 @@ Matrix rows(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
   return x;
 }
 
-Matrix labels(const Matrix& x) {
+Matrix gbt_labels(const Matrix& x) {
   Matrix y(x.rows(), 3);
   for (Eigen::Index i = 0; i < x.rows(); ++i)
     y.row(i) << std::sin(x(i, 0)) + x(i, 1) * x(i, 2), x(i, 3) > 0 ? 1.0 : -0.5, x(i, x.cols() - 1);
@@ -37,7 +37,7 @@ Matrix labels(const Matrix& x) {
 std::unique_ptr<Regressor> fitted() {
   auto r = RegressorRegistry::global().create("gbt", {"trees=20", "max_depth=6"});
   const Matrix x = rows(600, 27, 1);
-  r->fit(x, labels(x), 3);
+  r->fit(x, gbt_labels(x), 3);
   return r;
 }
 

@@ -35,7 +35,7 @@ Matrix random_rows(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
   return x;
 }
 
-Matrix labels(const Matrix& x) {
+Matrix model_labels(const Matrix& x) {
   Matrix y(x.rows(), 3);
   for (Eigen::Index i = 0; i < x.rows(); ++i) y.row(i) << x(i, 0) - x(i, x.cols() - 1), 0.5 * x(i, 1), x(i, 2);
   return y;
@@ -68,7 +68,7 @@ void reseal(nlohmann::json& header, const std::string& payload) {
 TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
   const FeatureMap& f = feature_map("state+clock+start");
   const Matrix x = random_rows(200, 27, 1);
-  const Model m = Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3, nullptr, f);
+  const Model m = Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3, nullptr, f);
   const fs::path path = temp_model("features");
   save_model(m, path);
   const Model back = load_model(path);
@@ -86,7 +86,7 @@ TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
 TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
   const Matrix x = random_rows(200, 24, 2);
   const fs::path path = temp_model("mismatch");
-  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3), path);
   auto [header, payload] = read_parts(path);
   header["features"] = "state+clock";  // 25 inputs, but the regressor and the header say 24
   reseal(header, payload);
@@ -104,7 +104,7 @@ TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
 TEST(ModelFile, TheChecksumCoversTheHeader) {
   const Matrix x = random_rows(200, 24, 5);
   const fs::path path = temp_model("header");
-  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3), path);
   auto [header, payload] = read_parts(path);
   header["x_standardizer"]["mean"][3] = 0.25;  // a changed standardiser, payload untouched
   write_parts(path, header, payload);
@@ -136,7 +136,7 @@ TEST(ModelFile, MatrixPayloadShapesAreCheckedBeforeAllocating) {
   const Matrix x = random_rows(100, 24, 6);
   for (const char* name : {"linear_svr", "knn", "mlp"}) {
     auto r = RegressorRegistry::global().create(name);
-    r->fit(x, labels(x), 1);
+    r->fit(x, model_labels(x), 1);
     std::string payload = r->save_payload();
     const std::uint64_t rows = 1ULL << 31;  // the first matrix's row count: 2^31 x cols doubles
     std::memcpy(payload.data() + 16, &rows, sizeof rows);
@@ -148,7 +148,7 @@ TEST(ModelFile, MatrixPayloadShapesAreCheckedBeforeAllocating) {
 TEST(ModelFile, RbfSvrPayloadCountsAreChecked) {
   const Matrix x = random_rows(40, 4, 9);
   auto r = RegressorRegistry::global().create("rbf_svr");
-  r->fit(x, labels(x), 1);
+  r->fit(x, model_labels(x), 1);
   const std::string payload = r->save_payload();
   auto load = [&](const std::string& text, std::size_t inputs) {
     return test::error_of([&] { RegressorRegistry::global().create("rbf_svr")->load_payload(text, inputs, 3); });
@@ -191,7 +191,7 @@ TEST(ModelFile, BadParametersAreRefusedNamingTheFile) {
   // ("rbf_svr: parameter ...") without the file's name.
   const Matrix x = random_rows(30, 24, 7);
   const fs::path path = temp_model("params");
-  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, labels(x), 3), path);
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3), path);
   const auto [original, payload] = read_parts(path);
   for (const auto& [key, value, expected] : {std::tuple<const char*, const char*, const char*>{
                                                  "epsilon", "-1", "parameter \"epsilon\" must be >= 0, got -1"},
@@ -210,7 +210,7 @@ TEST(ModelFile, BadParametersAreRefusedNamingTheFile) {
 
 TEST(ModelFile, VersionOneReadsAsTheStateMap) {
   const Matrix x = random_rows(200, 24, 4);
-  const Model m = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
+  const Model m = Model::train(RegressorRegistry::global().create("knn"), x, model_labels(x), 3);
   const fs::path path = temp_model("v1");
   save_model(m, path);
   auto [header, payload] = read_parts(path);
@@ -261,7 +261,7 @@ PickleLoader mean_loader(int* calls) {
 
 TEST(ModelFile, PickledRegressorsKeepTheirPickleBesideTheModel) {
   const Matrix x = random_rows(50, 24, 5);
-  const Model m = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, labels(x), 3);
+  const Model m = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, model_labels(x), 3);
   const fs::path path = temp_model("pickled"), pkl = pickle_path(path);
   EXPECT_EQ(pkl.string(), path.string() + ".pkl");
   save_model(m, path);
@@ -294,13 +294,13 @@ TEST(ModelFile, PickledRegressorsKeepTheirPickleBesideTheModel) {
 
 TEST(ModelFile, APickleThatIsNotOursIsNeverReplaced) {
   const Matrix x = random_rows(50, 24, 6);
-  const Model pickled = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, labels(x), 3);
+  const Model pickled = Model::train(std::make_unique<MeanPickled>("py_mean", Params()), x, model_labels(x), 3);
   const fs::path path = temp_model("users_pickle"), pkl = pickle_path(path);
   std::ofstream(pkl) << "the user's own pickle";
   EXPECT_THAT(test::error_of([&] { save_model(pickled, path); }), HasSubstr(pkl.string() + ": exists and is not a pickle saved with the dicestack model"));
   EXPECT_FALSE(fs::exists(path));
   // A built-in model beside it leaves the user's file alone...
-  const Model knn = Model::train(RegressorRegistry::global().create("knn"), x, labels(x), 3);
+  const Model knn = Model::train(RegressorRegistry::global().create("knn"), x, model_labels(x), 3);
   save_model(knn, path);
   EXPECT_TRUE(fs::exists(pkl));
   fs::remove(pkl);
