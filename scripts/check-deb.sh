@@ -25,7 +25,8 @@ cmake --build "$build" -j "$jobs"
 deb=$(ls "$build"/dicestack_*.deb)
 echo "check-deb.sh: built $deb ($(du -h "$deb" | cut -f1))"
 dpkg-deb -c "$deb" | awk '{print $6}' > "$build/deb-files.txt"
-for want in ./usr/bin/dicestack ./usr/lib/libdicestack_learners.so ./usr/lib/cmake/dicestack/dicestackConfig.cmake \
+lib=./usr/lib/$(dpkg-architecture -qDEB_HOST_MULTIARCH)  # GNUInstallDirs' libdir under /usr
+for want in ./usr/bin/dicestack "$lib/libdicestack_learners.so.0" "$lib/cmake/dicestack/dicestackConfig.cmake" \
             ./usr/lib/python3/dist-packages/dicestack/__init__.py ./usr/include/dicestack/learners/leaderboard.hpp; do
   grep -qx "$want" "$build/deb-files.txt" || fail "the package lacks $want"
 done
@@ -34,7 +35,7 @@ echo "check-deb.sh: depends: $(dpkg-deb -f "$deb" Depends)"
 apt-get install --simulate "$deb" > "$build/simulate.log" 2>&1 || { cat "$build/simulate.log"; fail "apt cannot resolve the package's dependencies"; }
 if [ $install -eq 1 ]; then
   apt-get install -y "$deb" > "$build/install.log" 2>&1 || { cat "$build/install.log"; fail "apt-get install failed"; }
-  trap 'apt-get remove -y dicestack > /dev/null 2>&1 || true' EXIT
+  trap 'apt-get purge -y dicestack > /dev/null 2>&1 || true' EXIT
   cd "$(mktemp -d)"
   env -u PYTHONPATH /usr/bin/dicestack --version
   env -u PYTHONPATH $python -c "import dicestack; print('import dicestack:', dicestack.__file__); dicestack.DiceStackEnv().reset(seed=1)"
