@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/mount.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -125,6 +126,60 @@ TEST(AtomicFile, DeadRunsLeftoversAreRemovedLiveOnesKept) {
   EXPECT_TRUE(fs::exists(parent));
   EXPECT_TRUE(fs::exists(other)) << "only leftovers of this target";
   fs::remove_all(dir);
+}
+
+// A full disk (a 16 KiB tmpfs, where this machine lets the test mount one): the error names the
+// path the user chose and the operating system's reason, the old output stays, nothing is left.
+class FullDisk : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = unique_dir("full");
+    if (::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=16k") != 0) GTEST_SKIP() << "cannot mount a tmpfs here";
+    mounted_ = true;
+  }
+  void TearDown() override {
+    if (mounted_) ::umount(dir_.c_str());
+    fs::remove_all(dir_);
+  }
+  fs::path dir_;
+  bool mounted_ = false;
+};
+
+TEST_F(FullDisk, AFileSaysNoSpaceNamingTheUsersPathAndKeepsTheOldOne) {
+  const fs::path out = dir_ / "table.txt";
+  std::ofstream(out) << "old\n";
+  try {
+    AtomicFile f(out, kText);
+    f.stream() << "new\n" << std::string(64 * 1024, 'x');
+    f.commit();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(out.string() + ": write failed: No space left on device"));
+    EXPECT_THAT(e.what(), ::testing::Not(HasSubstr(".tmp")));
+  }
+  std::ifstream in(out);
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first, "old");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 1) << "only the old file";
+}
+
+TEST_F(FullDisk, AFolderSaysNoSpaceNamingTheFolderNotItsScratchCopy) {
+  const fs::path out = dir_ / "set";
+  try {
+    replace_folder(
+        out, [](const fs::path&) { return true; }, [](const fs::path&) {},
+        [](const fs::path& tmp) {
+          AtomicFile f(tmp / "episode_0003.csv", kText, AtomicFile::Leftovers::skip);
+          f.stream() << std::string(64 * 1024, 'x');
+          f.commit();
+        });
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr((out / "episode_0003.csv").string() + ": write failed: No space left on device"));
+    EXPECT_THAT(e.what(), ::testing::Not(HasSubstr(".tmp")));
+  }
+  EXPECT_TRUE(fs::is_empty(dir_)) << "nothing half-written left";
 }
 
 }  // namespace

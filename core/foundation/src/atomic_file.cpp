@@ -1,5 +1,6 @@
 #include <dicestack/core/atomic_file.hpp>
 
+#include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -127,14 +128,29 @@ void replace_folder(const fs::path& dir, const std::function<bool(const fs::path
   check(dir);
   const fs::path tmp = temporary_sibling(dir, "tmp");
   const fs::path old = temporary_sibling(dir, "old");
-  fs::create_directory(tmp);
+  if (!fs::create_directory(tmp, ec) && ec) throw InputError(dir.string() + ": cannot write: " + ec.message());
+  // A failure names what the user chose: the scratch folder's name becomes the folder's.
+  auto as_users = [&](const std::string& message) {
+    std::string out = message;
+    const std::string scratch = tmp.string();
+    for (std::size_t at; (at = out.find(scratch)) != std::string::npos;) out.replace(at, scratch.size(), dir.string());
+    return out;
+  };
   try {
     fill(tmp);
     if (fs::exists(fs::symlink_status(dir, ec))) fs::rename(dir, old);
     fs::rename(tmp, dir);
+  } catch (const InputError& e) {
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+    throw InputError(as_users(e.what()));
+  } catch (const fs::filesystem_error& e) {
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+    throw InputError(dir.string() + ": cannot write: " + e.code().message());
   } catch (...) {
     fs::remove_all(tmp, ec);
-    if (!fs::exists(dir) && fs::exists(old)) fs::rename(old, dir, ec);
+    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
     throw;
   }
   fs::remove_all(old, ec);
@@ -171,8 +187,9 @@ AtomicFile::AtomicFile(fs::path path, const Ownership& owner, Leftovers leftover
     }
   }
   tmp_ = temporary_sibling(path_, "tmp");
+  errno = 0;
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw InputError(tmp_.string() + ": cannot create file");
+  if (!out_) throw InputError(path_.string() + ": cannot write: " + os_reason(errno));
 }
 
 AtomicFile::~AtomicFile() {
@@ -183,15 +200,41 @@ AtomicFile::~AtomicFile() {
   }
 }
 
+namespace {
+
+// Why writing to `file` fails: the stream keeps no reason, so one more byte is written to its
+// end the plain way and the system's answer returned (ENOSPC, EDQUOT, EIO, EROFS), or 0.
+int write_failure_reason(const fs::path& file) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd < 0) return errno;
+  int reason = 0;
+  if (::write(fd, "\n", 1) < 0) reason = errno;
+  else if (::fsync(fd) != 0) reason = errno;
+  ::close(fd);
+  return reason;
+}
+
+}  // namespace
+
 void AtomicFile::commit() {
+  errno = 0;
   out_.flush();
   const bool ok = static_cast<bool>(out_);
+  const int flush_errno = ok ? 0 : errno;
   out_.close();
-  if (!ok || out_.fail()) throw InputError(tmp_.string() + ": write failed");
+  if (!ok || out_.fail()) {
+    const int reason = flush_errno ? flush_errno : write_failure_reason(tmp_);
+    throw InputError(path_.string() + ": write failed: " + os_reason(reason));
+  }
   std::error_code ec;
   fs::rename(tmp_, path_, ec);
-  if (ec) throw InputError(path_.string() + ": cannot rename " + tmp_.string() + " into place: " + ec.message());
+  if (ec) throw InputError(path_.string() + ": cannot put the new file in place: " + ec.message());
   committed_ = true;
+}
+
+std::string os_reason(int error) {
+  if (error == 0) return "the operating system gave no reason (a stream error)";
+  return std::system_category().message(error);
 }
 
 }  // namespace dicestack

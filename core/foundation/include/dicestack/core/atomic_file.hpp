@@ -42,13 +42,17 @@ std::filesystem::path temporary_sibling(const std::filesystem::path& target, std
 std::vector<std::filesystem::path> dead_leftovers(const std::filesystem::path& target, std::string_view tag);
 
 /// Writes a whole folder beside `dir` with `fill`, then swaps it in (a previous `dir` is moved
-/// aside, then removed), so `dir` is never half-written. First cleans dead runs' leftovers of
+/// aside, then removed), so `dir` is never half-written. A failure (InputError, filesystem
+/// errors) is thrown as an InputError naming `dir` (and paths inside it), not the scratch folder. First cleans dead runs' leftovers of
 /// `dir`: their scratch folders are removed, and a folder a run moved aside and died before
 /// replacing is put back when `dir` is gone and `is_ours` recognises it (it is the only copy).
 /// Then `check` throws for a `dir` that is not ours; nothing is touched after a throw.
 void replace_folder(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& is_ours,
                     const std::function<void(const std::filesystem::path&)>& check,
                     const std::function<void(const std::filesystem::path&)>& fill);
+
+/// The operating system's words for `error` (an errno value): "No space left on device".
+std::string os_reason(int error);
 
 /// True when the pid names a process that exists (kill(pid, 0) does not fail with ESRCH).
 bool process_is_running(long pid);
