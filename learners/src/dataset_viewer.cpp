@@ -177,7 +177,14 @@ function choose(i) {
   body.children[i].classList.add("chosen");
   document.getElementById("name").textContent = data.episodes[i].name;
   if (episodes.has(i)) window.dicestackEpisode(i, { steps: episodes.get(i) });
-  else document.head.append(el("script", { src: data.episodes[i].script }));
+  else {
+    const script = el("script", { src: data.episodes[i].script });
+    script.addEventListener("error", () => {  // the page moved without its folder
+      if (chosen === i) document.getElementById("name").textContent = data.episodes[i].name + ": its data (" +
+        data.episodes[i].script + ") is missing; keep the _files folder beside the page";
+    });
+    document.head.append(script);
+  }
 }
 function tick(now) {
   if (!playing) return;

@@ -256,3 +256,11 @@ def test_the_episode_viewer_lists_the_set_and_its_cursor_follows_the_playback(br
     refused = subprocess.run([exe, "dataset", "view", str(demos), "--out", str(other)], capture_output=True, text=True)
     assert refused.returncode != 0 and "other_files" in refused.stderr
     assert not other.exists()
+    # A page moved without its folder says what is missing when an episode is chosen.
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    shutil.copy(page, moved / "view.html")
+    open_page(browser, moved / "view.html")
+    browser.find_elements(By.CSS_SELECTOR, "#list tbody tr")[1].click()
+    WebDriverWait(browser, 10).until(lambda d: "is missing" in d.find_element(By.ID, "name").text)
+    browser.get_log("browser")  # the failed load is reported there, as it should be
