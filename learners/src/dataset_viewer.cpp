@@ -4,7 +4,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
 #include <dicestack/learners/results_page.hpp>
 #include <dicestack/version.hpp>

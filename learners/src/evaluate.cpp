@@ -190,10 +190,12 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, c
         std::optional<DiceEnv> own;
         DiceEnv& env = episode_env(draw, envs.at(w), own);
         const State start = random_start_state(draw.world, episode_seed);
-        // Before step k the outcome covers steps 0..k-1: the first k that sees a wall names step k-1.
-        episode_options.before_step = [&t](const DiceEnv& e, std::size_t k) {
-          if (t.wall_step < 0 && e.outcome().wall_contact) t.wall_step = static_cast<int>(k) - 1;
-        };
+        // Only when results are asked for (a call per step): before step k the outcome covers
+        // steps 0..k-1, so the first k that sees a wall names step k-1.
+        if (request.results)
+          episode_options.before_step = [&t](const DiceEnv& e, std::size_t k) {
+            if (t.wall_step < 0 && e.outcome().wall_contact) t.wall_step = static_cast<int>(k) - 1;
+          };
         t.episode = rollout(env, timed, start, episode_seed, StepSource::policy, episode_options);
         if (t.wall_step < 0 && t.episode.outcome.wall_contact) t.wall_step = static_cast<int>(t.episode.size()) - 1;
         if (request.progress) request.progress(std::min(episodes, ++finished * ranks), episodes);

@@ -31,8 +31,6 @@ std::vector<RowPreview> unpack_previews(Unpacker& u) {
   return out;
 }
 
-void pack_rollouts(Packer& p, const std::vector<RowRollout>& rollouts) { p.put_vector(rollouts); }
-
 }  // namespace
 
 std::string pack_seed_result(const SeedResult& r) {
@@ -61,7 +59,7 @@ void pack_row(Packer& p, const LeaderboardRow& r) {
   p.put_string(r.regressor).put_string(r.learner).put_string(r.features);
   p.put(r.train_error).put(r.test_error).put(r.fit_s).put(r.us_per_step).put(r.dice_in_cup);
   p.put(r.episodes).put(r.stacked).put(r.walls).put(r.success);
-  pack_rollouts(p, r.rollouts);
+  p.put_vector(r.rollouts);
   pack_previews(p, r.success_preview);
   pack_previews(p, r.failure_preview);
 }

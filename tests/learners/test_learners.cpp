@@ -87,6 +87,48 @@ TEST(Evaluate, RatesAgreeWithRollingOutByHand) {
   EXPECT_EQ(s.mean_length, 80.0);
 }
 
+// Each rollout's results, the first wall contact's step included, as stepping the world by hand
+// finds them (the left push makes walls likely; some rollouts must touch one for the test to bite).
+TEST(Evaluate, PerRolloutResultsAgreeWithSteppingByHand) {
+  WorldConfig c;
+  c.episode.max_steps = 80;
+  std::vector<EpisodeResult> results;
+  EvalRequest request = test::eval_request(6, 9, 2, nullptr, InitialPush::left);
+  request.results = &results;
+  evaluate([] { return std::make_unique<Swing>(); }, c, request);
+  ASSERT_EQ(results.size(), 6u);
+  DiceEnv env(c);
+  int touched = 0;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const std::uint64_t seed = derive_seed(9, i);
+    Swing p;
+    p.reset(seed);
+    std::vector<State> states{env.reset_to(random_start_state(c, seed), seed)};
+    std::vector<Action> applied;
+    int wall_step = -1;
+    double reward = 0.0;
+    StepResult r;
+    do {
+      Action a = p.act(History{states, applied});
+      if (applied.empty()) a[0] -= 1.0;
+      r = env.step(a);
+      if (wall_step < 0 && r.info.outcome.wall_contact) wall_step = static_cast<int>(applied.size());
+      applied.push_back(r.applied);
+      reward += r.reward;
+      states.push_back(r.observation);
+    } while (!r.terminated && !r.truncated);
+    EXPECT_EQ(results[i].index, static_cast<int>(i));
+    EXPECT_EQ(results[i].seed, seed);
+    EXPECT_EQ(results[i].wall_step, wall_step) << "rollout " << i;
+    EXPECT_EQ(results[i].wall_contact, wall_step >= 0);
+    EXPECT_EQ(results[i].length, static_cast<int>(applied.size()));
+    EXPECT_DOUBLE_EQ(results[i].reward, reward);
+    EXPECT_EQ(results[i].success, r.info.outcome.realistic_success());
+    touched += wall_step >= 0 && wall_step < results[i].length - 1;
+  }
+  EXPECT_GT(touched, 0) << "no rollout touched a wall before its last step";
+}
+
 TEST(Evaluate, PlaybackReplaysARecordedRolloutExactly) {
   WorldConfig c;
   c.episode.max_steps = 50;

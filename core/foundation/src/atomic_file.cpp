@@ -136,21 +136,22 @@ void replace_folder(const fs::path& dir, const std::function<bool(const fs::path
     for (std::size_t at; (at = out.find(scratch)) != std::string::npos;) out.replace(at, scratch.size(), dir.string());
     return out;
   };
+  auto undo = [&] {  // the scratch copy goes; a folder moved aside comes back
+    fs::remove_all(tmp, ec);
+    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+  };
   try {
     fill(tmp);
     if (fs::exists(fs::symlink_status(dir, ec))) fs::rename(dir, old);
     fs::rename(tmp, dir);
   } catch (const InputError& e) {
-    fs::remove_all(tmp, ec);
-    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+    undo();
     throw InputError(as_users(e.what()));
   } catch (const fs::filesystem_error& e) {
-    fs::remove_all(tmp, ec);
-    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+    undo();
     throw InputError(dir.string() + ": cannot write: " + e.code().message());
   } catch (...) {
-    fs::remove_all(tmp, ec);
-    if (!fs::exists(dir, ec) && fs::exists(old, ec)) fs::rename(old, dir, ec);
+    undo();
     throw;
   }
   fs::remove_all(old, ec);
