@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/regressors/model.hpp>
 #include <dicestack/regressors/score.hpp>
@@ -85,8 +87,9 @@ int run_list(const ListOptions& opt) {
 
 struct RegressorBenchOptions {
   WorldOption world;
-  std::filesystem::path demos, export_dir;
+  std::filesystem::path demos, queries, export_dir;
   std::string split = "episodes";
+  std::string features = "state";
   std::vector<std::string> regressors;
   std::vector<std::string> sets;
   std::uint64_t seed = 1;
@@ -96,10 +99,10 @@ struct RegressorBenchOptions {
 
 // Writes X and Y of one side of the split as CSV with a header (17 significant digits, so
 // another tool reads back exactly these doubles).
-template <std::size_t N>
-void write_matrix_csv(const std::filesystem::path& path, const Matrix& m, const std::array<std::string_view, N>& names) {
+template <class Names>
+void write_matrix_csv(const std::filesystem::path& path, const Matrix& m, const Names& names) {
   std::string header;
-  for (std::size_t j = 0; j < N; ++j) header += (j ? "," : "") + std::string(names[j]);
+  for (std::size_t j = 0; j < names.size(); ++j) header += (j ? "," : "") + std::string(names[j]);
   AtomicFile file(path, Ownership::first_line("dicestack exported split CSV", {header}));
   auto& out = file.stream();
   out.precision(17);
@@ -109,11 +112,12 @@ void write_matrix_csv(const std::filesystem::path& path, const Matrix& m, const 
   file.commit();
 }
 
-void export_split(const Split& split, const std::filesystem::path& dir) {
+void export_split(const Split& split, const FeatureMap& features, const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
-  write_matrix_csv(dir / "train_x.csv", split.train.x, state_names());
+  const std::vector<std::string> columns = features.column_names();
+  write_matrix_csv(dir / "train_x.csv", split.train.x, columns);
   write_matrix_csv(dir / "train_y.csv", split.train.y, action_names());
-  write_matrix_csv(dir / "test_x.csv", split.test.x, state_names());
+  write_matrix_csv(dir / "test_x.csv", split.test.x, columns);
   write_matrix_csv(dir / "test_y.csv", split.test.y, action_names());
 }
 
@@ -122,23 +126,33 @@ int run_bench(const RegressorBenchOptions& opt) {
   const auto dir = opt.demos.empty() ? human_demo_set(world) : opt.demos;
   const DemoSet set = read_demo_set(dir);
   const DemoSplit demo_split(set.episodes, opt.split);
-  const Split& split = demo_split.matrices();
-  if (!opt.export_dir.empty()) export_split(split, opt.export_dir);
+  const FeatureMap& features = feature_map(opt.features);
+  const Split& split = demo_split.matrices(features);
+  if (!opt.export_dir.empty()) export_split(split, features, opt.export_dir);
+  // predict_row is timed on the test states, or on another set's (e.g. a policy's saved rollouts,
+  // which stray from the training states as no test split does).
+  std::optional<DemoSplit> query_split;
+  if (!opt.queries.empty()) query_split.emplace(read_demo_set(opt.queries).episodes, "none");
+  const Matrix& queries = query_split     ? query_split->matrices(features).train.x
+                          : split.test.rows() > 0 ? split.test.x
+                                                  : split.train.x;
   auto& reg = RegressorRegistry::global();
   const auto names = opt.regressors.empty() ? reg.names() : opt.regressors;
   nlohmann::json rows = nlohmann::json::array();
   if (!opt.json) {
+    if (query_split) print_line("predict_row timed on the " + std::to_string(queries.rows()) + " states of " + opt.queries.string());
     print_line("bench regressors: " + dir.string() + ", split " + split.description + "; " +
-               std::to_string(split.train.rows()) + " training rows, " + std::to_string(split.test.rows()) + " test rows");
+               std::to_string(split.train.rows()) + " training rows, " + std::to_string(split.test.rows()) + " test rows, features " +
+               features.name() + " (" + std::to_string(features.width()) + " inputs)");
     print_line("  regressor        fit s   predict_row us   batch rows/s   train error   test error");
   }
   for (const auto& name : names) {
     auto t0 = std::chrono::steady_clock::now();
-    Model model = Model::train(reg.create(name, opt.sets), split.train.x, split.train.y, opt.seed);
+    Model model = Model::train(reg.create(name, opt.sets), split.train.x, split.train.y, opt.seed, nullptr, features);
     const double fit_s = seconds_since(t0);
-    // predict_row: median over batches of 50 calls on test states (a timer read per call
-    // would dominate the fastest regressors).
-    const Matrix probe = model.x_scaler().apply(split.test.rows() > 0 ? split.test.x : split.train.x);
+    // predict_row: median over batches of 50 calls (a timer read per call would dominate the
+    // fastest regressors).
+    const Matrix probe = model.x_scaler().apply(queries);
     std::vector<double> per_call;
     double out[kActionDim];
     const auto n = static_cast<std::size_t>(probe.rows());
@@ -146,7 +160,7 @@ int run_bench(const RegressorBenchOptions& opt) {
       t0 = std::chrono::steady_clock::now();
       for (int k = 0; k < 50; ++k) {
         const auto row = static_cast<Eigen::Index>((static_cast<std::size_t>(b) * 50 + static_cast<std::size_t>(k)) % n);
-        model.regressor().predict_row({probe.row(row).data(), kStateDim}, out);
+        model.regressor().predict_row({probe.row(row).data(), static_cast<std::size_t>(probe.cols())}, out);
       }
       per_call.push_back(seconds_since(t0) / 50.0);
     }
@@ -161,7 +175,10 @@ int run_bench(const RegressorBenchOptions& opt) {
                        {"predict_row_us", row_us},
                        {"batch_rows_per_s", batch_rate},
                        {"train_error", errors.train_error},
-                       {"split", opt.split}};
+                       {"split", opt.split},
+                       {"train_rows", split.train.rows()},
+                       {"timed_rows", queries.rows()},
+                       {"features", features.name()}};
     if (errors.test_error) row["test_error"] = *errors.test_error;  // none: the split left no test row
     rows.push_back(row);
     if (!opt.json) {
@@ -197,6 +214,10 @@ void add_bench_regressors_command(CLI::App& bench) {
   cmd->add_option("--demos", opt->demos, "Demonstration folder (default: the paper's 68 recordings, converted)");
   cmd->add_option("--split", opt->split, "episodes (i % 5 == 4 is test) or rows (the paper's random 25%)")
       ->check(CLI::IsMember({"episodes", "rows"}))
+      ->capture_default_str();
+  cmd->add_option("--queries", opt->queries,
+                  "Time predict_row on this set's states (e.g. a policy's `evaluate --save-rollouts`) instead of the test states");
+  cmd->add_option("--features", opt->features, "Feature map the rows go through (`dicestack learners` lists them)")
       ->capture_default_str();
   cmd->add_option("--regressors", opt->regressors, "Only these (comma-separated)")->delimiter(',');
   cmd->add_option("--set", opt->sets, "key=value parameter for the regressor(s); repeatable");

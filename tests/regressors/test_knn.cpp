@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <string>
 #include <cmath>
 #include <numeric>
 
@@ -11,8 +12,9 @@ namespace dicestack {
 namespace {
 
 using test::random_matrix;
+using Index = Eigen::Index;
 
-// The mean label of the k nearest rows by brute force (l2 or l1).
+// The mean label of the k nearest rows by brute force (l2 or l1); equal distances: the earlier row.
 std::vector<double> brute_force(const Matrix& x, const Matrix& y, const double* q, int k, bool l1) {
   std::vector<std::pair<double, Eigen::Index>> d;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
@@ -20,7 +22,7 @@ std::vector<double> brute_force(const Matrix& x, const Matrix& y, const double* 
     for (Eigen::Index j = 0; j < x.cols(); ++j) s += l1 ? std::abs(x(i, j) - q[j]) : (x(i, j) - q[j]) * (x(i, j) - q[j]);
     d.emplace_back(s, i);
   }
-  std::sort(d.begin(), d.end());
+  std::sort(d.begin(), d.end());  // pairs: equal distances by row
   std::vector<double> out(static_cast<std::size_t>(y.cols()), 0.0);
   for (int n = 0; n < k; ++n)
     for (Eigen::Index j = 0; j < y.cols(); ++j) out[static_cast<std::size_t>(j)] += y(d[static_cast<std::size_t>(n)].second, j) / k;
@@ -28,19 +30,54 @@ std::vector<double> brute_force(const Matrix& x, const Matrix& y, const double* 
 }
 
 TEST(Knn, MatchesBruteForceSearch) {
-  for (const char* metric : {"l2", "l1"}) {
-    for (const Eigen::Index dims : {Eigen::Index{24}, Eigen::Index{5}}) {  // fixed-size and dynamic trees
-      const Matrix x = random_matrix(800, dims, 1), y = random_matrix(800, 3, 2), q = random_matrix(50, dims, 3);
-      auto knn = RegressorRegistry::global().create("knn", {"k=4", std::string("metric=") + metric});
-      knn->fit(x, y, 0);
-      double out[3];
-      for (Eigen::Index i = 0; i < q.rows(); ++i) {
-        knn->predict_row({q.row(i).data(), static_cast<std::size_t>(dims)}, out);
-        const auto expected = brute_force(x, y, q.row(i).data(), 4, std::string(metric) == "l1");
-        for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << metric << " " << dims;
+  for (const char* search : {"search=cluster_tree", "search=kdtree"})
+    for (const char* metric : {"l2", "l1"}) {
+      for (const Eigen::Index dims : {Eigen::Index{24}, Eigen::Index{5}, Eigen::Index{49}}) {  // fixed-size and dynamic trees
+        const Matrix x = random_matrix(800, dims, 1), y = random_matrix(800, 3, 2), q = random_matrix(50, dims, 3);
+        auto knn = RegressorRegistry::global().create("knn", {"k=4", std::string("metric=") + metric, search});
+        knn->fit(x, y, 0);
+        double out[3];
+        for (Eigen::Index i = 0; i < q.rows(); ++i) {
+          knn->predict_row({q.row(i).data(), static_cast<std::size_t>(dims)}, out);
+          const auto expected = brute_force(x, y, q.row(i).data(), 4, std::string(metric) == "l1");
+          for (int j = 0; j < 3; ++j)
+            ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << search << " " << metric << " " << dims;
+        }
       }
     }
-  }
+}
+
+TEST(Knn, ClusterTreeIsExactOnWideTrajectoryLikeRowsWithRepeats) {
+  // dart's rows: 49 wide, a start block shared by each episode's rows, smooth paths, repeated
+  // rows with different labels (a cup at rest). Queries from new starts, between the rows and
+  // far from them; equal distances go to the earlier row, as brute force orders them.
+  const Index episodes = 40, steps = 50, wide = 49;
+  Matrix x(episodes * steps, wide);
+  const Matrix starts = random_matrix(episodes, 24, 21), paths = random_matrix(episodes, 24, 22);
+  for (Index e = 0; e < episodes; ++e)
+    for (Index t = 0; t < steps; ++t) {
+      const Index r = e * steps + t;
+      const double phase = t < 10 ? 0.0 : static_cast<double>(t) / steps;  // at rest for 10 steps: repeats
+      x.row(r).head(24) = starts.row(e) + phase * paths.row(e);
+      x(r, 24) = phase;
+      x.row(r).tail(24) = starts.row(e);
+    }
+  const Matrix y = random_matrix(x.rows(), 3, 23);
+  Matrix q = x.topRows(30) + 0.3 * random_matrix(30, wide, 24);
+  q.bottomRows(10) *= 5.0;  // far from every row
+  for (const char* metric : {"metric=l2", "metric=l1"})
+    for (const char* k : {"k=1", "k=3", "k=64"}) {
+      auto knn = RegressorRegistry::global().create("knn", {k, metric, "leaf_size=4"});
+      knn->fit(x, y, 0);
+      const int kk = std::stoi(std::string(k).substr(2));
+      double out[3];
+      for (Index i = 0; i < q.rows() + 12; ++i) {
+        const double* query = i < q.rows() ? q.row(i).data() : x.row((i - q.rows()) * steps + 3).data();  // a repeated row
+        knn->predict_row({query, static_cast<std::size_t>(wide)}, out);
+        const auto expected = brute_force(x, y, query, kk, std::string(metric) == "metric=l1");
+        for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << metric << " " << k << " query " << i;
+      }
+    }
 }
 
 TEST(Knn, PrincipalAxesSearchMatchesBruteForceOnCorrelatedStates) {
@@ -51,7 +88,7 @@ TEST(Knn, PrincipalAxesSearchMatchesBruteForceOnCorrelatedStates) {
   const Matrix q = random_matrix(40, 4, 11) * mix + 0.01 * random_matrix(40, 24, 12);
   const Matrix y = random_matrix(1000, 3, 13);
   for (const char* rotate : {"rotate=true", "rotate=false"}) {
-    auto knn = RegressorRegistry::global().create("knn", {"k=3", rotate});
+    auto knn = RegressorRegistry::global().create("knn", {"k=3", rotate, "search=kdtree"});
     knn->fit(x, y, 0);
     double out[3];
     for (Eigen::Index i = 0; i < q.rows(); ++i) {
