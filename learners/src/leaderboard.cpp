@@ -329,6 +329,28 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     for (const auto& kv : opt.options) put(kv);
     return out;
   };
+  // Every option parsed against its learner's schema before any work (a bad value would
+  // otherwise surface when that row's turn to train came, after the rows before it), and an
+  // --option no learner of this run has is a typo, not a no-op.
+  for (const auto& l : learners) {
+    const auto& schema = LearnerRegistry::global().info(base(l)).params;
+    const Params params(schema, options_for(l), l);
+    if (std::any_of(schema.begin(), schema.end(), [](const ParamSpec& p) { return p.name == "perturb"; }))
+      learner_perturbation(params, world, l);  // a level or a file, checked against the world
+  }
+  for (const auto& kv : opt.options) {
+    const auto key = kv.substr(0, kv.find('='));
+    const bool used = std::any_of(learners.begin(), learners.end(), [&](const std::string& l) {
+      const auto& params = LearnerRegistry::global().info(base(l)).params;
+      return std::any_of(params.begin(), params.end(), [&](const ParamSpec& p) { return p.name == key; });
+    });
+    if (!used) {
+      std::string names;
+      for (const auto& l : learners) names += (names.empty() ? "" : ", ") + l;
+      throw ConfigError("--option " + kv + ": none of this leaderboard's learners (" + names + ") has an option \"" + key +
+                        "\" (`dicestack learners` lists each one's)");
+    }
+  }
   for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = baseline_names();
   for (const auto& b : opt.baselines) baseline(b);  // unknown names fail before any work

@@ -26,6 +26,7 @@ namespace dicestack {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct Process {
   int status = -1;
@@ -181,6 +182,18 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
   p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --baselines annealing");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown baseline \"annealing\""));
+  // Options are parsed before any row trains: the bc row, first in line, never starts.
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc,dart --option episodes=abc");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("dart: parameter \"episodes\" expects an integer, got \"abc\""));
+  EXPECT_THAT(p.output, Not(HasSubstr("training")));
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc,dart --option perturb=stormy");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("stormy"));
+  EXPECT_THAT(p.output, Not(HasSubstr("training")));
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --option iterations=3");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("--option iterations=3: none of this leaderboard's learners (bc) has an option \"iterations\""));
 }
 
 TEST(CliLearning, DadTrainsWithACurveAndRefusesTheRowSplit) {

@@ -76,3 +76,7 @@ def test_bad_arguments_raise(demos):
         dicestack.leaderboard(["knn"], ["bc"], demos, episodes=0, progress=False)
     with pytest.raises(FileNotFoundError):
         dicestack.leaderboard(["knn"], ["bc"], demos / "missing", progress=False)
+    with pytest.raises(ValueError, match='"episodes" expects an integer'):
+        dicestack.leaderboard(["knn"], ["bc", "dart"], demos, options={"episodes": "abc"}, progress=False)
+    with pytest.raises(ValueError, match='has an option "iterations"'):
+        dicestack.leaderboard(["knn"], ["bc"], demos, options={"iterations": 3}, progress=False)
