@@ -7,6 +7,7 @@
 
 #include <pybind11/stl.h>
 
+#include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/worker_pool.hpp>
 #include <dicestack/core/render.hpp>
@@ -181,12 +182,17 @@ class BatchArrays {
 /// terminated = truncated = False.
 class VectorEnv {
  public:
-  VectorEnv(const WorldConfig& world, int num_envs, int threads, const Perturbation& perturbation)
-      : pool_(std::min(resolve_threads(threads), std::max(num_envs, 1))) {
+  /// What one environment holds, with its share of the arrays a step returns: measured 107-114 KB
+  /// of resident memory each after a reset and 3 steps of 1,000 and of 10,000 environments.
+  static constexpr double kEnvironmentBytes = 120e3;
+
+  VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation)
+      : pool_(static_cast<int>(std::clamp<long long>(num_envs, 1, resolve_threads(threads)))) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
+    require_memory("DiceStackVectorEnv", static_cast<std::uint64_t>(num_envs), kEnvironmentBytes, "environments");
     envs_.reserve(static_cast<std::size_t>(num_envs));
     validate(perturbation, world);
-    for (int i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation);
+    for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation);
     done_.assign(envs_.size(), 0);
     slots_.resize(envs_.size());
   }
@@ -354,7 +360,7 @@ void bind_env(py::module_& m) {
       .def_property_readonly("episode_seed", &EnvCore::episode_seed);
 
   py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
-      .def(py::init([](const WorldConfig& world, int num_envs, const py::object& threads, const Perturbation& perturbation) {
+      .def(py::init([](const WorldConfig& world, long long num_envs, const py::object& threads, const Perturbation& perturbation) {
              return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation);
            }),
            py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none(), py::arg("perturbation") = Perturbation{})

@@ -1,5 +1,7 @@
 """DiceStackVectorEnv: batched shapes, Gymnasium's next-step autoreset, and the same results as
 stepping DiceStackEnvs one by one, whatever the thread count."""
+import time
+
 import numpy as np
 import pytest
 
@@ -87,3 +89,11 @@ def test_bad_arguments():
         venv.reset(seed=[1, 2, 3])
     with pytest.raises(ValueError, match="threads"):
         dicestack.DiceStackVectorEnv(2, threads=-1)
+
+
+def test_a_count_that_cannot_fit_is_refused_at_once_saying_what_it_needs():
+    start = time.monotonic()
+    for count in (10**6, 10**12):
+        with pytest.raises(ValueError, match=rf"DiceStackVectorEnv: {count} environments would need up to .* this machine has"):
+            dicestack.DiceStackVectorEnv(count)
+    assert time.monotonic() - start < 5
