@@ -1,9 +1,11 @@
 // `dicestack record`: demonstrations from an automatic expert (docs/expert.md).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
@@ -30,6 +32,9 @@ struct RecordOptions {
   bool json = false;
 };
 
+// Episodes recorded (and held) at a time.
+constexpr int kRecordBatch = 256;
+
 int run_record(const RecordOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
@@ -49,45 +54,56 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
     throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
   }
   RecordRequest request;
-  request.episodes = opt.episodes;
   request.seed = opt.seed;
   request.threads = opt.threads;
   request.noise = {opt.noise, opt.noise, opt.noise};
   request.perturbation = perturbation;
-  std::vector<Episode> eps = record_expert(opt.expert, expert, world, request, cluster);
-  if (!cluster.is_root()) return 0;  // the root writes and prints
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // What the set holds of each episode until the end (its meta.json entry): the only part of a
+  // recording that grows with the count.
+  require_memory("recording", static_cast<std::uint64_t>(opt.episodes), kEpisodeEntryBytes, "episodes");
+  DemoSet header;
+  header.world = world;
+  header.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string());
+  header.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
+                      std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
+                      (opt.no_replan ? " --no-replan" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
+                      (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
+                      (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
+                      "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
+                      (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
+                                             std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
+                                             "actions recorded"
+                                       : "") +
+                      (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its "
+                                                     "seed (" + perturbation_summary(perturbation) + ")");
   int success = 0, stacked = 0, walls = 0;
   double cup = 0.0;
-  for (const auto& e : eps) {
-    success += e.outcome.realistic_success();
-    stacked += e.outcome.stacked;
-    walls += e.outcome.wall_contact;
-    cup += e.outcome.dice_in_cup;
+  // Batches of kRecordBatch episodes, each written as it comes and dropped: memory stays that
+  // of one batch whatever the count (the episodes and their order are the same as in one go).
+  const auto record_all = [&](const EpisodeSink& keep) {
+    for (int first = 0; first < opt.episodes; first += kRecordBatch) {
+      request.first = static_cast<std::uint64_t>(first);
+      request.episodes = std::min(kRecordBatch, opt.episodes - first);
+      for (const Episode& e : record_expert(opt.expert, expert, world, request, cluster)) {  // collective
+        success += e.outcome.realistic_success();
+        stacked += e.outcome.stacked;
+        walls += e.outcome.wall_contact;
+        cup += e.outcome.dice_in_cup;
+        if (!opt.successes_only || e.outcome.realistic_success()) keep(e);
+      }
+    }
+  };
+  if (!cluster.is_root()) {  // the root writes and prints
+    record_all([](const Episode&) {});
+    return 0;
   }
-  DemoSet set;
-  set.world = world;
-  set.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string());
-  set.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
-                   std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
-                   (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
-                   (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
-                   (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
-                   "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
-                   (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
-                                          std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
-                                          "actions recorded"
-                                    : "") +
-                   (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its "
-                                                  "seed (" + perturbation_summary(perturbation) + ")");
-  for (auto& e : eps)
-    if (!opt.successes_only || e.outcome.realistic_success()) set.episodes.push_back(std::move(e));
-  write_demo_set(set, opt.out);
+  const std::size_t written = write_demo_set_streaming(header, opt.out, record_all);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double n = std::max(1, opt.episodes);
   if (opt.json) {
     print_line(nlohmann::json{{"expert", opt.expert},
                               {"episodes", opt.episodes},
-                              {"written", set.episodes.size()},
+                              {"written", written},
                               {"realistic_success_rate", success / n},
                               {"stacked_rate", stacked / n},
                               {"dice_in_cup_mean", cup / n},
@@ -103,7 +119,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
                 "expert %s, %d episodes from seed %llu: realistic success %.1f%%, stacked %.1f%%, dice in cup %.2f, "
                 "wall contact %.1f%%; %.3f s per episode (%.1f s)\nwrote %zu episodes to %s",
                 opt.expert.c_str(), opt.episodes, static_cast<unsigned long long>(opt.seed), 100 * success / n,
-                100 * stacked / n, cup / n, 100 * walls / n, seconds / n, seconds, set.episodes.size(),
+                100 * stacked / n, cup / n, 100 * walls / n, seconds / n, seconds, written,
                 opt.out.string().c_str());
   print_line(line);
   return 0;

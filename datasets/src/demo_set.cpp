@@ -95,27 +95,25 @@ void write_episode_csv(const Episode& e, const fs::path& path, AtomicFile::Lefto
   file.commit();
 }
 
-json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
-  json episodes = json::array();
-  bool perturbed = false;
-  for (std::size_t i = 0; i < set.episodes.size(); ++i) {
-    const Episode& e = set.episodes[i];
-    std::set<std::string_view> sources;
-    for (auto s : e.sources) sources.insert(to_string(s));
-    episodes.push_back({{"file", files[i]},
-                        {"seed", e.seed},
-                        {"steps", e.size()},
-                        {"origin", e.origin},
-                        {"sources", std::vector<std::string>(sources.begin(), sources.end())},
-                        {"outcome", outcome_json(e.outcome)},
-                        {"final_state", e.final_state ? json(*e.final_state) : json(nullptr)},
-                        {"terminated", e.terminated},
-                        {"truncated", e.truncated}});
-    if (!e.perturbation.empty()) {
-      episodes.back()["perturbation"] = json::parse(e.perturbation);
-      perturbed = true;
-    }
-  }
+json episode_entry(const Episode& e, const std::string& file) {
+  std::set<std::string_view> sources;
+  for (auto s : e.sources) sources.insert(to_string(s));
+  json entry{{"file", file},
+             {"seed", e.seed},
+             {"steps", e.size()},
+             {"origin", e.origin},
+             {"sources", std::vector<std::string>(sources.begin(), sources.end())},
+             {"outcome", outcome_json(e.outcome)},
+             {"final_state", e.final_state ? json(*e.final_state) : json(nullptr)},
+             {"terminated", e.terminated},
+             {"truncated", e.truncated}};
+  if (!e.perturbation.empty()) entry["perturbation"] = json::parse(e.perturbation);
+  return entry;
+}
+
+// meta.json of `set` (its episodes not read) with these episode entries.
+json meta_with_entries(const DemoSet& set, json episodes) {
+  const bool perturbed = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("perturbation"); });
   // Version 3 only adds the perturbation: a set without one is written as version 2.
   return {{"format", kDemoFormat},
           {"version", perturbed ? kDemoFormatVersion : 2},
@@ -132,7 +130,13 @@ json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
             {"reward", "DiceEnv::step's reward for arriving at the next state (empty: unknown)"},
             {"final_state", "the state after the last action (null: unknown)"}}},
           {"world", json::parse(to_json(set.world))},
-          {"episodes", episodes}};
+          {"episodes", std::move(episodes)}};
+}
+
+json meta_json(const DemoSet& set, const std::vector<std::string>& files) {
+  json episodes = json::array();
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) episodes.push_back(episode_entry(set.episodes[i], files[i]));
+  return meta_with_entries(set, std::move(episodes));
 }
 
 [[noreturn]] void meta_error(const fs::path& meta, const std::string& what) { throw InputError(meta.string() + ": " + what); }
@@ -510,6 +514,27 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
     meta.stream() << meta_json(set, files).dump(2) << '\n';
     meta.commit();
   });
+}
+
+std::size_t write_demo_set_streaming(const DemoSet& header, const fs::path& dir,
+                                     const std::function<void(const EpisodeSink&)>& produce) {
+  validate(header.world);
+  std::size_t written = 0;
+  const auto ours = [](const fs::path& p) { return is_own_demo_set(p); };
+  replace_folder(dir, ours, check_demo_set_replaceable, [&](const fs::path& tmp) {
+    json episodes = json::array();
+    produce([&](const Episode& e) {
+      check_episode(e);
+      const std::string file = episode_file_name(written);
+      write_episode_csv(e, tmp / file, AtomicFile::Leftovers::skip);
+      episodes.push_back(episode_entry(e, file));
+      ++written;
+    });
+    AtomicFile meta(tmp / "meta.json", meta_ownership());
+    meta.stream() << meta_with_entries(header, std::move(episodes)).dump(2) << '\n';
+    meta.commit();
+  });
+  return written;
 }
 
 std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Episode> episodes,

@@ -38,7 +38,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
       [&](std::size_t i, int w) {
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!expert) expert = make_expert(name, config);
-        const std::uint64_t s = training_start_seed(request.seed, i);
+        const std::uint64_t s = training_start_seed(request.seed, request.first + i);
         const PerturbationDraw draw = draw_perturbation(request.perturbation, world, s);
         std::optional<DiceEnv> own;
         DiceEnv& env = episode_env(draw, envs.at(w), own);

@@ -192,6 +192,42 @@ TEST(DemoSet, AppendAddsEpisodesAndKeepsTheOldOnes) {
   fs::remove_all(dir);
 }
 
+TEST(DemoSet, StreamingWriterWritesWhatTheWholeSetWriterWrites) {
+  DemoSet set = read_demo_set(kData / "good");
+  set.description = "streamed";
+  set.provenance = "unit test";
+  const fs::path whole = test::scratch_path("dicestack_demo_whole"), streamed = test::scratch_path("dicestack_demo_streamed");
+  fs::remove_all(whole);
+  fs::remove_all(streamed);
+  write_demo_set(set, whole);
+  DemoSet header = set;
+  header.episodes.clear();  // not read: the episodes come from produce
+  const std::size_t n = write_demo_set_streaming(header, streamed, [&](const EpisodeSink& add) {
+    for (const auto& e : set.episodes) add(e);
+  });
+  EXPECT_EQ(n, set.episodes.size());
+  for (const auto& entry : fs::directory_iterator(whole)) {
+    const auto name = entry.path().filename();
+    EXPECT_EQ(slurp(entry.path()), slurp(streamed / name)) << name;
+  }
+  // A failure halfway (here a malformed episode after a good one) leaves the old set as it was
+  // and no scratch folder.
+  DemoSet bad = set;
+  bad.episodes[1].actions.pop_back();
+  EXPECT_THAT(test::error_of([&] {
+                write_demo_set_streaming(header, streamed, [&](const EpisodeSink& add) {
+                  for (const auto& e : bad.episodes) add(e);
+                });
+              }),
+              HasSubstr("3 states, 2 actions"));
+  EXPECT_EQ(read_demo_set(streamed).description, "streamed");
+  EXPECT_EQ(read_demo_set(streamed).episodes.size(), 2u);
+  for (const auto& entry : fs::directory_iterator(streamed.parent_path()))
+    EXPECT_NE(entry.path().filename().string().rfind("." + streamed.filename().string(), 0), 0u) << entry.path();
+  fs::remove_all(whole);
+  fs::remove_all(streamed);
+}
+
 TEST(DemoSet, WriterRejectsMalformedEpisodes) {
   DemoSet set = read_demo_set(kData / "good");
   set.episodes[1].actions.pop_back();

@@ -4,6 +4,7 @@
 // units, world config, provenance, per-episode outcomes). Opens in any spreadsheet or pandas.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -93,6 +94,21 @@ void check_demo_set_replaceable(const std::filesystem::path& dir);
 /// never leaves half a set. Dead runs' scratch folders of `dir` are removed first (a live run's
 /// never). Throws InputError.
 void write_demo_set(const DemoSet& set, const std::filesystem::path& dir);
+
+/// Receives the episodes of write_demo_set_streaming, in order.
+using EpisodeSink = std::function<void(const Episode&)>;
+
+/// write_demo_set for a set too large to hold (record): `produce(add)` calls add(episode) for
+/// each episode in order; each is checked and written into the scratch folder as it comes, and
+/// meta.json last, from `header` (world, description, provenance; its episodes are not read).
+/// The folder replaces `dir` only when produce returns; a throw from produce or add leaves `dir`
+/// as it was. Holds one meta.json entry per episode, not its steps. Returns the number written.
+std::size_t write_demo_set_streaming(const DemoSet& header, const std::filesystem::path& dir,
+                                     const std::function<void(const EpisodeSink&)>& produce);
+
+/// What write_demo_set_streaming holds per episode, at most (its meta.json entry): for memory
+/// checks before a long recording.
+inline constexpr double kEpisodeEntryBytes = 8192.0;
 
 /// Appends episodes to the set in `dir` (created if missing or empty; any other folder without a
 /// meta.json is refused with InputError) and rewrites its meta.json

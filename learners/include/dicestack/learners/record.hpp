@@ -14,7 +14,9 @@ namespace dicestack {
 /// What record_expert runs.
 struct RecordRequest {
   int episodes = 0;
-  std::uint64_t seed = 0;  ///< episode i starts from random_start_state(world, training_start_seed(seed, i))
+  std::uint64_t seed = 0;  ///< episode i starts from random_start_state(world, training_start_seed(seed, first + i))
+  /// Where in the seeded sequence the request starts: a long recording asks for it in batches.
+  std::uint64_t first = 0;
   int threads = 0;         ///< 0: every core; the result does not depend on it
   /// DART's noise: per action dimension, a fraction of world.action.scale; the executed actions
   /// are perturbed and the expert's clean actions recorded.
