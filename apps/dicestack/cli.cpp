@@ -6,6 +6,7 @@
 #include <string>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/interrupt.hpp>
 #include <dicestack/regressors/registry.hpp>
 #include <dicestack/version.hpp>
 
@@ -45,18 +46,20 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   add_render_command(app);
   add_rollout_command(app);
   add_robustness_command(app, cluster);
-  if (cluster.size() > 1)
-    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-      const std::string name = sub->get_name();
-      // The subcommands every rank runs (their work is dealt over the cluster); the others run
-      // on the root alone.
-      static const std::set<std::string> distributed{"evaluate", "record",    "train", "leaderboard",
-                                                     "optimise", "reinforce", "rrt",   "robustness"};
-      if (!distributed.contains(name))
-        sub->preparse_callback([&cluster](std::size_t) {
-          if (!cluster.is_root()) throw RootOnly{};
-        });
-    }
+  // The long runs, whose work is dealt over threads and ranks. Ctrl-C stops them as an error
+  // would, at the next episode (interrupt.hpp); the other subcommands keep the default (play
+  // waits for keys, and must end at once). With several ranks, the other subcommands run on the
+  // root alone.
+  static const std::set<std::string> distributed{"evaluate", "record",    "train", "leaderboard",
+                                                 "optimise", "reinforce", "rrt",   "robustness"};
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    if (distributed.contains(sub->get_name()))
+      sub->preparse_callback([](std::size_t) { install_interrupt_handler(); });
+    else if (cluster.size() > 1)
+      sub->preparse_callback([&cluster](std::size_t) {
+        if (!cluster.is_root()) throw RootOnly{};
+      });
+  }
   try {
     RegressorRegistry::global().load_plugins_from_environment();
     app.parse(argc, argv);
@@ -64,6 +67,8 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
     return 0;  // the root runs this subcommand
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const Interrupted&) {
+    return fail("dicestack: interrupted", 130);
   } catch (const Error& e) {
     return fail(std::string("dicestack: error: ") + e.what(), 1);
   } catch (const std::exception& e) {

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,9 @@
 #include <algorithm>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <chrono>
+#include <iterator>
 
 #include <gif_lib.h>
 #include <nlohmann/json.hpp>
@@ -586,6 +590,60 @@ TEST(CliLearning, ABadRegressorSettingIsRefusedBeforeTheLearnerRecordsAnything) 
                         model.string());
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("gbt: parameter \"max_depth\" expects an integer, got \"abc\""));
+  EXPECT_FALSE(std::filesystem::exists(model));
+}
+
+// Starts dicestack with `args` in the background, its output dropped; returns its pid.
+pid_t start(const std::string& args) {
+  const std::string cmd = "exec " + std::string(DICESTACK_EXE) + " " + args + " >/dev/null 2>&1";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// The exit status of `pid` once it ends, or -1 if it has not ended within `seconds` (it is
+// then killed) or ended by a signal.
+int wait_for(pid_t pid, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int raw = 0;
+  while (waitpid(pid, &raw, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &raw, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(CliInterrupt, CtrlCStopsALongRunAtOnceAndLeavesTheOldOutput) {
+  const auto out = test::scratch_path("dicestack_cli_interrupt");
+  std::filesystem::remove_all(out);
+  ASSERT_EQ(run("record --expert mpc --episodes 2 --out " + out.string()).status, 0);
+  const std::string meta = file_text(out / "meta.json");
+  pid_t pid = start("record --expert mpc --noise 0.1 --episodes 100000 --out " + out.string());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_for(pid, 10.0), 130);
+  EXPECT_EQ(file_text(out / "meta.json"), meta) << "the set it was replacing is kept";
+  for (const auto& entry : std::filesystem::directory_iterator(out.parent_path()))
+    EXPECT_NE(entry.path().filename().string().rfind("." + out.filename().string(), 0), 0u) << "scratch left: " << entry.path();
+  std::filesystem::remove_all(out);
+
+  const auto model = test::scratch_path("dicestack_cli_interrupt.dsm");
+  pid = start("train --regressor gbt --learner dart --option episodes=50000 --out " + model.string());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_for(pid, 10.0), 130);
   EXPECT_FALSE(std::filesystem::exists(model));
 }
 

@@ -1,5 +1,7 @@
 #include <dicestack/core/parallel.hpp>
 
+#include <dicestack/core/interrupt.hpp>
+
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -18,7 +20,10 @@ int resolve_threads(int threads) {
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t, int)>& fn) {
   const int t = resolve_threads(threads);
   if (t == 1 || n <= 1) {
-    for (std::size_t i = 0; i < n; ++i) fn(i, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      throw_if_interrupted();
+      fn(i, 0);
+    }
     return;
   }
   tbb::task_arena arena(t);
@@ -29,6 +34,7 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
         // After an item threw, the other threads stop at their next item, not at the end of
         // their chunk (which can hold most of the loop): an interrupted evaluation ends at once.
         if (tbb::is_current_task_group_canceling()) return;
+        throw_if_interrupted();  // Ctrl-C on the command line: unwinds like an error
         fn(i, worker);
       }
     });
