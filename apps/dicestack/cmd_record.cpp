@@ -93,6 +93,9 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
       }
     }
   };
+  // Every rank makes the same record_expert calls (one per batch, from opt.episodes alone). If
+  // the root fails while writing, it stops making them; the run does not hang because a failure
+  // on any rank ends every rank (MPI_Abort in main.cpp).
   if (!cluster.is_root()) {  // the root writes and prints
     record_all([](const Episode&) {});
     return 0;

@@ -132,7 +132,11 @@ int run_bench(const RegressorBenchOptions& opt) {
   // predict_row is timed on the test states, or on another set's (e.g. a policy's saved rollouts,
   // which stray from the training states as no test split does).
   std::optional<DemoSplit> query_split;
-  if (!opt.queries.empty()) query_split.emplace(read_demo_set(opt.queries).episodes, "none");
+  if (!opt.queries.empty()) {
+    query_split.emplace(read_demo_set(opt.queries).episodes, "none");
+    if (query_split->matrices(features).train.x.rows() == 0)
+      throw InputError(opt.queries.string() + ": --queries holds no states to time predict_row on");
+  }
   const Matrix& queries = query_split     ? query_split->matrices(features).train.x
                           : split.test.rows() > 0 ? split.test.x
                                                   : split.train.x;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <limits>
 #include <random>
 #include <set>
@@ -531,7 +532,7 @@ std::size_t write_demo_set_streaming(const DemoSet& header, const fs::path& dir,
       ++written;
     });
     AtomicFile meta(tmp / "meta.json", meta_ownership());
-    meta.stream() << meta_with_entries(header, std::move(episodes)).dump(2) << '\n';
+    meta.stream() << std::setw(2) << meta_with_entries(header, std::move(episodes)) << '\n';  // dump(2), no copy as text
     meta.commit();
   });
   return written;

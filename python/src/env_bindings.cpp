@@ -187,9 +187,7 @@ class VectorEnv {
   static constexpr double kEnvironmentBytes = 120e3;
 
   VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation)
-      : pool_(static_cast<int>(std::clamp<long long>(num_envs, 1, resolve_threads(threads)))) {
-    if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
-    require_memory("DiceStackVectorEnv", static_cast<std::uint64_t>(num_envs), kEnvironmentBytes, "environments");
+      : pool_(pool_size(num_envs, threads)) {
     envs_.reserve(static_cast<std::size_t>(num_envs));
     validate(perturbation, world);
     for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation);
@@ -198,6 +196,13 @@ class VectorEnv {
   }
 
   std::size_t size() const { return envs_.size(); }
+
+  // The count checked before the pool's threads start: at least 1, and within memory.
+  static int pool_size(long long num_envs, int threads) {
+    if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
+    require_memory("DiceStackVectorEnv", static_cast<std::uint64_t>(num_envs), kEnvironmentBytes, "environments");
+    return static_cast<int>(std::min<long long>(num_envs, resolve_threads(threads)));
+  }
 
   py::tuple reset(const std::vector<std::optional<std::uint64_t>>& seeds) {
     if (seeds.size() != envs_.size())

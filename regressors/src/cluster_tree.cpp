@@ -12,6 +12,7 @@ using Vec = Eigen::Map<const Eigen::VectorXf>;
 
 // Rounding slack of every bound: a node or row is skipped only when it is farther than the
 // k-th found by more than float arithmetic over 64 terms can be off, so the search stays exact.
+// Relative only: knn's rows are standardised, so no square underflows.
 constexpr float kSlack = 1e-4f;
 
 // 2-means steps that move each split plane after the median one.
@@ -166,7 +167,6 @@ std::uint32_t ClusterTree::build(std::uint32_t begin, std::uint32_t end) {
     for (std::uint32_t i = 0; i < n; ++i) moved_right += (next[i] = along(begin + i, u) > s) != 0;
     if (moved_right < least || n - moved_right < least) break;  // lopsided: keep the last balanced plane
     const bool same = next == on_right;
-    v = u;
     on_right.swap(next);
     if (same) break;
   }

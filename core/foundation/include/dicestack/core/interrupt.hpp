@@ -16,7 +16,8 @@ class Interrupted : public Error {
   Interrupted() : Error("interrupted") {}
 };
 
-/// Makes SIGINT raise the flag (the first time; the second ends the process).
+/// Makes SIGINT raise the flag (the first time; the second ends the process). A SIGINT the
+/// process inherited as ignored stays ignored.
 void install_interrupt_handler();
 
 /// Whether a signal asked the run to stop. Cheap: an atomic load.
