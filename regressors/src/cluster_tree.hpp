@@ -29,7 +29,6 @@ class ClusterTree {
   std::size_t search(const float* query, std::size_t k, std::size_t* index, float* distance) const;
 
   const std::vector<std::size_t>& order() const { return order_; }
-  const Rows& rows() const { return rows_; }
 
  private:
   struct Node {
