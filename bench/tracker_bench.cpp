@@ -3,12 +3,14 @@
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
 //       [--recordings K [--subset-seed S]] [--probes P] [--paths N] [--no-optimise]
-//       [--noise F [--noise-window FROM,TO]] [--per-path] [--json]
+//       [--noise F [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path] [--json]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
 // --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
 // from each start instead, with and without that noise, and lists them by successes.
+// --rescue N runs the tracker expert with rescue_interval N (closed loop on the dice) instead of
+// the chosen path's follower.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include <tuple>
 #include <vector>
 
+#include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
@@ -55,6 +58,8 @@ Options parse(int argc, char** argv) {
     else if (a == "--probes") o.tracker.probes = std::stoi(next());
     else if (a == "--paths") o.tracker.keep = std::stoi(next());
     else if (a == "--no-optimise") o.tracker.optimise = false;
+    else if (a == "--rescue") o.tracker.rescue_interval = std::stoi(next());
+    else if (a == "--smooth") o.tracker.smooth = std::stod(next());
     else if (a == "--noise") o.noise = std::stod(next());
     else if (a == "--noise-window") {
       const std::string v = next();
@@ -67,12 +72,14 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Follows `follower` from env's state to the end of the episode, with the options' noise.
-Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std::uint64_t noise_seed, bool noisy) {
+// Follows `follower` (or, given, `expert`) from env's state to the end of the episode, with the
+// options' noise.
+Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std::uint64_t noise_seed, bool noisy,
+               Expert* expert = nullptr) {
   Rng rng(noise_seed);
   const int first = env.t();
   while (env.t() < env.config().episode.max_steps) {
-    Action a = follower.act(env.get_state(), env.t());
+    Action a = expert ? expert->act(env) : follower.act(env.get_state(), env.t());
     const double at = static_cast<double>(env.t() - first) / std::max(1, follower.length());
     if (noisy && at >= o.noise_from && at < o.noise_to)
       for (std::size_t k = 0; k < kActionDim; ++k) a[k] += o.noise * env.config().action.scale[k] * rng.normal();
@@ -127,6 +134,10 @@ int main(int argc, char** argv) try {
   };
   std::vector<Result> results(static_cast<std::size_t>(o.starts));
   EnvPool envs(world, o.threads), sims(world, o.threads);
+  ExpertConfig expert_config;
+  expert_config.recordings = recordings;
+  std::vector<std::unique_ptr<Expert>> experts;
+  for (int w = 0; w < resolve_threads(o.threads); ++w) experts.push_back(make_expert("tracker", expert_config));
   const auto t1 = clock::now();
   parallel_for(results.size(), o.threads, [&](std::size_t i, int w) {
     DiceEnv& env = envs.at(w);
@@ -136,7 +147,9 @@ int main(int argc, char** argv) try {
     r.choice = choose_path(*recordings, env, sims.at(w), s);
     const PathFollower follower(recordings->paths()[r.choice.path], r.choice.warp, env.get_state(), env.t(),
                                 o.tracker.gain);
-    r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0);
+    Expert* expert = o.tracker.rescue_interval > 0 ? experts[static_cast<std::size_t>(w)].get() : nullptr;
+    if (expert) expert->reset(s);
+    r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);
   });
   const double seconds = std::chrono::duration<double>(clock::now() - t1).count();
 

@@ -41,7 +41,12 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_paths", ParamType::integer, std::to_string(d.keep), 0, 1000000,
            "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all)", {}},
           {"tracker_recordings", ParamType::integer, "0", 0, 1000000,
-           "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}}};
+           "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}},
+          {"tracker_smooth", ParamType::real, "0", 0, 1000,
+           "tracker: smooth each path by a Gaussian of this std in steps before following it (0: as recorded)", {}},
+          {"tracker_rescue", ParamType::integer, std::to_string(d.rescue_interval), 0, 100000,
+           "tracker: every this many steps, check the path's rest still succeeds and join another recording "
+           "midway when not (0: choose once per episode)", {}}};
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
@@ -53,6 +58,8 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     tracker.probes = static_cast<int>(params.integer("tracker_probes"));
     tracker.optimise = params.boolean("tracker_optimise");
     tracker.keep = static_cast<int>(params.integer("tracker_paths"));
+    tracker.rescue_interval = static_cast<int>(params.integer("tracker_rescue"));
+    tracker.smooth = params.real("tracker_smooth");
     const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
     config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);

@@ -156,5 +156,96 @@ TEST(TrackerExpert, ChoosesOnceAndFollows) {
   for (std::size_t t = 0; t < 50; ++t) EXPECT_NEAR(e.states[t][si::kCupX], paths[0].states[t][si::kCupX], 0.01) << t;
 }
 
+TEST(PathFollower, JoinsAPathMidwayAtItsPhase) {
+  // A follower that starts at step 30 with 20 recorded steps already played acts, from any
+  // state, as the follower of the whole path started at step 10 does.
+  const CupPath path = scripted_path(4);
+  const State frame = path.states.front();
+  PathWarp joined;
+  joined.phase = 20.0;
+  const PathFollower whole(path, {}, frame, 10, 10.0), midway(path, joined, frame, 30, 10.0);
+  EXPECT_EQ(midway.length(), whole.length() - 20);
+  EXPECT_DOUBLE_EQ(midway.phase(45), 35.0);
+  for (const int step : {30, 47, 90, 1000})
+    for (const std::size_t t : {std::size_t{3}, std::size_t{40}}) {
+      const Action a = whole.act(path.states[t], step), b = midway.act(path.states[t], step);
+      for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_DOUBLE_EQ(a[k], b[k]) << step << " " << t;
+    }
+}
+
+TEST(Recordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
+  const WorldConfig w = test::short_world(100);
+  CupPath path = scripted_path(4, w);
+  const CupPath clean = path;
+  // Step-to-step jitter in the pose and the action, as a hand on a mouse adds.
+  for (std::size_t t = 0; t < path.states.size(); ++t) {
+    const double sign = t % 2 ? 1.0 : -1.0;
+    path.states[t][si::kCupY] += 0.01 * sign;
+    path.actions[t][0] += 0.5 * sign;
+  }
+  TrackerConfig c;
+  c.probes = 0;
+  c.smooth = 4.0;
+  const Recordings r({path}, w, c, 0), smooth_clean({clean}, w, c, 0);
+  const CupPath& s = r.paths().front();
+  const CupPath& sc = smooth_clean.paths().front();
+  ASSERT_EQ(s.states.size(), path.states.size());
+  double jitter = 0.0, drift = 0.0;
+  for (std::size_t t = 0; t < s.states.size(); ++t) {
+    EXPECT_EQ(s.actions[t][0], 0.0);  // the actions are folded into the velocities
+    EXPECT_EQ(s.states[t][si::die(1)], path.states[t][si::die(1)]);  // the dice as recorded
+    drift += std::abs(sc.states[t][si::kCupY] - clean.states[t][si::kCupY]) / static_cast<double>(s.states.size());
+    if (t < 12 || t + 12 >= s.states.size()) continue;  // within 3 std of an end the window is one-sided
+    jitter = std::max(jitter, std::abs(s.states[t][si::kCupVx] - sc.states[t][si::kCupVx]));
+    jitter = std::max(jitter, std::abs(s.states[t][si::kCupY] - sc.states[t][si::kCupY]));
+  }
+  // The jitter (0.5 in the velocity, 1 cm in the pose) is gone: the noisy and the clean path
+  // smooth to the same motion. The scripted path turns sharply, and smoothing it over 4 steps
+  // moves its cup by 1.4 cm on average.
+  EXPECT_LT(jitter, 1e-3);
+  EXPECT_LT(drift, 0.02) << drift;
+  c.smooth = -1.0;
+  EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"smooth\""), std::string::npos);
+  c.smooth = 0.0;
+  c.rescue_interval = -1;
+  EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"rescue_interval\""), std::string::npos);
+}
+
+TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
+  // The tracker follows a scripted episode's path from its own start; at step 20 the cup is
+  // knocked sideways and the path no longer stacks. A rescue from there joins another recording
+  // whose continuation simulates to a success, and is deterministic.
+  const WorldConfig w;
+  std::vector<CupPath> paths;
+  for (std::uint64_t s = 0; paths.size() < 3; ++s) {
+    DiceEnv env(w);
+    env.reset(s);
+    auto expert = make_expert("scripted");
+    expert->reset(s);
+    const ExpertEpisode e = run_expert_episode(*expert, env, true);
+    if (e.outcome.realistic_success()) paths.push_back({"p" + std::to_string(s), e.states, e.actions});
+  }
+  TrackerConfig c;
+  c.probes = 0;
+  const Recordings r(paths, w, c, 0);
+  DiceEnv env(w), sim(w);
+  env.reset_to(paths[0].states.front());
+  const State frame = env.get_state();
+  const TrackerChoice current = choose_path(r, env, sim, 1);
+  ASSERT_TRUE(current.success);
+  const PathFollower follower(r.paths()[current.path], current.warp, frame, 0, c.gain);
+  while (env.t() < 20) env.step(follower.act(env.get_state(), env.t()));
+  env.step({0.6, 0.0, 0.0});  // the knock
+  ASSERT_FALSE(still_succeeds(follower, env, sim, c.hold_steps)) << "the knock did not matter";
+  const TrackerChoice a = rescue_path(r, env, sim, frame, current, follower.phase(env.t()), 5);
+  const TrackerChoice b = rescue_path(r, env, sim, frame, current, follower.phase(env.t()), 5);
+  ASSERT_TRUE(a.success);
+  EXPECT_NE(a.path, current.path);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.warp.phase, b.warp.phase);
+  EXPECT_EQ(a.simulations, b.simulations);
+  EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps));
+}
+
 }  // namespace
 }  // namespace dicestack

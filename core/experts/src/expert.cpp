@@ -222,7 +222,9 @@ class MpcExpert final : public Expert {
 
 // Follows one recorded cup path chosen once per episode, at its first query, by simulating the
 // recordings from that state (choose_path); afterwards only tracks it. Its actions are then a
-// function of the start, the step and the state: consistent labels, as DART needs.
+// function of the start, the step and the state: consistent labels, as DART needs. With
+// rescue_interval > 0 it also checks, that often, that the path's rest still simulates to a
+// success from the state reached, and joins another recording midway when not (rescue_path).
 class TrackerExpert final : public Expert {
  public:
   explicit TrackerExpert(const ExpertConfig& config) : recordings_(config.recordings) {}
@@ -236,20 +238,33 @@ class TrackerExpert final : public Expert {
 
   Action do_act(const DiceEnv& env) override {
     const int t = env.t();
-    if (!follower_.valid() || t < start_step_) {
+    const TrackerConfig& c = recordings_->config();
+    if (!follower_.valid() || t < first_step_) {
+      frame_ = env.get_state();
       choice_ = choose_path(*recordings_, env, planning_sim(sim_, env), seed_);
-      start_step_ = t;
-      follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, env.get_state(), t,
-                               recordings_->config().gain);
+      first_step_ = last_check_ = t;
+      follow(t);
+    } else if (c.rescue_interval > 0 && t - last_check_ >= c.rescue_interval && t - start_step_ < follower_.length()) {
+      last_check_ = t;
+      if (!still_succeeds(follower_, env, planning_sim(sim_, env), c.hold_steps)) {
+        choice_ = rescue_path(*recordings_, env, *sim_, frame_, choice_, follower_.phase(t), seed_);
+        follow(t);
+      }
     }
     return follower_.act(env.get_state(), t);
+  }
+
+  void follow(int t) {
+    start_step_ = t;
+    follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, frame_, t, recordings_->config().gain);
   }
 
   std::shared_ptr<const Recordings> recordings_;
   std::uint64_t seed_ = 0;
   PathFollower follower_;
   TrackerChoice choice_;
-  int start_step_ = 0;
+  State frame_{};
+  int first_step_ = 0, start_step_ = 0, last_check_ = 0;
   std::optional<DiceEnv> sim_;
 };
 

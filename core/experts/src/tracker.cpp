@@ -1,6 +1,7 @@
 #include <dicestack/core/tracker.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -36,6 +37,42 @@ void check_path(const CupPath& p) {
   }
 }
 
+// `path` with its cup pose and velocity during each step (the state's, plus the step's action)
+// smoothed by a Gaussian of std `sigma` steps, the actions folded into the velocities; the dice
+// are left as recorded.
+CupPath smoothed(const CupPath& path, double sigma) {
+  const std::size_t n = path.states.size();
+  const auto radius = static_cast<std::ptrdiff_t>(std::ceil(3.0 * sigma));
+  constexpr std::size_t pose[3] = {si::kCupX, si::kCupY, si::kCupAngle};
+  constexpr std::size_t velocity[3] = {si::kCupVx, si::kCupVy, si::kCupW};
+  std::vector<std::array<double, 6>> raw(n);  // pose (angle unwrapped), velocity during the step
+  for (std::size_t t = 0; t < n; ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      raw[t][k] = path.states[t][pose[k]];
+      raw[t][3 + k] = path.states[t][velocity[k]] + path.actions[t][k];
+    }
+  for (std::size_t t = 1; t < n; ++t)
+    raw[t][2] = raw[t - 1][2] + std::remainder(raw[t][2] - raw[t - 1][2], 2.0 * std::numbers::pi);
+  CupPath out = path;
+  for (std::size_t t = 0; t < n; ++t) {
+    std::array<double, 6> sum{};
+    double weight = 0.0;
+    for (std::ptrdiff_t d = -radius; d <= radius; ++d) {
+      const auto u = static_cast<std::ptrdiff_t>(t) + d;
+      if (u < 0 || u >= static_cast<std::ptrdiff_t>(n)) continue;  // the window shrinks at the ends
+      const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
+      for (std::size_t k = 0; k < 6; ++k) sum[k] += w * raw[static_cast<std::size_t>(u)][k];
+      weight += w;
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      out.states[t][pose[k]] = sum[k] / weight;
+      out.states[t][velocity[k]] = sum[3 + k] / weight;
+      out.actions[t][k] = 0.0;
+    }
+  }
+  return out;
+}
+
 // One simulated episode of a follower: higher is better; only a realistic success scores above 0.
 struct Trial {
   double score = -1e300;
@@ -62,14 +99,87 @@ Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& st
   return trial;
 }
 
-// x in [-1, 1]^3 (clipped) to a warp inside the config's bounds.
-PathWarp warp_from(const Eigen::VectorXd& x, const TrackerConfig& c) {
+// x in [-1, 1]^3 (clipped) to a warp of `base` inside the config's bounds.
+PathWarp warp_from(const Eigen::VectorXd& x, const TrackerConfig& c, const PathWarp& base) {
   auto clip = [](double v) { return std::clamp(v, -1.0, 1.0); };
-  PathWarp w;
-  w.time_scale = std::exp(clip(x[0]) * std::log1p(c.time_scale_range));
-  w.offset = clip(x[1]) * c.offset_range;
-  w.amplitude = 1.0 + clip(x[2]) * c.amplitude_range;
+  PathWarp w = base;
+  w.time_scale = base.time_scale * std::exp(clip(x[0]) * std::log1p(c.time_scale_range));
+  w.offset = base.offset + clip(x[1]) * c.offset_range;
+  w.amplitude = base.amplitude * (1.0 + clip(x[2]) * c.amplitude_range);
   return w;
+}
+
+// A path to try, moved by its base warp.
+struct Candidate {
+  std::size_t path = 0;
+  PathWarp warp;
+};
+
+// Simulates `candidates` in turn from env's state (each moved into the frame of `frame`); the
+// first success wins. Failing that, CMA-ES over warps of the `optimise_paths` closest, with
+// `evaluations` each; failing all, the closest.
+TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
+                     const std::vector<Candidate>& candidates, int evaluations, std::uint64_t seed) {
+  const TrackerConfig& c = recordings.config();
+  const EnvSnapshot start = env.snapshot();
+  const int t = env.t();
+  const auto& paths = recordings.paths();
+  TrackerChoice choice;
+  double best = -1e300;
+  // Keeps the best failure so far; returns true on a success (which is then the choice).
+  auto consider = [&](std::size_t p, const PathWarp& w) {
+    const Trial trial = simulate(PathFollower(paths[p], w, frame, t, c.gain), sim, start, c.hold_steps);
+    ++choice.simulations;
+    if (trial.score > best) {  // a success outscores every failure
+      best = trial.score;
+      choice.path = p;
+      choice.warp = w;
+      choice.success = trial.success;
+    }
+    return trial;
+  };
+  std::vector<std::pair<double, std::size_t>> near;  // (score, candidate) as given
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const Trial trial = consider(candidates[k].path, candidates[k].warp);
+    if (trial.success) return choice;
+    near.emplace_back(trial.score, k);
+  }
+  if (!c.optimise) return choice;
+  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
+  for (const auto& [score, k] : near) {
+    const Candidate& base = candidates[k];
+    CmaesOptions o;
+    o.sigma0 = 0.3;  // in units of the warp bounds
+    o.max_evaluations = evaluations;
+    o.seed = derive_seed(seed, base.path);
+    Cmaes es(Eigen::VectorXd::Zero(3), o);
+    while (!es.done()) {
+      const Eigen::MatrixXd& x = es.ask();
+      std::vector<double> values(static_cast<std::size_t>(x.rows()));
+      for (Eigen::Index r = 0; r < x.rows(); ++r) {
+        const Trial trial = consider(base.path, warp_from(x.row(r).transpose(), c, base.warp));
+        if (trial.success) return choice;
+        values[static_cast<std::size_t>(r)] = -trial.score;
+      }
+      es.tell(values);
+    }
+  }
+  return choice;
+}
+
+// How far recorded state `r` (its x moved by `shift`) is from `s`, for joining a path there: the
+// cup's pose and velocity, and the dice relative to the cup. Metres, with angles at 0.1 m/rad and
+// velocities over 0.1 s (the feedback's time constant).
+double join_distance(const State& r, double shift, const State& s) {
+  double d = 0.3 * std::abs(r[si::kCupX] + shift - s[si::kCupX]) + std::abs(r[si::kCupY] - s[si::kCupY]) +
+             0.1 * std::abs(std::remainder(r[si::kCupAngle] - s[si::kCupAngle], 2.0 * std::numbers::pi)) +
+             0.1 * (std::abs(r[si::kCupVx] - s[si::kCupVx]) + std::abs(r[si::kCupVy] - s[si::kCupVy])) +
+             0.01 * std::abs(r[si::kCupW] - s[si::kCupW]);
+  for (std::size_t i = 0; i < kDiceCount; ++i)
+    for (std::size_t k = 0; k < 2; ++k)
+      d += std::abs((r[si::die(i) + k] - r[k]) - (s[si::die(i) + k] - s[k])) / static_cast<double>(kDiceCount);
+  return d;
 }
 
 }  // namespace
@@ -90,19 +200,29 @@ void validate(const TrackerConfig& c) {
   require(c.offset_range >= 0.0 && c.offset_range <= 10.0, "offset_range", "in [0, 10]", c.offset_range);
   require(c.amplitude_range >= 0.0 && c.amplitude_range < 1.0, "amplitude_range", "in [0, 1)", c.amplitude_range);
   require(c.hold_steps >= 0 && c.hold_steps <= 100000, "hold_steps", "in [0, 100000]", c.hold_steps);
+  require(c.smooth >= 0.0 && c.smooth <= 1000.0, "smooth", "in [0, 1000]", c.smooth);
+  require(c.rescue_interval >= 0 && c.rescue_interval <= 100000, "rescue_interval", "in [0, 100000]",
+          c.rescue_interval);
+  require(c.rescue_evaluations >= 1 && c.rescue_evaluations <= 100000, "rescue_evaluations", "in [1, 100000]",
+          c.rescue_evaluations);
 }
 
 PathFollower::PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain)
     : path_(&path), warp_(warp), start_step_(start_step), gain_(gain) {
   centre_ = mean_dice_x(path.states.front());
   shift_ = mean_dice_x(start) - centre_ + warp.offset;
-  length_ = static_cast<int>(std::ceil(static_cast<double>(path.states.size() - 1) / warp.time_scale));
+  length_ = static_cast<int>(
+      std::ceil(std::max(0.0, static_cast<double>(path.states.size() - 1) - warp.phase) / warp.time_scale));
+}
+
+double PathFollower::phase(int step) const {
+  return warp_.phase + std::max(0.0, static_cast<double>(step - start_step_) * warp_.time_scale);
 }
 
 Action PathFollower::act(const State& s, int step) const {
   const auto& states = path_->states;
   const auto& actions = path_->actions;
-  const double u = std::max(0.0, static_cast<double>(step - start_step_) * warp_.time_scale);
+  const double u = phase(step);
   const std::size_t last = states.size() - 1;
   const bool held = static_cast<double>(last) <= u;
   const std::size_t i = held ? last : static_cast<std::size_t>(u);
@@ -135,6 +255,8 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
   validate(config_);
   if (paths_.empty()) throw InputError("tracker: no recordings to follow");
   for (const auto& p : paths_) check_path(p);
+  if (config_.smooth > 0.0)
+    for (auto& p : paths_) p = smoothed(p, config_.smooth);
   probe_successes_.assign(paths_.size(), 0);
   const auto probes = static_cast<std::size_t>(config_.probes);
   if (probes > 0) {
@@ -163,52 +285,40 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
 }
 
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed) {
-  const TrackerConfig& c = recordings.config();
-  const EnvSnapshot start = env.snapshot();
+  std::vector<Candidate> candidates;
+  for (const std::size_t p : recordings.order()) candidates.push_back({p, {}});
+  return search(recordings, env, sim, env.get_state(), candidates, recordings.config().optimise_evaluations, seed);
+}
+
+bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps) {
+  return simulate(follower, sim, env.snapshot(), hold_steps).success;
+}
+
+TrackerChoice rescue_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
+                          const TrackerChoice& current, double current_phase, std::uint64_t seed) {
   const State s = env.get_state();
-  const int t = env.t();
-  const auto& paths = recordings.paths();
-  TrackerChoice choice;
-  double best = -1e300;
-  // Keeps the best failure so far; returns true on a success (which is then the choice).
-  auto consider = [&](std::size_t p, const PathWarp& w) {
-    const Trial trial = simulate(PathFollower(paths[p], w, s, t, c.gain), sim, start, c.hold_steps);
-    ++choice.simulations;
-    if (trial.score > best) {  // a success outscores every failure
-      best = trial.score;
-      choice.path = p;
-      choice.warp = w;
-      choice.success = trial.success;
-    }
-    return trial;
-  };
-  std::vector<std::pair<double, std::size_t>> near;  // (score, path) of the recordings as recorded
+  const double frame_x = mean_dice_x(frame);
+  std::vector<Candidate> candidates;
+  PathWarp rest = current.warp;
+  rest.phase = current_phase;
+  candidates.push_back({current.path, rest});
   for (const std::size_t p : recordings.order()) {
-    const Trial trial = consider(p, {});
-    if (trial.success) return choice;
-    near.emplace_back(trial.score, p);
-  }
-  if (!c.optimise) return choice;
-  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
-  for (const auto& [score, p] : near) {
-    CmaesOptions o;
-    o.sigma0 = 0.3;  // in units of the warp bounds
-    o.max_evaluations = c.optimise_evaluations;
-    o.seed = derive_seed(seed, p);
-    Cmaes es(Eigen::VectorXd::Zero(3), o);
-    while (!es.done()) {
-      const Eigen::MatrixXd& x = es.ask();
-      std::vector<double> values(static_cast<std::size_t>(x.rows()));
-      for (Eigen::Index r = 0; r < x.rows(); ++r) {
-        const Trial trial = consider(p, warp_from(x.row(r).transpose(), c));
-        if (trial.success) return choice;
-        values[static_cast<std::size_t>(r)] = -trial.score;
-      }
-      es.tell(values);
+    if (p == current.path) continue;
+    const CupPath& path = recordings.paths()[p];
+    const double shift = frame_x - mean_dice_x(path.states.front());
+    std::size_t join = 0;
+    double nearest = 1e300;
+    for (std::size_t i = 0; i + 1 < path.states.size(); ++i) {
+      const double d = join_distance(path.states[i], shift, s);
+      if (d < nearest) nearest = d, join = i;
     }
+    PathWarp w;
+    w.phase = static_cast<double>(join);
+    w.offset = s[si::kCupX] - (path.states[join][si::kCupX] + shift);  // meet the cup where it is
+    candidates.push_back({p, w});
   }
-  return choice;
+  const TrackerConfig& c = recordings.config();
+  return search(recordings, env, sim, frame, candidates, c.rescue_evaluations, derive_seed(seed, env.t()));
 }
 
 }  // namespace dicestack

@@ -29,6 +29,7 @@ struct PathWarp {
   double time_scale = 1.0;  ///< recorded steps per control step (> 1 plays it faster)
   double offset = 0.0;      ///< extra shift in x, m
   double amplitude = 1.0;   ///< the path's x about its dice' mean x is scaled by this
+  double phase = 0.0;       ///< recorded steps already played at the follower's first step (a rescue joins midway)
 };
 
 /// Settings of the tracker. The warp bounds say how far a correction may go, they are not tuned
@@ -44,14 +45,24 @@ struct TrackerConfig {
   double offset_range = 0.3;       ///< |offset| <= this, m
   double amplitude_range = 0.15;   ///< |amplitude - 1| <= this, in [0, 1)
   int hold_steps = 60;       ///< a simulation ends this many steps after the path's end, >= 0
+  /// Closed loop on the dice: every this many steps the rest of the followed path is simulated
+  /// from the state reached; when it no longer ends in a success, a rescue joins a recording
+  /// midway (rescue_path). 0: the path is chosen once per episode. >= 0.
+  int rescue_interval = 0;
+  int rescue_evaluations = 30;  ///< simulated warps per recording in a rescue's search (CMA-ES), >= 1
+  /// Each path's pose and velocity are smoothed by a Gaussian of this std, in steps, before it
+  /// is followed (0: as recorded). A person's per-step jitter is no part of the motion a learner
+  /// can fit: labels are the path's accelerations. In [0, 1000].
+  double smooth = 0.0;
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
 void validate(const TrackerConfig& config);
 
 /// Follows one recorded path moved into a start's frame (x shifted by the difference of the
-/// dice' mean x), then warped: dv = v_ref + gain (p_ref - p) - v on the cup's x, y and angle,
-/// with v_ref the recorded velocity after the recorded action. After the path's end it holds the
+/// dice' mean x in `start` and in the recording's first state), then warped: dv = v_ref +
+/// gain (p_ref - p) - v on the cup's x, y and angle, with v_ref the recorded velocity after the
+/// recorded action. After the path's end it holds the
 /// last pose. act() is a pure function of the state and the step.
 class PathFollower {
  public:
@@ -62,12 +73,14 @@ class PathFollower {
   Action act(const State& s, int step) const;
   /// Control steps from the start step to the path's end.
   int length() const { return length_; }
+  /// Recorded steps played by control step `step`.
+  double phase(int step) const;
   bool valid() const { return path_ != nullptr; }
 
  private:
   const CupPath* path_ = nullptr;
   PathWarp warp_;
-  int start_step_ = 0, length_ = 0;
+  int start_step_ = 0, length_ = 0;  // length_: steps from start_step_ to the path's end
   double centre_ = 0.0, shift_ = 0.0, gain_ = 10.0;
 };
 
@@ -114,5 +127,17 @@ struct TrackerChoice {
 /// failing all, the closest (fewest judge tolerances from a stack, no wall). Deterministic in
 /// the state, the recordings and `seed`.
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed);
+
+/// Whether `follower`, followed from env's current state, simulates to a realistic success.
+bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps);
+
+/// A rescue, mid-episode, when the followed path (`current`, moved into the frame of `frame`,
+/// the episode's start) no longer simulates to a success from env's state: its rest, then every
+/// recording joined at its step nearest the state (the cup's pose and velocity, the dice
+/// relative to the cup) with x moved to meet the cup, first success wins; if none and
+/// config.optimise, warps of the closest. Failing all, the closest, which may be `current`.
+/// Deterministic in the state, `current`, the recordings and `seed`.
+TrackerChoice rescue_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
+                          const TrackerChoice& current, double current_phase, std::uint64_t seed);
 
 }  // namespace dicestack
