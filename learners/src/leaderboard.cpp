@@ -1,8 +1,6 @@
 #include <dicestack/learners/leaderboard.hpp>
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -288,35 +286,32 @@ const LeaderboardFormat& leaderboard_format(const std::string& name) {
   throw std::logic_error("unreachable");
 }
 
-Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
-  LeaderboardRequest opt = request;
-  const Profile& profile = leaderboard_profile(opt.profile);
-  check_one_of("split", opt.split, {"episodes", "rows"});
-  const LeaderboardFormat& format = leaderboard_format(opt.format);
-  if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
-  if (opt.seeds < 1) throw ConfigError("leaderboard: seeds must be at least 1, got " + std::to_string(opt.seeds));
-  Cluster& cluster = *opt.cluster;
-  std::function<void(const std::string&, double, bool)> report = [&](const std::string& text, double fraction, bool milestone) {
-    if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
-  };
-  auto say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
-  const WorldConfig& world = opt.world;
-  const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
-  const int episodes = opt.episodes > 0 ? opt.episodes : profile.rollouts;
-  const auto& dir = opt.demos;
-  const DemoSet set = read_demo_set(dir);
-  const auto regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
-  // Learner rows by spec ("dart" or "dart:expert=tracker"), each with its registered learner.
-  std::map<std::string, LearnerSpec> specs;
-  const auto learners = opt.learners.empty() ? profile.learners : opt.learners;
-  for (const auto& l : learners) specs.emplace(l, parse_learner_spec(l));  // unknown names fail before any work
-  auto base = [&](const std::string& spec) { return specs.at(spec).name; };
-  // Learner options: the profile's defaults, then the spec's, then --option (for every learner
-  // that has the key).
-  auto options_for = [&](const std::string& spec) {
-    const std::string learner = base(spec);
-    const auto defaults = profile.learner_options.find(learner);
-    std::vector<std::string> out = defaults == profile.learner_options.end() ? std::vector<std::string>{} : defaults->second;
+namespace {
+
+using Say = std::function<void(const std::string& text, double fraction)>;
+
+// What a run will do, settled before any work: every name and option checked, the rows in
+// table order, and the text and settings every format carries.
+struct RunPlan {
+  LeaderboardRequest request;  // baselines "all" expanded
+  const Profile* profile = nullptr;
+  Perturbation perturbation;
+  int episodes = 0;  // rollouts per training seed
+  DemoSet set;
+  std::vector<std::string> regressors, learners;
+  std::map<std::string, LearnerSpec> specs;  // each learner row's spec ("dart:expert=tracker")
+  std::vector<std::pair<std::string, std::string>> combos;  // (learner, feature map) rows
+  std::string header;
+  json meta;
+
+  const std::string& base(const std::string& spec) const { return specs.at(spec).name; }
+
+  // A learner row's options: the profile's defaults, then the spec's, then --option (for every
+  // learner that has the key).
+  std::vector<std::string> options_for(const std::string& spec) const {
+    const std::string& learner = base(spec);
+    const auto defaults = profile->learner_options.find(learner);
+    std::vector<std::string> out = defaults == profile->learner_options.end() ? std::vector<std::string>{} : defaults->second;
     auto put = [&](const std::string& kv) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -326,47 +321,73 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
         }
     };
     for (const auto& kv : specs.at(spec).options) put(kv);
-    for (const auto& kv : opt.options) put(kv);
+    for (const auto& kv : request.options) put(kv);
     return out;
-  };
+  }
+
+  // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart). A
+  // pair names a learner row by its spec ("dart:expert=tracker") or every row of a learner ("dart").
+  bool left_out(const std::string& learner, const std::string& regressor) const {
+    if (!request.regressors.empty()) return false;  // named regressors are always run
+    return std::any_of(profile->left_out.begin(), profile->left_out.end(), [&](const auto& pair) {
+      return pair.second == regressor && (pair.first == learner || pair.first == base(learner));
+    });
+  }
+
+  static std::string row_key(const std::string& learner, const std::string& features, const std::string& regressor) {
+    return learner + "/" + features + "/" + regressor;
+  }
+};
+
+// Every name, option and count of the request, checked against its registry or schema.
+void check_request(RunPlan& plan) {
+  LeaderboardRequest& opt = plan.request;
+  check_one_of("split", opt.split, {"episodes", "rows"});
+  leaderboard_format(opt.format);
+  if (opt.episodes < 0) throw ConfigError("leaderboard: episodes must be positive (0: the profile's), got " + std::to_string(opt.episodes));
+  if (opt.seeds < 1) throw ConfigError("leaderboard: seeds must be at least 1, got " + std::to_string(opt.seeds));
+  for (const auto& l : plan.learners) plan.specs.emplace(l, parse_learner_spec(l));  // unknown names fail before any work
   // Every option parsed against its learner's schema before any work (a bad value would
   // otherwise surface when that row's turn to train came, after the rows before it), and an
   // --option no learner of this run has is a typo, not a no-op.
-  for (const auto& l : learners) {
-    const auto& schema = LearnerRegistry::global().info(base(l)).params;
-    const Params params(schema, options_for(l), l);
+  for (const auto& l : plan.learners) {
+    const auto& schema = LearnerRegistry::global().info(plan.base(l)).params;
+    const Params params(schema, plan.options_for(l), l);
     if (std::any_of(schema.begin(), schema.end(), [](const ParamSpec& p) { return p.name == "perturb"; }))
-      learner_perturbation(params, world, l);  // a level or a file, checked against the world
+      learner_perturbation(params, opt.world, l);  // a level or a file, checked against the world
   }
   for (const auto& kv : opt.options) {
     const auto key = kv.substr(0, kv.find('='));
-    const bool used = std::any_of(learners.begin(), learners.end(), [&](const std::string& l) {
-      const auto& params = LearnerRegistry::global().info(base(l)).params;
+    const bool used = std::any_of(plan.learners.begin(), plan.learners.end(), [&](const std::string& l) {
+      const auto& params = LearnerRegistry::global().info(plan.base(l)).params;
       return std::any_of(params.begin(), params.end(), [&](const ParamSpec& p) { return p.name == key; });
     });
     if (!used) {
       std::string names;
-      for (const auto& l : learners) names += (names.empty() ? "" : ", ") + l;
+      for (const auto& l : plan.learners) names += (names.empty() ? "" : ", ") + l;
       throw ConfigError("--option " + kv + ": none of this leaderboard's learners (" + names + ") has an option \"" + key +
                         "\" (`dicestack learners` lists each one's)");
     }
   }
-  for (const auto& r : regressors) RegressorRegistry::global().info(r);  // fail fast on typos
+  for (const auto& r : plan.regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = baseline_names();
   for (const auto& b : opt.baselines) baseline(b);  // unknown names fail before any work
-  for (const auto& l : learners)
-    if (LearnerRegistry::global().info(base(l)).needs_trajectories && opt.split == "rows")
+  for (const auto& l : plan.learners)
+    if (LearnerRegistry::global().info(plan.base(l)).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
+}
 
-  // (learner, feature map) rows: each learner with every map of --features it can read, or with
-  // its own default map.
+// The (learner, feature map) rows: each learner with every map of --features it can read, or
+// with its own default map.
+std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan, const Say& say) {
+  const LeaderboardRequest& opt = plan.request;
   std::vector<std::pair<std::string, std::string>> combos;
-  for (const auto& l : learners) {
-    const LearnerInfo& info = LearnerRegistry::global().info(base(l));
+  for (const auto& l : plan.learners) {
+    const LearnerInfo& info = LearnerRegistry::global().info(plan.base(l));
     // The paper profile's full picture: every learner with the bare state and with dart's map too.
     std::vector<std::string> maps{info.default_features};
-    if (profile.every_feature_map && info.default_features != "state") maps.insert(maps.begin(), "state");
-    if (profile.every_feature_map && info.default_features == "state")
+    if (plan.profile->every_feature_map && info.default_features != "state") maps.insert(maps.begin(), "state");
+    if (plan.profile->every_feature_map && info.default_features == "state")
       maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work
@@ -380,130 +401,141 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
       combos.emplace_back(l, f);
     }
   }
+  return combos;
+}
 
-  // Episode split: learners get the training episodes. Row split (the paper's protocol): they
-  // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
-  const DemoSplit split(set.episodes, opt.split);
-
+// The header line and the settings (meta) every format carries; a progress file is reused only
+// with the same meta.
+void describe_run(RunPlan& plan, const DemoSplit& split) {
+  const LeaderboardRequest& opt = plan.request;
   std::size_t frames = 0;
-  for (const auto& e : set.episodes) frames += e.size();
+  for (const auto& e : plan.set.episodes) frames += e.size();
   std::ostringstream header;
-  header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << dir.string() << " (" << set.episodes.size()
-         << " episodes, " << frames << " frames); split " << split.matrices().description << "; profile " << opt.profile << "; "
-         << episodes << " rollouts per training seed from random starts (seed " << opt.seed << "), " << opt.seeds
-         << " training seed(s); rates with 95% Wilson intervals";
+  header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << opt.demos.string() << " ("
+         << plan.set.episodes.size() << " episodes, " << frames << " frames); split " << split.matrices().description
+         << "; profile " << opt.profile << "; " << plan.episodes << " rollouts per training seed from random starts (seed "
+         << opt.seed << "), " << opt.seeds << " training seed(s); rates with 95% Wilson intervals";
   json learner_options = json::object(), row_features = json::array();
-  for (const auto& l : learners) learner_options[l] = options_for(l);
-  for (const auto& [l, f] : combos) row_features.push_back(l + " " + f);
+  for (const auto& l : plan.learners) learner_options[l] = plan.options_for(l);
+  for (const auto& [l, f] : plan.combos) row_features.push_back(l + " " + f);
   header << "; learner options " << learner_options.dump() << "; features " << row_features.dump();
-  // Rows the profile leaves out unless the regressors are named (quick: rbf_svr under dart).
-  auto left_out = [&](const std::string& learner, const std::string& regressor) {
-    if (!opt.regressors.empty()) return false;  // named regressors are always run
-    // A pair names a learner row by its spec ("dart:expert=tracker") or every row of a learner ("dart").
-    return std::any_of(profile.left_out.begin(), profile.left_out.end(), [&](const auto& pair) {
-      return pair.second == regressor && (pair.first == learner || pair.first == base(learner));
-    });
-  };
-  if (std::any_of(learners.begin(), learners.end(), [&](const std::string& l) {
-        return std::any_of(regressors.begin(), regressors.end(), [&](const std::string& r) { return left_out(l, r); });
+  if (std::any_of(plan.learners.begin(), plan.learners.end(), [&](const std::string& l) {
+        return std::any_of(plan.regressors.begin(), plan.regressors.end(), [&](const std::string& r) { return plan.left_out(l, r); });
       }))
-    header << "; " << profile.left_out_note;
-  if (!perturbation.nominal())
-    header << "; rollouts in perturbed worlds (" << opt.perturb << ": " << perturbation_summary(perturbation)
+    header << "; " << plan.profile->left_out_note;
+  if (!plan.perturbation.nominal())
+    header << "; rollouts in perturbed worlds (" << opt.perturb << ": " << perturbation_summary(plan.perturbation)
            << "), drawn per episode; training nominal";
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
            << " budgets, then played from the same random starts";
-  json meta{{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION}, {"demos", dir.string()}, {"episodes_in_demos", set.episodes.size()},
-                  {"split", split.matrices().description}, {"profile", opt.profile}, {"rollouts_per_seed", episodes},
-                  {"training_seeds", opt.seeds}, {"seed", opt.seed}};
-
-  // Resume: rows already measured with the same settings are read back (by the root, which
-  // alone writes the file; the other ranks get its reading).
-  const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
-  if (!opt.out.empty()) {  // refuse a user's files before any work
-    check_replaceable(opt.out, format.ownership());
-    check_replaceable(partial, partial_ownership());
-    if (format.check_beside) format.check_beside(opt.out);
-  }
+  plan.header = header.str();
+  plan.meta = {{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION},
+               {"demos", opt.demos.string()}, {"episodes_in_demos", plan.set.episodes.size()},
+               {"split", split.matrices().description}, {"profile", opt.profile}, {"rollouts_per_seed", plan.episodes},
+               {"training_seeds", opt.seeds}, {"seed", opt.seed}};
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
-  if (!perturbation.nominal()) meta["perturb"] = json::parse(perturbation_to_json(perturbation));
-  json done = json::parse(on_root(cluster, [&] {
+  if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
+}
+
+// Resume: the rows of <out>.partial.json measured with the same settings, read by the root
+// (which alone writes the file) and given to every rank. A row not held whole is left out (it
+// is measured again); an unreadable file only means no rows to reuse.
+json rows_already_measured(Cluster& cluster, const std::filesystem::path& partial, const json& meta) {
+  return json::parse(on_root(cluster, [&] {
     json rows_done = json::object();
-    if (!partial.empty() && std::filesystem::exists(partial)) {
-      try {
-        json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
-        // Rows of another version or other settings are not reused.
-        if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) rows_done = p.value("rows", json::object());
-        if (!rows_done.is_object()) rows_done = json::object();
-        for (auto it = rows_done.begin(); it != rows_done.end();) {  // a row not held whole is measured again
-          try {
-            row_from(*it);
-            ++it;
-          } catch (const std::exception&) {
-            it = rows_done.erase(it);
-          }
+    if (partial.empty() || !std::filesystem::exists(partial)) return rows_done.dump();
+    try {
+      json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
+      // Rows of another version or other settings are not reused.
+      if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) rows_done = p.value("rows", json::object());
+      if (!rows_done.is_object()) rows_done = json::object();
+      for (auto it = rows_done.begin(); it != rows_done.end();) {
+        try {
+          row_from(*it);
+          ++it;
+        } catch (const std::exception&) {
+          it = rows_done.erase(it);
         }
-      } catch (const std::exception&) {  // an unreadable progress file only means no rows to reuse
       }
+    } catch (const std::exception&) {
     }
     return rows_done.dump();
   }));
+}
 
-  const std::size_t total = combos.size() * regressors.size();
-  // Progress in units of rows: one per (learner, map, regressor) and per baseline.
-  const double units = static_cast<double>(total + opt.baselines.size()) + 0.5;
+// One unit of the run: a training seed of a learner row, or a baseline whole (its seeds share
+// one optimisation).
+struct Job {
+  std::size_t index = 0;  // 1-based place among the learner rows; 0 for a baseline
+  std::string learner, features, regressor, key;
+  int seed = 0;  // which training seed of the row (learner rows)
+  std::size_t baseline = 0;
+};
 
-  // The work still to do, in table order: each (learner, map, regressor) row once per training
-  // seed, then each baseline whole (its seeds share one optimisation).
-  struct Job {
-    std::size_t index = 0;  // 1-based place among the learner rows; 0 for a baseline
-    std::string learner, features, regressor, key;
-    int seed = 0;  // which training seed of the row (learner rows)
-    std::size_t baseline = 0;
-  };
+// The work still to do, in table order: each learner row not left out nor already measured,
+// once per training seed, then each baseline.
+std::vector<Job> pending_jobs(const RunPlan& plan, const json& done) {
   std::vector<Job> jobs;
   std::size_t index = 0;
-  for (const auto& [learner_name, features] : combos)
-    for (const auto& name : regressors) {
+  for (const auto& [learner, features] : plan.combos)
+    for (const auto& name : plan.regressors) {
       ++index;
-      const std::string key = learner_name + "/" + features + "/" + name;
-      if (!left_out(learner_name, name) && !done.contains(key))
-        for (int s = 0; s < opt.seeds; ++s) jobs.push_back({index, learner_name, features, name, key, s, 0});
+      const std::string key = RunPlan::row_key(learner, features, name);
+      if (!plan.left_out(learner, name) && !done.contains(key))
+        for (int s = 0; s < plan.request.seeds; ++s) jobs.push_back({index, learner, features, name, key, s, 0});
     }
-  for (std::size_t b = 0; b < opt.baselines.size(); ++b) jobs.push_back({0, "baseline", "-", opt.baselines[b], "", 0, b});
+  for (std::size_t b = 0; b < plan.request.baselines.size(); ++b)
+    jobs.push_back({0, "baseline", "-", plan.request.baselines[b], "", 0, b});
+  return jobs;
+}
 
-  // Each job's work (learner_seed, baseline_row) and how a row adds its seeds up (combine).
-  RowSettings settings;
-  settings.world = world;
-  settings.profile = &profile;
-  settings.split = &split;
-  settings.episodes = episodes;
-  settings.seeds = opt.seeds;
-  settings.seed = opt.seed;
-  settings.threads = opt.threads;
-  settings.perturbation = perturbation;
-  settings.previews = opt.format == "html";
-  settings.learner_options = options_for;
-  const RowRunner runner(settings, report);
+// The deal over several ranks, on one line: which rank runs each job, and each rank's estimated load.
+std::string deal_text(const std::vector<double>& cost, int ranks) {
+  const std::vector<int> owner = deal_items(cost.size(), ranks, cost);
+  std::vector<double> load(static_cast<std::size_t>(ranks), 0.0);
+  std::string ranks_of;
+  for (std::size_t j = 0; j < cost.size(); ++j) {
+    load[static_cast<std::size_t>(owner[j])] += cost[j];
+    ranks_of += (j ? " " : "") + std::to_string(owner[j]);
+  }
+  std::string loads;
+  for (double l : load) loads += (loads.empty() ? "" : " ") + std::to_string(static_cast<long>(std::lround(l)));
+  return "deal: " + std::to_string(cost.size()) + " jobs on " + std::to_string(ranks) + " ranks, estimated seconds per rank " +
+         loads + "; rank of each job in table order: " + ranks_of;
+}
 
-  // Finished rows by their first job; a learner row goes to <out>.partial.json as soon as the
-  // root has all its seeds.
+// Runs the jobs (over the ranks when there are several: deal_jobs, longest first by
+// estimated_row_cost) and returns each job's row, by the job that starts it: a learner row at
+// its first seed's job, once the root has all its seeds. The root writes each finished learner
+// row to `partial` (when not empty) as it completes.
+std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, const std::vector<Job>& jobs,
+                                                        const RowRunner& runner, json& done,
+                                                        const std::filesystem::path& partial, const Say& say,
+                                                        const std::function<void()>*& poll) {
+  const LeaderboardRequest& opt = plan.request;
+  Cluster& cluster = *opt.cluster;
   std::vector<std::optional<LeaderboardRow>> measured(jobs.size());
   std::vector<std::optional<SeedResult>> seed_results(jobs.size());
-  std::size_t finished_jobs = 0;
+  std::size_t finished = 0;
   auto keep_row = [&](std::size_t j, LeaderboardRow row) {
     if (!jobs[j].key.empty() && !partial.empty() && cluster.is_root()) {
       done[jobs[j].key] = partial_row_json(row);
       AtomicFile f(partial, partial_ownership());
-      f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", meta}, {"rows", done}}.dump();
+      f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", plan.meta}, {"rows", done}}.dump();
       f.commit();
     }
     measured[j] = std::move(row);
   };
   // Job j's result (a packed SeedResult or baseline row) has arrived.
-  auto keep = [&](std::size_t j, std::string_view bytes) {
-    ++finished_jobs;
+  auto keep = [&](std::size_t j, const std::string& bytes, int rank) {
+    ++finished;
+    if (cluster.size() > 1 && cluster.is_root() && rank != cluster.rank())
+      say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
+                               std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
+                         : "baseline " + jobs[j].regressor) +
+              " finished on rank " + std::to_string(rank),
+          static_cast<double>(finished) / (static_cast<double>(jobs.size()) + 0.5));
     if (jobs[j].index == 0) {
       Unpacker u(bytes, "leaderboard baseline row");
       keep_row(j, unpack_row(u));
@@ -518,144 +550,132 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     }
     keep_row(first, runner.combine(jobs[first].learner, jobs[first].features, jobs[first].regressor, seeds));
   };
-  // One job (a baseline, or one seed of a learner row) on `inner` (the single process when
-  // several ranks share the run); its progress fraction runs from `from` to `from + span`.
-  auto run_job = [&](std::size_t j, Cluster& inner, double from, double span) {
+  // Progress in units of rows (one per learner row and per baseline) on one process; in units
+  // of jobs finished over several ranks, where they finish out of order.
+  const std::size_t learner_rows = plan.combos.size() * plan.regressors.size();
+  const double row_units = static_cast<double>(learner_rows + opt.baselines.size()) + 0.5;
+  const double job_units = static_cast<double>(jobs.size()) + 0.5;
+  auto run = [&](std::size_t j, const std::function<void()>& poll_now) {
     const Job& job = jobs[j];
+    double from = static_cast<double>(finished) / job_units, span = 1.0 / job_units;
+    if (cluster.size() == 1) {
+      from = (job.index ? static_cast<double>(job.index - 1) + static_cast<double>(job.seed) / opt.seeds
+                        : static_cast<double>(learner_rows + job.baseline)) / row_units;
+      span = (job.index ? 1.0 / opt.seeds : 1.0) / row_units;
+    }
+    poll = &poll_now;  // the root takes other ranks' results while it reports its own job's progress
+    struct Unset {
+      const std::function<void()>*& poll;
+      ~Unset() { poll = nullptr; }
+    } unset{poll};
+    Cluster& inner = local_cluster();  // a job runs whole on its rank
     if (job.index == 0) {
       Packer p;
       pack_row(p, runner.baseline_row(job.regressor, inner, from, span));
       return p.take();
     }
-    const std::string row_text =
-        "[" + std::to_string(job.index) + "/" + std::to_string(total) + "] " + job.learner + " " + job.regressor;
+    const std::string row_text = "[" + std::to_string(job.index) + "/" + std::to_string(learner_rows) + "] " + job.learner + " " + job.regressor;
     return pack_seed_result(runner.learner_seed(job.learner, job.features, job.regressor, job.seed, row_text, inner, from, span));
   };
-  if (cluster.size() == 1) {
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      const double from = jobs[j].index ? static_cast<double>(jobs[j].index - 1) + static_cast<double>(jobs[j].seed) / opt.seeds
-                                        : static_cast<double>(total + jobs[j].baseline);
-      keep(j, run_job(j, cluster, from / units, (jobs[j].index ? 1.0 / opt.seeds : 1.0) / units));
-    }
-  } else {
-    // Several ranks: each job (one seed of a row, or a baseline) runs whole on the rank the deal
-    // gives it (the most expensive first, each to the least loaded rank); a non-root rank sends
-    // each result to the root as it finishes. The root takes them in between (and during) its
-    // own jobs, writes the progress file, and at the end waits for the rest and broadcasts them.
-    std::vector<double> cost(jobs.size());
-    for (std::size_t j = 0; j < jobs.size(); ++j)
-      cost[j] = estimated_row_cost(jobs[j].index ? base(jobs[j].learner) : "baseline", jobs[j].regressor, jobs[j].features,
-                                   profile, jobs[j].index ? episodes : episodes * opt.seeds);
-    const std::vector<int> owner = deal_items(jobs.size(), cluster.size(), cost);
-    const double job_units = static_cast<double>(jobs.size()) + 0.5;
-    {  // the deal, on one line: which rank runs each job, and the estimated load of each rank
-      std::vector<double> load(static_cast<std::size_t>(cluster.size()), 0.0);
-      std::string ranks_of;
-      for (std::size_t j = 0; j < jobs.size(); ++j) {
-        load[static_cast<std::size_t>(owner[j])] += cost[j];
-        ranks_of += (j ? " " : "") + std::to_string(owner[j]);
-      }
-      std::string loads;
-      for (double l : load) loads += (loads.empty() ? "" : " ") + std::to_string(static_cast<long>(std::lround(l)));
-      say("deal: " + std::to_string(jobs.size()) + " jobs on " + std::to_string(cluster.size()) +
-              " ranks, estimated seconds per rank " + loads + "; rank of each job in table order: " + ranks_of,
-          0.0);
-    }
-    std::vector<std::string> results(jobs.size());
-    auto take_arrivals = [&](bool wait) {
-      for (auto& [from_rank, bytes] : cluster.receive(wait)) {
-        Unpacker u(bytes, "leaderboard result from rank " + std::to_string(from_rank));
-        const auto j = static_cast<std::size_t>(u.get<std::uint64_t>());
-        if (j >= jobs.size() || !results[j].empty())
-          throw Error("leaderboard: rank " + std::to_string(from_rank) + " sent result " + std::to_string(j) + " unexpectedly");
-        results[j] = u.get_string();
-        keep(j, results[j]);
-        say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
-                                 std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
-                           : "baseline " + jobs[j].regressor) +
-                " finished on rank " + std::to_string(from_rank),
-            static_cast<double>(finished_jobs) / job_units);
-      }
-    };
-    std::chrono::steady_clock::time_point last_poll{};
-    std::atomic<bool> polling{false};
-    const auto plain_report = report;  // restored below: the polling report refers to this block's locals
-    if (cluster.is_root()) {
-      // While it works on its own jobs, the root looks for other ranks' results at most once a
-      // second, from whichever thread reports (one at a time; not from inside a poll).
-      const auto user_report = report;
-      report = [&, user_report](const std::string& text, double fraction, bool milestone) {
-        user_report(text, fraction, milestone);
-        if (polling.exchange(true)) return;
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last_poll > std::chrono::seconds(1)) {
-          last_poll = now;
-          try {
-            take_arrivals(false);
-          } catch (...) {
-            polling = false;
-            throw;
-          }
-        }
-        polling = false;
-      };
-    }
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      if (owner[j] != cluster.rank()) continue;
-      std::string bytes = run_job(j, local_cluster(), static_cast<double>(finished_jobs) / job_units, 1.0 / job_units);
-      if (cluster.is_root()) {
-        results[j] = std::move(bytes);
-        keep(j, results[j]);
-        take_arrivals(false);
-      } else {
-        cluster.send_to_root(Packer().put<std::uint64_t>(j).put_string(bytes).take());
-      }
-    }
-    if (cluster.is_root())
-      while (finished_jobs < jobs.size()) take_arrivals(true);
-    Packer all;
-    if (cluster.is_root())
-      for (const std::string& r : results) all.put_string(r);
-    std::string bytes = all.take();
-    cluster.broadcast(bytes);
-    if (!cluster.is_root()) {
-      Unpacker u(bytes, "leaderboard results from rank 0");
-      for (std::size_t j = 0; j < jobs.size(); ++j) keep(j, u.get_string());
-    }
-    report = plain_report;
-  }
+  std::vector<double> cost(jobs.size());
+  for (std::size_t j = 0; j < jobs.size(); ++j)
+    cost[j] = estimated_row_cost(jobs[j].index ? plan.base(jobs[j].learner) : "baseline", jobs[j].regressor, jobs[j].features,
+                                 *plan.profile, jobs[j].index ? plan.episodes : plan.episodes * opt.seeds);
+  if (cluster.size() > 1) say(deal_text(cost, cluster.size()), 0.0);
+  deal_jobs(cluster, cost, run, keep);
+  return measured;
+}
 
-  // The table in its order: learner rows (measured now or read back), then the baselines.
+// The table in its order: learner rows (measured now or read back), then the baselines.
+std::vector<LeaderboardRow> table_rows(const RunPlan& plan, const std::vector<Job>& jobs,
+                                       std::vector<std::optional<LeaderboardRow>>& measured, const json& done) {
   std::vector<LeaderboardRow> rows;
-  std::size_t next = 0;
-  index = 0;
-  for (const auto& [learner_name, features] : combos)
-    for (const auto& name : regressors) {
+  std::size_t next = 0, index = 0;
+  for (const auto& [learner, features] : plan.combos)
+    for (const auto& name : plan.regressors) {
       ++index;
-      if (left_out(learner_name, name)) continue;
+      if (plan.left_out(learner, name)) continue;
       if (next < jobs.size() && jobs[next].index == index) {
-        rows.push_back(*measured[next]);
-        next += static_cast<std::size_t>(opt.seeds);
+        rows.push_back(std::move(*measured[next]));
+        next += static_cast<std::size_t>(plan.request.seeds);
       } else {
-        rows.push_back(row_from(done[learner_name + "/" + features + "/" + name]));
+        rows.push_back(row_from(done.at(RunPlan::row_key(learner, features, name))));
       }
     }
-  for (; next < jobs.size(); ++next) rows.push_back(*measured[next]);
-  // Playback of the demonstrations themselves (paper VI-A), for reference.
-  say("playback of the demonstrations", (units - 0.5) / units);
-  const EvalStats pb = evaluate_playback(set.episodes, world, opt.threads, cluster);
+  for (; next < jobs.size(); ++next) rows.push_back(std::move(*measured[next]));
+  return rows;
+}
+
+// Playback of the demonstrations themselves (paper VI-A), for reference.
+LeaderboardRow playback_row(const RunPlan& plan) {
+  const EvalStats pb = evaluate_playback(plan.set.episodes, plan.request.world, plan.request.threads, *plan.request.cluster);
   LeaderboardRow playback{"(demonstrations)", "playback"};
   playback.train_error = playback.test_error = -1;
   add_outcomes(playback, pb, 1);
   playback.us_per_step = 0;  // playback reads recorded actions: no policy time to report
-  rows.push_back(playback);
+  return playback;
+}
+
+}  // namespace
+
+Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
+  // Where the root stands in its own job's progress, other ranks' results are taken (deal_jobs).
+  const std::function<void()>* poll = nullptr;
+  const RowReport report = [&](const std::string& text, double fraction, bool milestone) {
+    if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
+    if (poll) (*poll)();
+  };
+  const Say say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
+
+  RunPlan plan;
+  plan.request = request;
+  const LeaderboardRequest& opt = plan.request;
+  plan.profile = &leaderboard_profile(opt.profile);
+  plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
+  plan.episodes = opt.episodes > 0 ? opt.episodes : plan.profile->rollouts;
+  plan.regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
+  plan.learners = opt.learners.empty() ? plan.profile->learners : opt.learners;
+  check_request(plan);
+  plan.set = read_demo_set(opt.demos);
+  plan.combos = row_combos(plan, say);
+  // Episode split: learners get the training episodes. Row split (the paper's protocol): they
+  // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
+  const DemoSplit split(plan.set.episodes, opt.split);
+  describe_run(plan, split);
+
+  const LeaderboardFormat& format = leaderboard_format(opt.format);
+  const std::filesystem::path partial = opt.out.empty() ? std::filesystem::path() : std::filesystem::path(opt.out.string() + ".partial.json");
+  if (!opt.out.empty()) {  // refuse a user's files before any work
+    check_replaceable(opt.out, format.ownership());
+    check_replaceable(partial, partial_ownership());
+    if (format.check_beside) format.check_beside(opt.out);
+  }
+  json done = rows_already_measured(*opt.cluster, partial, plan.meta);
+  const std::vector<Job> jobs = pending_jobs(plan, done);
+
+  RowSettings settings;
+  settings.world = opt.world;
+  settings.profile = plan.profile;
+  settings.split = &split;
+  settings.episodes = plan.episodes;
+  settings.seeds = opt.seeds;
+  settings.seed = opt.seed;
+  settings.threads = opt.threads;
+  settings.perturbation = plan.perturbation;
+  settings.previews = opt.format == "html";
+  settings.learner_options = [&plan](const std::string& spec) { return plan.options_for(spec); };
+  const RowRunner runner(settings, report);
+  auto measured = measure_jobs(plan, jobs, runner, done, partial, say, poll);
 
   Leaderboard board;
-  board.rows = std::move(rows);
-  board.header = header.str();
-  board.meta_json = meta.dump();
-  board.world = world;
-  board.demos_description = set.description;
+  board.rows = table_rows(plan, jobs, measured, done);
+  const double units = static_cast<double>(plan.combos.size() * plan.regressors.size() + opt.baselines.size()) + 0.5;
+  say("playback of the demonstrations", (units - 0.5) / units);
+  board.rows.push_back(playback_row(plan));
+  board.header = plan.header;
+  board.meta_json = plan.meta.dump();
+  board.world = opt.world;
+  board.demos_description = plan.set.description;
   return board;
 }
 

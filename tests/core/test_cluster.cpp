@@ -6,6 +6,7 @@
 #include <limits>
 #include <condition_variable>
 #include <mutex>
+#include <numeric>
 #include <thread>
 
 #include <dicestack/core/cluster.hpp>
@@ -86,6 +87,18 @@ struct ThreadRanks {
   std::vector<std::string> slots;
   int arrived = 0, generation = 0;
   std::vector<std::string> gathered;
+  std::vector<std::pair<int, std::string>> mailbox;  // messages to the root
+
+  void send(int rank, std::string bytes) {
+    std::lock_guard lock(m);
+    mailbox.emplace_back(rank, std::move(bytes));
+    cv.notify_all();
+  }
+  std::vector<std::pair<int, std::string>> receive(bool wait) {
+    std::unique_lock lock(m);
+    if (wait) cv.wait(lock, [&] { return !mailbox.empty(); });
+    return std::exchange(mailbox, {});
+  }
 
   std::vector<std::string> gather(int rank, std::string mine) {
     std::unique_lock lock(m);
@@ -111,8 +124,8 @@ class ThreadRank final : public Cluster {
   std::vector<std::string> all_gather(std::string mine) override { return all_.gather(rank_, std::move(mine)); }
   void broadcast(std::string& bytes) override { bytes = all_.gather(rank_, rank_ == 0 ? bytes : "")[0]; }
   void barrier() override { all_.gather(rank_, ""); }
-  void send_to_root(std::string) override {}
-  std::vector<std::pair<int, std::string>> receive(bool) override { return {}; }
+  void send_to_root(std::string bytes) override { all_.send(rank_, std::move(bytes)); }
+  std::vector<std::pair<int, std::string>> receive(bool wait) override { return all_.receive(wait); }
 
  private:
   ThreadRanks& all_;
@@ -143,6 +156,51 @@ TEST(Cluster, DistributedMapGivesEveryRankAllResultsInIndexOrder) {
       for (auto& t : threads) t.join();
       EXPECT_EQ(ran, static_cast<int>(n)) << "each item runs on exactly one rank";
       for (const auto& g : got) EXPECT_EQ(g, alone);
+    }
+  }
+}
+
+TEST(Cluster, DealtJobsRunOnceAndEveryRankSeesEveryResult) {
+  const std::size_t n = 11;
+  std::vector<double> cost(n);
+  for (std::size_t i = 0; i < n; ++i) cost[i] = static_cast<double>((i * 7) % 4);
+  auto result = [](std::size_t i) { return "job " + std::to_string(i); };
+  for (int ranks : {1, 2, 3}) {
+    ThreadRanks all(ranks);
+    const std::vector<int> owner = deal_items(n, ranks, cost);
+    std::vector<std::vector<std::size_t>> seen(static_cast<std::size_t>(ranks));
+    std::vector<std::vector<std::size_t>> ran(static_cast<std::size_t>(ranks));
+    std::vector<std::thread> threads;
+    for (int r = 0; r < ranks; ++r)
+      threads.emplace_back([&, r] {
+        ThreadRank me(all, r);
+        Cluster& cluster = ranks == 1 ? local_cluster() : me;
+        const auto mine = static_cast<std::size_t>(r);
+        deal_jobs(
+            cluster, cost,
+            [&](std::size_t i, const std::function<void()>& poll) {
+              ran[mine].push_back(i);
+              poll();  // as a job's progress report does; no result may come twice through it
+              poll();
+              return result(i);
+            },
+            [&](std::size_t i, const std::string& bytes, int rank) {
+              EXPECT_EQ(bytes, result(i));
+              EXPECT_EQ(rank, owner[i]) << "the rank that ran it";
+              seen[mine].push_back(i);
+            });
+      });
+    for (auto& t : threads) t.join();
+    for (int r = 0; r < ranks; ++r) {
+      std::vector<std::size_t> expected;
+      for (std::size_t i = 0; i < n; ++i)
+        if (owner[i] == r) expected.push_back(i);
+      EXPECT_EQ(ran[static_cast<std::size_t>(r)], expected) << "a rank runs its own jobs, in index order";
+      std::vector<std::size_t> got = seen[static_cast<std::size_t>(r)];
+      if (r == 0) std::sort(got.begin(), got.end());  // the root takes them as they come
+      std::vector<std::size_t> every(n);
+      std::iota(every.begin(), every.end(), std::size_t{0});
+      EXPECT_EQ(got, every) << ranks << " ranks, rank " << r;
     }
   }
 }

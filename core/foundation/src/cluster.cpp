@@ -1,6 +1,8 @@
 #include <dicestack/core/cluster.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <numeric>
 #include <stdexcept>
 
@@ -74,6 +76,66 @@ std::vector<std::string> distributed_map_bytes(Cluster& cluster, std::size_t n, 
   for (std::size_t i = 0; i < n; ++i)
     if (!seen[i]) throw Error("distributed_map: no rank returned item " + std::to_string(i));
   return out;
+}
+
+void deal_jobs(Cluster& cluster, const std::vector<double>& cost,
+               const std::function<std::string(std::size_t, const std::function<void()>&)>& run,
+               const std::function<void(std::size_t, const std::string&, int)>& arrived) {
+  const std::size_t n = cost.size();
+  const std::vector<int> owner = deal_items(n, cluster.size(), cost);
+  std::vector<std::string> results(n);
+  std::vector<bool> seen(n, false);
+  std::size_t count = 0;
+  auto take = [&](std::size_t i, std::string bytes, int rank) {
+    results[i] = std::move(bytes);
+    seen[i] = true;
+    ++count;
+    arrived(i, results[i], rank);
+  };
+  // Root: the results other ranks have sent so far (or, with `wait`, at least one).
+  auto take_arrivals = [&](bool wait) {
+    for (auto& [rank, bytes] : cluster.receive(wait)) {
+      Unpacker u(bytes, "deal_jobs: result from rank " + std::to_string(rank));
+      const auto i = static_cast<std::size_t>(u.get<std::uint64_t>());
+      if (i >= n || seen[i] || owner[i] != rank)
+        throw Error("deal_jobs: rank " + std::to_string(rank) + " sent result " + std::to_string(i) + " unexpectedly");
+      take(i, u.get_string(), rank);
+    }
+  };
+  std::atomic<bool> polling{false};
+  std::chrono::steady_clock::time_point last_poll{};
+  const std::function<void()> poll = [&] {
+    if (cluster.size() == 1 || !cluster.is_root() || polling.exchange(true)) return;
+    struct Release {
+      std::atomic<bool>& flag;
+      ~Release() { flag = false; }
+    } release{polling};
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_poll < std::chrono::seconds(1)) return;
+    last_poll = now;
+    take_arrivals(false);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner[i] != cluster.rank()) continue;
+    std::string bytes = run(i, poll);
+    if (cluster.is_root()) {
+      take(i, std::move(bytes), cluster.rank());
+      if (cluster.size() > 1) take_arrivals(false);
+    } else {
+      cluster.send_to_root(Packer().put<std::uint64_t>(i).put_string(bytes).take());
+    }
+  }
+  if (cluster.size() == 1) return;
+  if (cluster.is_root())
+    while (count < n) take_arrivals(true);
+  Packer all;
+  if (cluster.is_root())
+    for (const std::string& r : results) all.put_string(r);
+  std::string bytes = all.take();
+  cluster.broadcast(bytes);
+  if (cluster.is_root()) return;
+  Unpacker u(bytes, "deal_jobs: results from rank 0");
+  for (std::size_t i = 0; i < n; ++i) arrived(i, u.get_string(), owner[i]);
 }
 
 std::string on_root(Cluster& cluster, const std::function<std::string()>& fn) {
