@@ -26,6 +26,20 @@ CupPath scripted_path(std::uint64_t seed, const WorldConfig& world = {}) {
   return {"scripted_" + std::to_string(seed), e.states, e.actions};
 }
 
+// The first `n` scripted episodes (random starts 0, 1, ...) that end in a realistic success.
+std::vector<CupPath> successful_scripted_paths(std::size_t n) {
+  std::vector<CupPath> paths;
+  for (std::uint64_t s = 0; paths.size() < n; ++s) {
+    DiceEnv env(WorldConfig{});
+    env.reset(s);
+    auto expert = make_expert("scripted");
+    expert->reset(s);
+    const ExpertEpisode e = run_expert_episode(*expert, env, true);
+    if (e.outcome.realistic_success()) paths.push_back({"p" + std::to_string(s), e.states, e.actions});
+  }
+  return paths;
+}
+
 double mean_dice_x(const State& s) { return (s[si::die(0)] + s[si::die(1)] + s[si::die(2)]) / 3.0; }
 
 // Follows `follower` from `start` for the path's length; the largest |cup x - (recorded x + shift)|.
@@ -101,15 +115,7 @@ TEST(Recordings, RankingDoesNotDependOnThreads) {
 TEST(ChoosePath, FindsARecordingThatSucceedsAndIsDeterministic) {
   const WorldConfig w;
   // Paths of successful scripted episodes; a start of one of them is a start some path succeeds from.
-  std::vector<CupPath> paths;
-  for (std::uint64_t s = 0; paths.size() < 3; ++s) {
-    DiceEnv env(w);
-    env.reset(s);
-    auto expert = make_expert("scripted");
-    expert->reset(s);
-    const ExpertEpisode e = run_expert_episode(*expert, env, true);
-    if (e.outcome.realistic_success()) paths.push_back({"p" + std::to_string(s), e.states, e.actions});
-  }
+  const std::vector<CupPath> paths = successful_scripted_paths(3);
   TrackerConfig c;
   c.probes = 0;
   c.optimise = false;
@@ -216,15 +222,7 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   // knocked sideways and the path no longer stacks. A rescue from there joins another recording
   // whose continuation simulates to a success, and is deterministic.
   const WorldConfig w;
-  std::vector<CupPath> paths;
-  for (std::uint64_t s = 0; paths.size() < 3; ++s) {
-    DiceEnv env(w);
-    env.reset(s);
-    auto expert = make_expert("scripted");
-    expert->reset(s);
-    const ExpertEpisode e = run_expert_episode(*expert, env, true);
-    if (e.outcome.realistic_success()) paths.push_back({"p" + std::to_string(s), e.states, e.actions});
-  }
+  const std::vector<CupPath> paths = successful_scripted_paths(3);
   TrackerConfig c;
   c.probes = 0;
   const Recordings r(paths, w, c, 0);
