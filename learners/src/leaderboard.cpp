@@ -1,6 +1,7 @@
 #include <dicestack/learners/leaderboard.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -512,7 +513,7 @@ std::string deal_text(const std::vector<double>& cost, int ranks) {
 std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, const std::vector<Job>& jobs,
                                                         const RowRunner& runner, json& done,
                                                         const std::filesystem::path& partial, const Say& say,
-                                                        const std::function<void()>*& poll) {
+                                                        std::atomic<const std::function<void()>*>& poll) {
   const LeaderboardRequest& opt = plan.request;
   Cluster& cluster = *opt.cluster;
   std::vector<std::optional<LeaderboardRow>> measured(jobs.size());
@@ -528,14 +529,8 @@ std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, con
     measured[j] = std::move(row);
   };
   // Job j's result (a packed SeedResult or baseline row) has arrived.
-  auto keep = [&](std::size_t j, const std::string& bytes, int rank) {
+  auto store = [&](std::size_t j, const std::string& bytes) {
     ++finished;
-    if (cluster.size() > 1 && cluster.is_root() && rank != cluster.rank())
-      say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
-                               std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
-                         : "baseline " + jobs[j].regressor) +
-              " finished on rank " + std::to_string(rank),
-          static_cast<double>(finished) / (static_cast<double>(jobs.size()) + 0.5));
     if (jobs[j].index == 0) {
       Unpacker u(bytes, "leaderboard baseline row");
       keep_row(j, unpack_row(u));
@@ -549,6 +544,15 @@ std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, con
       seeds.push_back(*seed_results[k]);
     }
     keep_row(first, runner.combine(jobs[first].learner, jobs[first].features, jobs[first].regressor, seeds));
+  };
+  auto keep = [&](std::size_t j, const std::string& bytes, int rank) {
+    store(j, bytes);
+    if (cluster.size() > 1 && cluster.is_root() && rank != cluster.rank())
+      say((jobs[j].index ? jobs[j].learner + " " + jobs[j].features + " " + jobs[j].regressor + " (seed " +
+                               std::to_string(opt.seed + static_cast<std::uint64_t>(jobs[j].seed)) + ")"
+                         : "baseline " + jobs[j].regressor) +
+              " finished on rank " + std::to_string(rank),
+          static_cast<double>(finished) / (static_cast<double>(jobs.size()) + 0.5));
   };
   // Progress in units of rows (one per learner row and per baseline) on one process; in units
   // of jobs finished over several ranks, where they finish out of order.
@@ -565,7 +569,7 @@ std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, con
     }
     poll = &poll_now;  // the root takes other ranks' results while it reports its own job's progress
     struct Unset {
-      const std::function<void()>*& poll;
+      std::atomic<const std::function<void()>*>& poll;
       ~Unset() { poll = nullptr; }
     } unset{poll};
     Cluster& inner = local_cluster();  // a job runs whole on its rank
@@ -620,10 +624,10 @@ LeaderboardRow playback_row(const RunPlan& plan) {
 
 Leaderboard run_leaderboard(const LeaderboardRequest& request, const LeaderboardProgressFn& progress) {
   // Where the root stands in its own job's progress, other ranks' results are taken (deal_jobs).
-  const std::function<void()>* poll = nullptr;
+  std::atomic<const std::function<void()>*> poll{nullptr};  // read from the job's worker threads
   const RowReport report = [&](const std::string& text, double fraction, bool milestone) {
     if (progress) progress({text, std::clamp(fraction, 0.0, 1.0), milestone});
-    if (poll) (*poll)();
+    if (const auto* p = poll.load()) (*p)();
   };
   const Say say = [&](const std::string& text, double fraction) { report(text, fraction, true); };
 
@@ -631,11 +635,11 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   plan.request = request;
   const LeaderboardRequest& opt = plan.request;
   plan.profile = &leaderboard_profile(opt.profile);
-  plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
   plan.episodes = opt.episodes > 0 ? opt.episodes : plan.profile->rollouts;
   plan.regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
   plan.learners = opt.learners.empty() ? plan.profile->learners : opt.learners;
   check_request(plan);
+  plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
   plan.set = read_demo_set(opt.demos);
   plan.combos = row_combos(plan, say);
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they

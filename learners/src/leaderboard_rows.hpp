@@ -65,7 +65,7 @@ void pick_previews(const std::vector<Episode>& episodes, std::uint64_t training_
 
 class RowRunner {
  public:
-  /// Both are kept by reference: `report` may be swapped by the caller during the run.
+  /// Both are kept by reference and must outlive the runner.
   RowRunner(const RowSettings& settings, const RowReport& report) : s_(settings), report_(report) {}
 
   /// Seed `seed_index` (0-based) of a learner row, named `row_text` in progress ("[2/17] bc

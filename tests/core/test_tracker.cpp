@@ -163,20 +163,26 @@ TEST(TrackerExpert, ChoosesOnceAndFollows) {
 }
 
 TEST(PathFollower, JoinsAPathMidwayAtItsPhase) {
-  // A follower that starts at step 30 with 20 recorded steps already played acts, from any
-  // state, as the follower of the whole path started at step 10 does.
+  // A follower that starts at step 30 with the recorded steps the whole path's follower (started
+  // at step 10) has played by then acts, from any state, as that follower does: at the recorded
+  // pace and faster.
   const CupPath path = scripted_path(4);
   const State frame = path.states.front();
-  PathWarp joined;
-  joined.phase = 20.0;
-  const PathFollower whole(path, {}, frame, 10, 10.0), midway(path, joined, frame, 30, 10.0);
-  EXPECT_EQ(midway.length(), whole.length() - 20);
-  EXPECT_DOUBLE_EQ(midway.phase(45), 35.0);
-  for (const int step : {30, 47, 90, 1000})
-    for (const std::size_t t : {std::size_t{3}, std::size_t{40}}) {
-      const Action a = whole.act(path.states[t], step), b = midway.act(path.states[t], step);
-      for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_DOUBLE_EQ(a[k], b[k]) << step << " " << t;
-    }
+  for (const double pace : {1.0, 1.3}) {
+    PathWarp warp;
+    warp.time_scale = pace;
+    const PathFollower whole(path, warp, frame, 10, 10.0);
+    warp.phase = whole.phase(30);
+    const PathFollower midway(path, warp, frame, 30, 10.0);
+    EXPECT_DOUBLE_EQ(warp.phase, 20.0 * pace);
+    EXPECT_EQ(midway.length(), whole.length() - 20) << pace;
+    EXPECT_NEAR(midway.phase(45), 20.0 * pace + 15.0 * pace, 1e-9);
+    for (const int step : {30, 47, 90, 1000})
+      for (const std::size_t t : {std::size_t{3}, std::size_t{40}}) {
+        const Action a = whole.act(path.states[t], step), b = midway.act(path.states[t], step);
+        for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_NEAR(a[k], b[k], 1e-9) << pace << " " << step << " " << t;
+      }
+  }
 }
 
 TEST(Recordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
@@ -210,6 +216,18 @@ TEST(Recordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
   // moves its cup by 1.4 cm on average.
   EXPECT_LT(jitter, 1e-3);
   EXPECT_LT(drift, 0.02) << drift;
+  // The velocity during a step is the state's plus the action's: the same path with its
+  // actions moved into the states' velocities smooths to the same motion.
+  CupPath moved = clean;
+  for (std::size_t t = 0; t < moved.states.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t v = k == 0 ? si::kCupVx : k == 1 ? si::kCupVy : si::kCupW;
+      moved.states[t][v] += moved.actions[t][k];
+      moved.actions[t][k] = 0.0;
+    }
+  const Recordings smooth_moved({moved}, w, c, 0);
+  for (std::size_t t = 0; t < sc.states.size(); ++t)
+    EXPECT_NEAR(smooth_moved.paths().front().states[t][si::kCupVx], sc.states[t][si::kCupVx], 1e-9) << t;
   c.smooth = -1.0;
   EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"smooth\""), std::string::npos);
   c.smooth = 0.0;
@@ -239,10 +257,40 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   const TrackerChoice b = rescue_path(r, env, sim, frame, current, follower.phase(env.t()), 5);
   ASSERT_TRUE(a.success);
   EXPECT_NE(a.path, current.path);
+  EXPECT_GT(a.warp.phase, 0.0) << "joined midway, not from the recording's start";
   EXPECT_EQ(a.path, b.path);
   EXPECT_EQ(a.warp.phase, b.warp.phase);
   EXPECT_EQ(a.simulations, b.simulations);
   EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps));
+}
+
+TEST(TrackerExpert, RescuesAKnockedEpisodeWhenAskedTo) {
+  // The same knock as above, met by the expert itself: choosing once, it follows its path to a
+  // failure; with a check every 5 steps it joins another recording and stacks, the same way twice.
+  const WorldConfig w;
+  const std::vector<CupPath> paths = successful_scripted_paths(3);
+  auto run = [&](int rescue_interval) {
+    TrackerConfig c;
+    c.probes = 0;
+    c.rescue_interval = rescue_interval;
+    ExpertConfig config;
+    config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
+    auto tracker = make_expert("tracker", config);
+    tracker->reset(1);
+    DiceEnv env(w);
+    env.reset_to(paths[0].states.front());
+    std::vector<Action> actions;
+    while (env.t() < env.config().episode.max_steps) {
+      const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
+      actions.push_back(a);
+      if (env.step(a).terminated) break;
+    }
+    return std::make_pair(env.outcome().realistic_success(), actions);
+  };
+  EXPECT_FALSE(run(0).first) << "the knock breaks the path chosen once";
+  const auto rescued = run(5);
+  EXPECT_TRUE(rescued.first);
+  EXPECT_EQ(run(5).second, rescued.second);
 }
 
 }  // namespace

@@ -224,7 +224,8 @@ class MpcExpert final : public Expert {
 // recordings from that state (choose_path); afterwards only tracks it. Its actions are then a
 // function of the start, the step and the state: consistent labels, as DART needs. With
 // rescue_interval > 0 it also checks, that often, that the path's rest still simulates to a
-// success from the state reached, and joins another recording midway when not (rescue_path).
+// success from the state reached, and joins another recording midway when not (rescue_path):
+// its actions then depend on when it switched, too.
 class TrackerExpert final : public Expert {
  public:
   explicit TrackerExpert(const ExpertConfig& config) : recordings_(config.recordings) {}

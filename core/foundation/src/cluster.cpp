@@ -102,14 +102,17 @@ void deal_jobs(Cluster& cluster, const std::vector<double>& cost,
       take(i, u.get_string(), rank);
     }
   };
-  std::atomic<bool> polling{false};
+  // Set while the root takes results: a poll meanwhile (from `arrived`, or a second thread)
+  // returns at once.
+  std::atomic<bool> taking{false};
+  struct Taking {
+    std::atomic<bool>& flag;
+    ~Taking() { flag = false; }
+  };
   std::chrono::steady_clock::time_point last_poll{};
   const std::function<void()> poll = [&] {
-    if (cluster.size() == 1 || !cluster.is_root() || polling.exchange(true)) return;
-    struct Release {
-      std::atomic<bool>& flag;
-      ~Release() { flag = false; }
-    } release{polling};
+    if (cluster.size() == 1 || !cluster.is_root() || taking.exchange(true)) return;
+    const Taking release{taking};
     const auto now = std::chrono::steady_clock::now();
     if (now - last_poll < std::chrono::seconds(1)) return;
     last_poll = now;
@@ -119,6 +122,8 @@ void deal_jobs(Cluster& cluster, const std::vector<double>& cost,
     if (owner[i] != cluster.rank()) continue;
     std::string bytes = run(i, poll);
     if (cluster.is_root()) {
+      taking = true;
+      const Taking release{taking};
       take(i, std::move(bytes), cluster.rank());
       if (cluster.size() > 1) take_arrivals(false);
     } else {
@@ -126,8 +131,11 @@ void deal_jobs(Cluster& cluster, const std::vector<double>& cost,
     }
   }
   if (cluster.size() == 1) return;
-  if (cluster.is_root())
+  if (cluster.is_root()) {
+    taking = true;
+    const Taking release{taking};
     while (count < n) take_arrivals(true);
+  }
   Packer all;
   if (cluster.is_root())
     for (const std::string& r : results) all.put_string(r);

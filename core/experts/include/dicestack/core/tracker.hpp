@@ -41,9 +41,9 @@ struct TrackerConfig {
   bool optimise = true;      ///< when no recording succeeds as recorded, search warps
   int optimise_paths = 4;    ///< the warp search tries the recordings that came closest, >= 1
   int optimise_evaluations = 60;   ///< simulated warps per recording (CMA-ES), >= 1
-  double time_scale_range = 0.15;  ///< warps keep |log time_scale| <= log(1 + this), in [0, 1)
-  double offset_range = 0.3;       ///< |offset| <= this, m
-  double amplitude_range = 0.15;   ///< |amplitude - 1| <= this, in [0, 1)
+  double time_scale_range = 0.15;  ///< a search keeps |log time_scale| <= log(1 + this) about its base, in [0, 1)
+  double offset_range = 0.3;       ///< |offset| <= this, m, per search (a rescue's join also moves x to meet the cup)
+  double amplitude_range = 0.15;   ///< |amplitude - 1| <= this, in [0, 1), per search (a rescue's warps compose)
   int hold_steps = 60;       ///< a simulation ends this many steps after the path's end, >= 0
   /// Closed loop on the dice: every this many steps the rest of the followed path is simulated
   /// from the state reached; when it no longer ends in a success, a rescue joins a recording
@@ -128,7 +128,10 @@ struct TrackerChoice {
 /// the state, the recordings and `seed`.
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed);
 
-/// Whether `follower`, followed from env's current state, simulates to a realistic success.
+/// Whether `follower`, followed from env's current state, simulates to a realistic success
+/// within `follower.length() + hold_steps` steps from now (and the episode's limit). For a
+/// follower started earlier that is longer than the rest of its path plus the hold: a lenient
+/// check, as measured (docs/learners.md).
 bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps);
 
 /// A rescue, mid-episode, when the followed path (`current`, moved into the frame of `frame`,

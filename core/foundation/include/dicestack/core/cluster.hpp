@@ -145,9 +145,12 @@ std::vector<T> distributed_map(Cluster& cluster, std::size_t n, int threads, con
 /// deal_items gives it, a rank's own jobs in index order. Every rank sees every result once
 /// through `arrived(i, bytes, rank that ran it)`: the root as results come in (after each of its
 /// own jobs, and whenever one of them calls `poll`: at most once a second, and a call from
-/// inside a poll or from a second thread meanwhile returns at once), the other ranks at the
-/// end, in index order. A non-root rank sends each result to the root as it finishes; the root
-/// broadcasts them all at the end. Collective. On one rank the jobs run in index order.
+/// inside `arrived` or from a second thread meanwhile returns at once; `arrived` then runs on
+/// the polling thread, beside the job's other threads), the other ranks at the end, in index
+/// order. A non-root rank sends each result to the root as it finishes; the root broadcasts
+/// them all at the end. Collective. On one rank the jobs run in index order. An exception from
+/// `run` on a non-root rank leaves the root waiting: the tool then ends the whole run, as for
+/// distributed_map (docs/scaling.md).
 void deal_jobs(Cluster& cluster, const std::vector<double>& cost,
                const std::function<std::string(std::size_t i, const std::function<void()>& poll)>& run,
                const std::function<void(std::size_t i, const std::string& bytes, int rank)>& arrived);
