@@ -23,7 +23,7 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
     for (std::size_t t = 0; t < e->size(); ++t, ++row) {
       const History h{std::span<const State>(e->states.data(), t + 1), std::span<const Action>(e->actions.data(), t)};
       features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
-      for (std::size_t j = 0; j < kActionDim; ++j) d.y(row, static_cast<Eigen::Index>(j)) = e->actions[t][j];
+      features.label(e->states[t], e->actions[t], {d.y.row(row).data(), kActionDim});
     }
   }
   return d;
@@ -130,7 +130,8 @@ const Split& DemoSplit::matrices(const FeatureMap& features) const {
   if (!slot) {
     if (rule_ == "rows" && features.name() != state_features().name())
       throw ConfigError("features \"" + features.name() +
-                        "\" read an episode's history; the row split shuffles the rows: use the episode split");
+                        "\": the row split shuffles the rows into one pseudo-episode of states and actions, which only "
+                        "the \"state\" map reads as recorded: use the episode split");
     if (rule_ == "episodes") {
       slot = std::make_unique<Split>(split_by_episode(all_, features));
     } else if (rule_ == "rows") {

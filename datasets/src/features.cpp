@@ -27,12 +27,15 @@ struct Blocks {
 
 class BuiltinFeatureMap final : public FeatureMap {
  public:
-  BuiltinFeatureMap(std::string name, std::string description, Blocks blocks)
-      : name_(std::move(name)), description_(std::move(description)), blocks_(blocks) {}
+  BuiltinFeatureMap(std::string name, std::string description, Blocks blocks,
+                    ActionTarget target = ActionTarget::impulse)
+      : name_(std::move(name)), description_(std::move(description)), blocks_(blocks), target_(target) {}
 
   std::string name() const override { return name_; }
   int version() const override { return 1; }
   std::string description() const override { return description_; }
+  ActionTarget target() const override { return target_; }
+  const Blocks& blocks() const { return blocks_; }
 
   std::size_t width() const override {
     return current_width() + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
@@ -84,7 +87,10 @@ class BuiltinFeatureMap final : public FeatureMap {
 
   std::string name_, description_;
   Blocks blocks_;
+  ActionTarget target_;
 };
+
+constexpr std::size_t kCupVelocity[kActionDim] = {si::kCupVx, si::kCupVy, si::kCupW};
 
 const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
   static const auto* maps = [] {
@@ -105,12 +111,33 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "cup+clock+start_state",
         "a pattern with feedback on the cup alone: the cup's position and velocity, t and the whole start state",
         Blocks{true, false, false, true, Current::cup}));
+    // Every map again, its regressor answering the cup velocity to set.
+    const std::size_t bases = v->size();
+    for (std::size_t i = 0; i < bases; ++i) {
+      const BuiltinFeatureMap& m = *(*v)[i];
+      v->push_back(std::make_unique<BuiltinFeatureMap>(
+          m.name() + std::string(kVelocityTargetSuffix),
+          m.description() + "; answers the cup velocity to set (the action is its difference from the cup's velocity)",
+          m.blocks(), ActionTarget::velocity));
+    }
     return v;
   }();
   return *maps;
 }
 
 }  // namespace
+
+void FeatureMap::label(const State& current, const Action& action, std::span<double> out) const {
+  const bool velocity = target() == ActionTarget::velocity;
+  for (std::size_t k = 0; k < kActionDim; ++k) out[k] = action[k] + (velocity ? current[kCupVelocity[k]] : 0.0);
+}
+
+Action FeatureMap::action(const State& current, std::span<const double> output) const {
+  const bool velocity = target() == ActionTarget::velocity;
+  Action a;
+  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = output[k] - (velocity ? current[kCupVelocity[k]] : 0.0);
+  return a;
+}
 
 const FeatureMap& feature_map(std::string_view name) {
   for (const auto& m : builtin_maps())

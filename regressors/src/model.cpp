@@ -139,9 +139,9 @@ Action Model::act(const History& history) const {
   x_.apply_row({row.data(), width}, {z.data(), width});
   std::array<double, kActionDim> out;
   regressor_->predict_row({z.data(), width}, out);
-  Action a;
-  y_.invert_row(out, a);
-  return a;
+  std::array<double, kActionDim> answer;
+  y_.invert_row(out, answer);
+  return features_->action(history.current(), answer);
 }
 
 Action Model::act(const State& state) const { return act(History{{&state, 1}, {}}); }

@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <vector>
 
 #include <dicestack/core/error.hpp>
@@ -116,6 +117,42 @@ TEST(Features, DatasetRowsSeeEachStepsOwnHistory) {
     EXPECT_EQ(d.x(t, 25), 0.0);                    // the start's cup x
   }
   EXPECT_EQ(make_dataset({e}).x.cols(), 24);  // "state" by default
+}
+
+TEST(Features, AVelocityMapSeesTheSameRowAndAnswersTheCupVelocityToSet) {
+  const FeatureMap& base = feature_map("state+clock+start_state");
+  const FeatureMap& v = feature_map("state+clock+start_state/velocity");
+  EXPECT_EQ(v.name(), "state+clock+start_state/velocity");
+  EXPECT_EQ(base.target(), ActionTarget::impulse);
+  EXPECT_EQ(v.target(), ActionTarget::velocity);
+  const std::vector<State> states{numbered(100), numbered(200)};
+  EXPECT_EQ(row_of(v, History{states, {}}), row_of(base, History{states, {}}));
+  EXPECT_EQ(v.column_names(), base.column_names());
+  // numbered(200): cup vx, vy, w = 221, 222, 223.
+  const Action a{0.5, -1.0, 2.0};
+  std::array<double, kActionDim> label{};
+  v.label(states[1], a, label);
+  EXPECT_EQ(label, (std::array<double, kActionDim>{221.5, 221.0, 225.0}));
+  EXPECT_EQ(v.action(states[1], label), a) << "answer and label invert each other";
+  base.label(states[1], a, label);
+  EXPECT_EQ(label, (std::array<double, kActionDim>{0.5, -1.0, 2.0})) << "an impulse map answers the action";
+  for (const auto& n : feature_map_names()) {
+    if (n.ends_with(kVelocityTargetSuffix)) continue;
+    EXPECT_EQ(feature_map(n + std::string(kVelocityTargetSuffix)).width(), feature_map(n).width()) << n;
+  }
+}
+
+TEST(Features, DatasetLabelsOfAVelocityMapAreTheCupVelocityEachStepSets) {
+  Episode e;
+  e.name = "episode_0000";
+  e.states = {numbered(0), numbered(1)};
+  e.actions = {{0.1, 0.2, 0.3}, {0.4, 0.5, 0.6}};
+  e.sources.assign(2, StepSource::expert);
+  const Dataset d = make_dataset({e}, feature_map("state/velocity"));
+  for (Eigen::Index t = 0; t < 2; ++t)
+    for (Eigen::Index k = 0; k < 3; ++k)
+      EXPECT_DOUBLE_EQ(d.y(t, k), e.states[static_cast<std::size_t>(t)][21 + static_cast<std::size_t>(k)] +
+                                      e.actions[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]);
 }
 
 }  // namespace

@@ -83,6 +83,26 @@ TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
   fs::remove(path);
 }
 
+TEST(ModelFile, AVelocityMapActsWithTheCupVelocityItsRegressorAnswersLessTheCupsVelocityNow) {
+  // A regressor fitted on velocity labels answers a velocity; the model's action is that less the
+  // current cup velocity, and the file keeps the map.
+  const FeatureMap& f = feature_map("state/velocity");
+  const Matrix x = random_rows(200, 24, 4);
+  const Model m = Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3, nullptr, f);
+  const fs::path path = temp_model("velocity");
+  save_model(m, path);
+  const Model back = load_model(path);
+  EXPECT_EQ(back.features().name(), "state/velocity");
+  State s{};
+  for (std::size_t j = 0; j < kStateDim; ++j) s[j] = 0.01 * static_cast<double>(j);
+  Matrix row(1, 24);
+  for (Eigen::Index j = 0; j < 24; ++j) row(0, j) = s[static_cast<std::size_t>(j)];
+  const Matrix answer = back.predict(row);
+  const Action a = back.act(s);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(a[k], answer(0, static_cast<Eigen::Index>(k)) - s[21 + k], 1e-12) << k;
+  fs::remove(path);
+}
+
 TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
   const Matrix x = random_rows(200, 24, 2);
   const fs::path path = temp_model("mismatch");

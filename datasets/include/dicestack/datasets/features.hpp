@@ -31,7 +31,14 @@ struct History {
 /// The widest row any built-in map produces (a stack buffer on the hot path).
 inline constexpr std::size_t kMaxFeatureWidth = 64;
 
-/// A named, versioned map from a History to one input row. Immutable; thread-safe.
+/// What a policy's regressor answers: the action itself (the cup's velocity change, the paper's
+/// impulse), or the cup velocity the action is to set (the action is then that velocity minus
+/// the cup's velocity now). An expert that tracks a reference by cancelling the cup's velocity
+/// error gives labels that hold the noise of the last step; as velocities they are smooth.
+enum class ActionTarget { impulse, velocity };
+
+/// A named, versioned map from a History to one input row, and from the regressor's answer to
+/// an action. Immutable; thread-safe.
 class FeatureMap {
  public:
   virtual ~FeatureMap() = default;
@@ -47,6 +54,13 @@ class FeatureMap {
   virtual std::string description() const = 0;
   /// Writes the row for `history` into `out` (width() values). Hot path: never allocates.
   virtual void compute(const History& history, std::span<double> out) const = 0;
+  /// What the regressor's kActionDim outputs are (default: the action).
+  virtual ActionTarget target() const { return ActionTarget::impulse; }
+
+  /// The regressor's answer for `action` taken in state `current`: a training label.
+  void label(const State& current, const Action& action, std::span<double> out) const;
+  /// The action for the regressor's answer `output` in state `current`. Hot path.
+  Action action(const State& current, std::span<const double> output) const;
 };
 
 /// The built-in maps, by name:
@@ -55,9 +69,15 @@ class FeatureMap {
 ///  - "state+clock+start": + t, the start's cup x and the start's mean die x
 ///  - "state+history": + the previous state (the start repeated at t = 0): the last step's
 ///    velocity changes, which carry the previous action
-///  - "state+clock+start_state": + t and the whole start state (dart's default)
+///  - "state+clock+start_state": + t and the whole start state
+///  - "clock+start_state", "cup+clock+start_state": open loop, and feedback on the cup alone
+/// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
+/// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default).
 /// Throws ConfigError for another name, listing these.
 const FeatureMap& feature_map(std::string_view name);
+
+/// The suffix of a map whose regressor answers the cup velocity to set (ActionTarget::velocity).
+inline constexpr std::string_view kVelocityTargetSuffix = "/velocity";
 
 /// Names feature_map() accepts, in listing order.
 std::vector<std::string> feature_map_names();

@@ -37,12 +37,13 @@ class Model {
   static Model train(std::unique_ptr<Regressor> regressor, const Matrix& x, const Matrix& y, std::uint64_t seed,
                      std::vector<std::string>* warnings = nullptr, const FeatureMap& features = state_features());
 
-  /// Hot path: the action after `history` (features, standardise, predict_row, unstandardise);
-  /// no allocation.
+  /// Hot path: the action after `history` (features, standardise, predict_row, unstandardise,
+  /// the map's answer turned into an action); no allocation.
   Action act(const History& history) const;
   /// The action for a lone state, seen as the first of an episode (t = 0, its own start).
   Action act(const State& state) const;
-  /// Actions for every row of `rows` (N x features().width(), feature rows).
+  /// The regressor's answers for every row of `rows` (N x features().width(), feature rows): the
+  /// actions, or for a "/velocity" map the cup velocities to set (FeatureMap::target).
   Matrix predict(const Matrix& rows) const;
 
   const FeatureMap& features() const { return *features_; }
