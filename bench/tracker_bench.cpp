@@ -60,6 +60,10 @@ Options parse(int argc, char** argv) {
     else if (a == "--no-optimise") o.tracker.optimise = false;
     else if (a == "--rescue") o.tracker.rescue_interval = std::stoi(next());
     else if (a == "--smooth") o.tracker.smooth = std::stod(next());
+    else if (a == "--robust") o.tracker.robust_trials = std::stoi(next());
+    else if (a == "--robust-noise") o.tracker.robust_noise = std::stod(next());
+    else if (a == "--robust-warp") o.tracker.robust_warp = std::stod(next());
+    else if (a == "--keep-extremes") o.tracker.keep_extremes = true;
     else if (a == "--noise") o.noise = std::stod(next());
     else if (a == "--noise-window") {
       const std::string v = next();
@@ -89,7 +93,10 @@ Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std
 }
 
 int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, const Options& o) {
-  const auto paths = cup_paths(episodes);
+  TrackerConfig unranked = o.tracker;  // the paths as the tracker follows them (smoothed), no ranking
+  unranked.probes = 0;
+  const Recordings recordings(cup_paths(episodes), world, unranked, 0, o.threads);
+  const auto& paths = recordings.paths();
   const auto n = static_cast<std::size_t>(o.starts);
   std::vector<int> ok(paths.size() * n), ok_noisy(paths.size() * n);
   EnvPool envs(world, o.threads);
@@ -98,19 +105,20 @@ int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, con
     for (const bool noisy : {false, true}) {
       DiceEnv& env = envs.at(w);
       env.reset_to(random_start_state(world, s), s);
-      const PathFollower follower(paths[item / n], {}, env.get_state(), 0, o.tracker.gain);
+      const PathFollower follower(paths[item / n], {}, env.get_state(), 0, o.tracker.gain, o.tracker.keep_extremes);
       (noisy ? ok_noisy : ok)[item] = follow(env, follower, o, derive_seed(s, 2), noisy).realistic_success();
     }
   });
-  std::vector<std::tuple<int, int, std::string>> rows;
+  std::vector<std::tuple<int, int, int, std::string>> rows;
   for (std::size_t p = 0; p < paths.size(); ++p) {
-    int a = 0, b = 0;
-    for (std::size_t i = 0; i < n; ++i) a += ok[p * n + i], b += ok_noisy[p * n + i];
-    rows.emplace_back(a, b, paths[p].name);
+    int a = 0, b = 0, both = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      a += ok[p * n + i], b += ok_noisy[p * n + i], both += ok[p * n + i] && ok_noisy[p * n + i];
+    rows.emplace_back(a, b, both, paths[p].name);
   }
   std::sort(rows.rbegin(), rows.rend());
-  std::printf("recording: realistic successes of %d starts as recorded, and with noise %.3f\n", o.starts, o.noise);
-  for (const auto& [a, b, name] : rows) std::printf("%s %d %d\n", name.c_str(), a, b);
+  std::printf("recording: realistic successes of %d starts as recorded, with noise %.3f, and both\n", o.starts, o.noise);
+  for (const auto& [a, b, both, name] : rows) std::printf("%s %d %d %d\n", name.c_str(), a, b, both);
   return 0;
 }
 
@@ -146,7 +154,7 @@ int main(int argc, char** argv) try {
     Result& r = results[i];
     r.choice = choose_path(*recordings, env, sims.at(w), s);
     const PathFollower follower(recordings->paths()[r.choice.path], r.choice.warp, env.get_state(), env.t(),
-                                o.tracker.gain);
+                                o.tracker.gain, o.tracker.keep_extremes);
     Expert* expert = o.tracker.rescue_interval > 0 ? experts[static_cast<std::size_t>(w)].get() : nullptr;
     if (expert) expert->reset(s);
     r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);

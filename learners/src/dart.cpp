@@ -1,5 +1,6 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
@@ -57,10 +58,17 @@ class Dart final : public Learner {
     return r;
   }
 
+  // The tracker cancels the cup's velocity error each step, so under DART's noise its actions
+  // hold the last step's noise; the velocities it sets are smooth (docs/learners.md).
+  std::string preferred_features() const override {
+    return params().choice("expert") == "tracker" ? "state+clock+start_state" + std::string(kVelocityTargetSuffix)
+                                                  : std::string();
+  }
+
   static std::vector<ParamSpec> schema() {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
-    const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos)", names},
+    const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos; its default --features is state+clock+start_state/velocity)", names},
             {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},

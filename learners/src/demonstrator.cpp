@@ -1,5 +1,7 @@
 #include <dicestack/learners/demonstrator.hpp>
 
+#include <sstream>
+#include <string>
 #include <utility>
 
 #include <dicestack/core/error.hpp>
@@ -32,8 +34,31 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
   return std::make_shared<const Recordings>(cup_paths(demos), world, config, seed, threads, cluster);
 }
 
+namespace {
+
+// A default's text as a user types it: 4, 0.1, 0.02.
+std::string number_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+// The tracker as the learners' expert: the bare tracker's settings but for what was tuned for
+// DART on the tuning seeds (docs/learners.md, "Policies from the human recordings"): the three
+// best-ranked recordings, smoothed, chosen robust to a learner's errors.
+TrackerConfig learner_tracker_defaults() {
+  TrackerConfig d;
+  d.keep = 3;
+  d.smooth = 4.0;
+  d.robust_trials = 5;
+  d.robust_warp = 0.02;
+  return d;
+}
+
 std::vector<ParamSpec> tracker_param_specs() {
-  const TrackerConfig d;
+  const TrackerConfig d = learner_tracker_defaults();
   return {{"tracker_probes", ParamType::integer, std::to_string(d.probes), 0, 100000,
            "tracker: training starts that rank the recordings (most successes first)", {}},
           {"tracker_optimise", ParamType::boolean, d.optimise ? "true" : "false", 0, 1,
@@ -42,11 +67,19 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all)", {}},
           {"tracker_recordings", ParamType::integer, "0", 0, 1000000,
            "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}},
-          {"tracker_smooth", ParamType::real, "0", 0, 1000,
+          {"tracker_smooth", ParamType::real, number_text(d.smooth), 0, 1000,
            "tracker: smooth each path by a Gaussian of this std in steps before following it (0: as recorded)", {}},
           {"tracker_rescue", ParamType::integer, std::to_string(d.rescue_interval), 0, 100000,
            "tracker: every this many steps, check the path's rest still succeeds and join another recording "
-           "midway when not (0: choose once per episode)", {}}};
+           "midway when not (0: choose once per episode)", {}},
+          {"tracker_robust", ParamType::integer, std::to_string(d.robust_trials), 0, 1000,
+           "tracker: noisy trials a choice must also pass, and that rank the recordings (0: off)", {}},
+          {"tracker_robust_noise", ParamType::real, number_text(d.robust_noise), 0, 10,
+           "tracker: the std of those trials' executed-action noise, as a fraction of action.scale", {}},
+          {"tracker_robust_warp", ParamType::real, number_text(d.robust_warp), 0, 1,
+           "tracker: std of each noisy trial's random warp (time scale, offset m, amplitude; 0: none)", {}},
+          {"tracker_keep_extremes", ParamType::boolean, d.keep_extremes ? "true" : "false", 0, 1,
+           "tracker: narrow a moved path's swing to reach no further than the recording's", {}}};
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
@@ -60,6 +93,10 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     tracker.keep = static_cast<int>(params.integer("tracker_paths"));
     tracker.rescue_interval = static_cast<int>(params.integer("tracker_rescue"));
     tracker.smooth = params.real("tracker_smooth");
+    tracker.robust_trials = static_cast<int>(params.integer("tracker_robust"));
+    tracker.robust_noise = params.real("tracker_robust_noise");
+    tracker.robust_warp = params.real("tracker_robust_warp");
+    tracker.keep_extremes = params.boolean("tracker_keep_extremes");
     const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
     config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);

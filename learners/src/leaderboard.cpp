@@ -386,9 +386,10 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
   for (const auto& l : plan.learners) {
     const LearnerInfo& info = LearnerRegistry::global().info(plan.base(l));
     // The paper profile's full picture: every learner with the bare state and with dart's map too.
-    std::vector<std::string> maps{info.default_features};
-    if (plan.profile->every_feature_map && info.default_features != "state") maps.insert(maps.begin(), "state");
-    if (plan.profile->every_feature_map && info.default_features == "state")
+    const std::string own = default_features(plan.base(l), plan.options_for(l));
+    std::vector<std::string> maps{own};
+    if (plan.profile->every_feature_map && own != "state") maps.insert(maps.begin(), "state");
+    if (plan.profile->every_feature_map && own == "state")
       maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work

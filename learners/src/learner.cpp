@@ -58,6 +58,12 @@ LearnerSpec parse_learner_spec(std::string_view text, const LearnerRegistry& reg
   return spec;
 }
 
+std::string default_features(std::string_view learner, const std::vector<std::string>& options) {
+  const LearnerRegistry& r = LearnerRegistry::global();
+  const std::string preferred = r.create(learner, options)->preferred_features();
+  return preferred.empty() ? r.info(learner).default_features : preferred;
+}
+
 namespace {
 
 std::shared_ptr<Model> fit_here(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {

@@ -21,7 +21,7 @@ TrainReport train_model(const TrainRequest& request) {
   // after DART had recorded its episodes) fails here, before any work.
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(
-      request.features.empty() ? LearnerRegistry::global().info(request.learner).default_features : request.features);
+      request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
   const DemoSplit split(request.demos, request.split);

@@ -129,6 +129,59 @@ TEST(ChoosePath, FindsARecordingThatSucceedsAndIsDeterministic) {
   EXPECT_TRUE(test::bit_equal(env.get_state(), paths[1].states.front()));  // the environment is not touched
 }
 
+TEST(ChoosePath, RobustTrialsKeepTheChoiceWhenTheyAreNoiselessAndPickTheMostRobustOtherwise) {
+  const WorldConfig w;
+  const std::vector<CupPath> paths = successful_scripted_paths(3);
+  TrackerConfig c;
+  c.probes = 0;
+  c.optimise = false;
+  DiceEnv env(w), sim(w);
+  env.reset_to(paths[1].states.front());
+  const TrackerChoice plain = choose_path(Recordings(paths, w, c, 0), env, sim, 3);
+  ASSERT_TRUE(plain.success);
+  // Trials without noise or warp replay the same episode: they all succeed, the choice stays,
+  // and each costs one simulation.
+  c.robust_trials = 4;
+  c.robust_noise = 0.0;
+  const TrackerChoice noiseless = choose_path(Recordings(paths, w, c, 0), env, sim, 3);
+  EXPECT_EQ(noiseless.path, plain.path);
+  EXPECT_EQ(noiseless.simulations, plain.simulations + 4);
+  // Trials that no path survives: every candidate is simulated, and the choice is still a success
+  // as simulated (the one with most noisy successes; all have none, so the first), the same twice.
+  c.robust_noise = 10.0;
+  const Recordings hopeless(paths, w, c, 0);
+  const TrackerChoice a = choose_path(hopeless, env, sim, 3), b = choose_path(hopeless, env, sim, 3);
+  EXPECT_TRUE(a.success);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.simulations, b.simulations);
+  EXPECT_GT(a.simulations, noiseless.simulations);
+  EXPECT_EQ(a.path, plain.path);
+  // Out of range: named.
+  c.robust_trials = -1;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust_trials\""), std::string::npos);
+  c.robust_trials = 1;
+  c.robust_warp = 2.0;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust_warp\""), std::string::npos);
+}
+
+TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
+  const WorldConfig w = test::short_world(200);
+  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  TrackerConfig c;
+  c.probes = 4;
+  const Recordings plain(paths, w, c, 7, 1);
+  // Noiseless trials: each success scores 1 + 3, the order stays.
+  c.robust_trials = 3;
+  c.robust_noise = 0.0;
+  const Recordings noiseless(paths, w, c, 7, 1);
+  EXPECT_EQ(noiseless.order(), plain.order());
+  for (std::size_t p = 0; p < paths.size(); ++p) EXPECT_EQ(noiseless.probe_successes()[p], 4 * plain.probe_successes()[p]);
+  // Noisy trials are drawn per (path, probe, trial): the same on any number of threads.
+  c.robust_noise = 0.1;
+  c.robust_warp = 0.02;
+  EXPECT_EQ(Recordings(paths, w, c, 7, 1).probe_successes(), Recordings(paths, w, c, 7, 2).probe_successes());
+}
+
 TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
   EXPECT_NE(test::error_of([] { make_expert("tracker"); }).find("needs recordings"), std::string::npos);
   EXPECT_NE(test::error_of([] { make_expert("trackr"); }).find("scripted, mpc, tracker"), std::string::npos);

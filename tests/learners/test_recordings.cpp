@@ -152,5 +152,14 @@ TEST(LearnerSpec, ParsesOptionsAndRefusesUnknownOnes) {
   EXPECT_THROW(parse_learner_spec("dart:noise"), ConfigError);
 }
 
+TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringVelocities) {
+  EXPECT_EQ(default_features("bc"), "state");
+  EXPECT_EQ(default_features("dart"), "state+clock+start_state");
+  EXPECT_EQ(default_features("dart", {"expert=mpc"}), "state+clock+start_state");
+  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state/velocity");
+  EXPECT_EQ(feature_map(default_features("dart", {"expert=tracker"})).target(), ActionTarget::velocity);
+  EXPECT_THROW(default_features("dart", {"expert=oracle"}), ConfigError);
+}
+
 }  // namespace
 }  // namespace dicestack

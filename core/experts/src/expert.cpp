@@ -257,7 +257,8 @@ class TrackerExpert final : public Expert {
 
   void follow(int t) {
     start_step_ = t;
-    follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, frame_, t, recordings_->config().gain);
+    const TrackerConfig& c = recordings_->config();
+    follower_ = PathFollower(recordings_->paths()[choice_.path], choice_.warp, frame_, t, c.gain, c.keep_extremes);
   }
 
   std::shared_ptr<const Recordings> recordings_;

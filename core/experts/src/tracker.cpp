@@ -6,6 +6,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <string>
 
 #include <dicestack/core/cmaes.hpp>
 #include <dicestack/core/error.hpp>
@@ -19,6 +20,7 @@ namespace {
 namespace si = state_index;
 
 constexpr std::uint64_t kProbeStream = 0x70726f6265ULL;  // "probe"
+constexpr std::uint64_t kProbeNoiseStream = 0x70726f62654eULL;  // "probeN"
 
 double mean_dice_x(const State& s) {
   double x = 0.0;
@@ -79,14 +81,21 @@ struct Trial {
   bool success = false;
 };
 
-Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps) {
+// `noise` > 0 adds executed-action noise of that std (x action.scale) drawn from `noise_seed`.
+Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps,
+               double noise = 0.0, std::uint64_t noise_seed = 0) {
   sim.restore(start);
+  Rng rng(noise_seed);
+  const Action& scale = sim.config().action.scale;
   const bool clean = !sim.outcome().wall_contact;
   const int end = sim.t() + follower.length() + hold_steps;
   State s = sim.get_state();
   Trial trial;
   while (sim.t() < sim.config().episode.max_steps && sim.t() < end) {
-    const StepResult r = sim.step(follower.act(s, sim.t()));
+    Action a = follower.act(s, sim.t());
+    if (noise > 0.0)
+      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += noise * scale[k] * rng.normal();
+    const StepResult r = sim.step(a);
     s = r.observation;
     if (r.terminated) {
       trial.success = true;
@@ -97,6 +106,22 @@ Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& st
   }
   trial.score = -stack_shortfall(s, sim.config()) - (sim.outcome().wall_contact ? 1000.0 : 0.0);
   return trial;
+}
+
+// One noisy trial of a candidate, as a learner would play it: executed-action noise on every
+// step and, with robust_warp, the whole path a little off (time scale, offset, amplitude drawn
+// once). 1 if it still ends in a realistic success.
+int robust_trial(const CupPath& path, const PathWarp& warp, const State& frame, int start_step, const TrackerConfig& c,
+                 DiceEnv& sim, const EnvSnapshot& start, std::uint64_t seed) {
+  PathWarp jittered = warp;
+  if (c.robust_warp > 0.0) {
+    Rng rng(derive_seed(seed, 1));
+    jittered.time_scale *= std::exp(c.robust_warp * rng.normal());
+    jittered.offset += c.robust_warp * rng.normal();
+    jittered.amplitude *= 1.0 + c.robust_warp * rng.normal();
+  }
+  const PathFollower follower(path, jittered, frame, start_step, c.gain, c.keep_extremes);
+  return simulate(follower, sim, start, c.hold_steps, c.robust_noise, seed).success ? 1 : 0;
 }
 
 // x in [-1, 1]^3 (clipped) to a warp of `base` inside the config's bounds.
@@ -126,17 +151,41 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
   const auto& paths = recordings.paths();
   TrackerChoice choice;
   double best = -1e300;
-  // Keeps the best failure so far; returns true on a success (which is then the choice).
+  int best_robust = -1;
+  std::optional<TrackerChoice> robust_best;  // the success with most noisy successes so far
+  int simulations = 0;
+  // Keeps the best failure so far; returns true on a success (which is then the choice). With
+  // robust trials, a success that fails some noisy trial is kept aside and the search goes on.
   auto consider = [&](std::size_t p, const PathWarp& w) {
-    const Trial trial = simulate(PathFollower(paths[p], w, frame, t, c.gain), sim, start, c.hold_steps);
-    ++choice.simulations;
+    const PathFollower follower(paths[p], w, frame, t, c.gain, c.keep_extremes);
+    Trial trial = simulate(follower, sim, start, c.hold_steps);
+    ++simulations;
+    if (trial.success && c.robust_trials > 0) {
+      int wins = 0;
+      for (int k = 0; k < c.robust_trials; ++k, ++simulations)
+        wins += robust_trial(paths[p], w, frame, t, c, sim, start, derive_seed(seed, static_cast<std::uint64_t>(simulations)));
+      if (wins > best_robust) {
+        best_robust = wins;
+        robust_best = TrackerChoice{p, w, true, 0};
+      }
+      if (wins < c.robust_trials) trial.success = false;  // keep looking
+      else trial.score = 2.0;
+    }
     if (trial.score > best) {  // a success outscores every failure
       best = trial.score;
       choice.path = p;
       choice.warp = w;
       choice.success = trial.success;
     }
+    choice.simulations = simulations;
     return trial;
+  };
+  auto finish = [&]() {
+    if (!choice.success && robust_best) {
+      choice = *robust_best;
+      choice.simulations = simulations;
+    }
+    return choice;
   };
   std::vector<std::pair<double, std::size_t>> near;  // (score, candidate) as given
   for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -144,7 +193,7 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
     if (trial.success) return choice;
     near.emplace_back(trial.score, k);
   }
-  if (!c.optimise) return choice;
+  if (!c.optimise || robust_best) return finish();
   std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
   for (const auto& [score, k] : near) {
@@ -165,7 +214,7 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
       es.tell(values);
     }
   }
-  return choice;
+  return finish();
 }
 
 // How far recorded state `r` (its x moved by `shift`) is from `s`, for joining a path there: the
@@ -203,14 +252,27 @@ void validate(const TrackerConfig& c) {
   require(c.smooth >= 0.0 && c.smooth <= 1000.0, "smooth", "in [0, 1000]", c.smooth);
   require(c.rescue_interval >= 0 && c.rescue_interval <= 100000, "rescue_interval", "in [0, 100000]",
           c.rescue_interval);
+  require(c.robust_trials >= 0 && c.robust_trials <= 1000, "robust_trials", "in [0, 1000]", c.robust_trials);
+  require(c.robust_noise >= 0.0 && c.robust_noise <= 10.0, "robust_noise", "in [0, 10]", c.robust_noise);
+  require(c.robust_warp >= 0.0 && c.robust_warp <= 1.0, "robust_warp", "in [0, 1]", c.robust_warp);
   require(c.rescue_evaluations >= 1 && c.rescue_evaluations <= 100000, "rescue_evaluations", "in [1, 100000]",
           c.rescue_evaluations);
 }
 
-PathFollower::PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain)
+PathFollower::PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain,
+                           bool keep_extremes)
     : path_(&path), warp_(warp), start_step_(start_step), gain_(gain) {
   centre_ = mean_dice_x(path.states.front());
   shift_ = mean_dice_x(start) - centre_ + warp.offset;
+  if (keep_extremes) {
+    // The moved swing reaches no further left or right than the recording did from its own start.
+    double lo = centre_, hi = centre_;
+    for (const State& s : path.states) lo = std::min(lo, s[si::kCupX]), hi = std::max(hi, s[si::kCupX]);
+    double room = 1.0;
+    if (hi - centre_ > 1e-9) room = std::min(room, (hi - centre_ - shift_) / (warp_.amplitude * (hi - centre_)));
+    if (centre_ - lo > 1e-9) room = std::min(room, (centre_ + shift_ - lo) / (warp_.amplitude * (centre_ - lo)));
+    warp_.amplitude *= std::max(room, 0.5);
+  }
   length_ = static_cast<int>(
       std::ceil(std::max(0.0, static_cast<double>(path.states.size() - 1) - warp.phase) / warp.time_scale));
 }
@@ -270,10 +332,17 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
           DiceEnv& env = envs.at(w);
           const State start = random_start_state(world, training_start_seed(derive_seed(seed_, kProbeStream), probe));
           env.reset_to(start, 0);
-          const PathFollower follower(paths_[path], {}, start, 0, config_.gain);
-          return simulate(follower, sims.at(w), env.snapshot(), config_.hold_steps).success ? 1 : 0;
+          const PathFollower follower(paths_[path], {}, start, 0, config_.gain, config_.keep_extremes);
+          const EnvSnapshot snap = env.snapshot();
+          // A probe scores 1 for a success as simulated, plus 1 per noisy trial that succeeds too.
+          if (!simulate(follower, sims.at(w), snap, config_.hold_steps).success) return 0;
+          int score = 1;
+          for (int k = 0; k < config_.robust_trials; ++k)
+            score += robust_trial(paths_[path], {}, start, 0, config_, sims.at(w), snap,
+                                  derive_seed(derive_seed(seed_, kProbeNoiseStream), item * 1000 + static_cast<std::size_t>(k)));
+          return score;
         },
-        [](const int& v) { return std::string(1, v ? '1' : '0'); }, [](std::string_view b) { return b == "1" ? 1 : 0; });
+        [](const int& v) { return std::to_string(v); }, [](std::string_view b) { return std::stoi(std::string(b)); });
     for (std::size_t item = 0; item < wins.size(); ++item) probe_successes_[item / probes] += wins[item];
   }
   order_.resize(paths_.size());

@@ -76,6 +76,9 @@ class Learner {
   const Params& params() const { return params_; }
   /// Throws InputError if there are no demonstrations, ConfigError for a bad regressor.
   virtual LearnResult learn(const LearnContext& context) const = 0;
+  /// The feature map this learner, with its options, reads when none is named; empty: its
+  /// registry default (LearnerInfo::default_features). See default_features().
+  virtual std::string preferred_features() const { return {}; }
 
  private:
   std::string name_;
@@ -118,6 +121,11 @@ struct LearnerSpec {
 /// Parses and checks a spec against the registry (unknown learner, option or value: ConfigError,
 /// naming the spec).
 LearnerSpec parse_learner_spec(std::string_view text, const LearnerRegistry& registry = LearnerRegistry::global());
+
+/// The feature map a learner with these options reads when none is named: its registry default,
+/// unless its options call for another (dart labelled by the tracker answers cup velocities).
+/// Throws ConfigError as LearnerRegistry::create.
+std::string default_features(std::string_view learner, const std::vector<std::string>& options = {});
 
 /// Fits `context.regressor` on every step of `data`, each seen through `context.features`:
 /// behaviour cloning's one step. Collective over context.cluster: the root fits, the others

@@ -54,6 +54,18 @@ struct TrackerConfig {
   /// is followed (0: as recorded). A person's per-step jitter is no part of the motion a learner
   /// can fit: labels are the path's accelerations. In [0, 1000].
   double smooth = 0.0;
+  /// Robust choices: a candidate that succeeds as simulated is also simulated this many times
+  /// as a learner would play it (robust_trial: executed-action noise of std robust_noise x
+  /// action.scale, and the whole path off by a random warp of std robust_warp), and the first
+  /// whose trials all succeed is chosen; failing that, the success with most. The ranking's
+  /// probes count those trials too. 0: off. In [0, 1000].
+  int robust_trials = 0;
+  double robust_noise = 0.1;  ///< in [0, 10]
+  double robust_warp = 0.0;   ///< std of each noisy trial's random warp (time scale, offset in m, amplitude), in [0, 1]
+  /// A path moved to a start away from the recording's own swings that far nearer one wall: the
+  /// recordings swing the cup ~3 m either side of the dice, up to the walls. With this, its swing
+  /// is narrowed (about the dice) to reach no further than the recording's did.
+  bool keep_extremes = false;
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
@@ -68,7 +80,10 @@ class PathFollower {
  public:
   PathFollower() = default;
   /// `path` must outlive the follower.
-  PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain);
+  /// keep_extremes: narrow the swing (amplitude about the dice) so that the moved path reaches
+  /// no further left or right than the recording did (TrackerConfig::keep_extremes).
+  PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain,
+               bool keep_extremes = false);
 
   Action act(const State& s, int step) const;
   /// Control steps from the start step to the path's end.
@@ -97,10 +112,11 @@ class Recordings {
              int threads = 0, Cluster& cluster = local_cluster());
 
   const std::vector<CupPath>& paths() const { return paths_; }
-  /// Path indices in the order the tracker tries them: most probe successes first, then by index;
+  /// Path indices in the order the tracker tries them: highest probe score first, then by index;
   /// only the first config.keep of them when keep > 0 (the others are never followed).
   const std::vector<std::size_t>& order() const { return order_; }
-  /// Probe successes per path (index as in paths()).
+  /// Probe score per path (index as in paths()): its successes from the probe starts, and with
+  /// robust_trials, 1 more for each noisy trial of such a success that also succeeds.
   const std::vector<int>& probe_successes() const { return probe_successes_; }
   const TrackerConfig& config() const { return config_; }
   std::uint64_t seed() const { return seed_; }
