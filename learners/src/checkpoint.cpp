@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <map>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
@@ -191,7 +191,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
   const fs::path path = c.checkpoint_dir / state_file;
   json state;
   try {
-    state = parse_json_limited<json>(std::ifstream(path), path.string());
+    state = parse_json_limited<json>(read_file(path), path.string());
   } catch (const json::exception& e) {
     throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
   }

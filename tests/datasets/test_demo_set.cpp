@@ -285,6 +285,32 @@ fs::path unique_dir(const std::string& name) {
   return dir;
 }
 
+TEST(DemoSetBadInput, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
+  const fs::path dir = unique_dir("unreadable");
+  fs::copy(kData / "good", dir / "set");
+  const fs::path episode = dir / "set" / "episode_0001.csv";
+  // The episode file without read permission (issue 27: "cannot open" said nothing more).
+  fs::permissions(episode, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return test::error_of([&] { read_demo_set(dir / "set"); }); });
+  fs::permissions(episode, fs::perms::owner_read | fs::perms::owner_write);
+  if (denied) {
+    EXPECT_EQ(*denied, episode.string() + ": cannot open for reading: Permission denied");
+  }
+  // A folder where the episode file should be, and where meta.json should be.
+  fs::remove(episode);
+  fs::create_directory(episode);
+  EXPECT_EQ(test::error_of([&] { read_demo_set(dir / "set"); }), episode.string() + ": read failed: Is a directory");
+  EXPECT_EQ(test::error_of([&] { read_episode_csv(episode); }), episode.string() + ": read failed: Is a directory");
+  fs::remove(episode);
+  EXPECT_EQ(test::error_of([&] { read_episode_csv(episode); }),
+            episode.string() + ": cannot open for reading: No such file or directory");
+  fs::remove(dir / "set" / "meta.json");
+  fs::create_directory(dir / "set" / "meta.json");
+  EXPECT_EQ(test::error_of([&] { read_demo_set(dir / "set"); }), (dir / "set" / "meta.json").string() + ": read failed: Is a directory");
+  fs::remove_all(dir);
+  if (!denied) GTEST_SKIP() << "cannot drop root's privileges here: the unreadable file was not tried";
+}
+
 TEST(DemoSet, AUsersFolderIsRefusedAndLeftUntouched) {
   const DemoSet set = read_demo_set(kData / "good");
   const fs::path root = unique_dir("user");

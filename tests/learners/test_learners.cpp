@@ -317,6 +317,10 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   nlohmann::json v1 = saved;  // version 1: the same state without "version"
   v1.erase("version");
   EXPECT_EQ(resume_with(v1), "");
+  std::filesystem::remove(path);  // a folder where the state should be: the system's reason
+  std::filesystem::create_directory(path);
+  EXPECT_EQ(test::error_of([&] { LearnerRegistry::global().create("dagger", options)->learn(c); }),
+            path.string() + ": read failed: Is a directory");
   std::filesystem::remove_all(c.checkpoint_dir);
 }
 
