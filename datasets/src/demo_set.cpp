@@ -470,11 +470,15 @@ bool is_own_demo_set(const fs::path& dir, std::string* why) {
       if (entry.is_object() && entry.contains("file") && entry["file"].is_string()) listed.insert(entry["file"].get<std::string>());
   const Ownership sidecar = Ownership::json_object("dicestack baseline summary", kBaselineFormat);
   std::vector<std::string> foreign;
+  std::size_t summaries = 0;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     const bool file = it->is_regular_file(ec) && !it->is_symlink(ec);
     if (meta_ok && file && (name == "meta.json" || listed.contains(name))) continue;
-    if (meta_ok && file && it->path().extension() == ".json" && sidecar.recognises(it->path())) continue;
+    if (file && name != "meta.json" && it->path().extension() == ".json" && sidecar.recognises(it->path())) {
+      ++summaries;
+      continue;
+    }
     if (is_scratch_name(name)) continue;
     foreign.push_back(name == "meta.json" ? std::string("a meta.json that is not ours") : name + (it->is_directory(ec) ? "/" : ""));
   }
@@ -483,7 +487,9 @@ bool is_own_demo_set(const fs::path& dir, std::string* why) {
     std::sort(foreign.begin(), foreign.end());
     return no("it holds " + foreign.front() + (foreign.size() > 1 ? " and " + std::to_string(foreign.size() - 1) + " more" : ""));
   }
-  if (!meta_ok) return no("it has no dicestack meta.json");
+  // Only baseline summaries and no meta.json: what rrt wrote when it found no path, before its
+  // folder always held a set.
+  if (!meta_ok && summaries == 0) return no("it has no dicestack meta.json");
   return true;
 }
 
@@ -498,7 +504,13 @@ void check_demo_set_replaceable(const fs::path& dir) {
                    "); refusing to replace it: choose another --out or remove it yourself");
 }
 
-void write_demo_set(const DemoSet& set, const fs::path& dir) {
+void write_demo_set(const DemoSet& set, const fs::path& dir) { write_demo_set(set, dir, {}); }
+
+void write_demo_set(const DemoSet& set, const fs::path& dir, const std::map<std::string, std::string>& sidecars) {
+  for (const auto& [name, bytes] : sidecars)
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name == "meta.json" ||
+        fs::path(name).extension() == ".csv")
+      throw InputError(dir.string() + ": \"" + name + "\" cannot be written beside a demonstration set");
   validate(set.world);
   std::vector<std::string> files;
   for (std::size_t i = 0; i < set.episodes.size(); ++i) {
@@ -511,6 +523,11 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
     AtomicFile meta(tmp / "meta.json", meta_ownership());
     meta.stream() << meta_json(set, files).dump(2) << '\n';
     meta.commit();
+    for (const auto& [name, bytes] : sidecars) {
+      AtomicFile f(tmp / name, Ownership::unchecked("sidecar of a demonstration set"), AtomicFile::Leftovers::skip);
+      f.stream() << bytes;
+      f.commit();
+    }
   });
 }
 

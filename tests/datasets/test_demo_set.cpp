@@ -364,6 +364,33 @@ TEST(DemoSet, OurOwnSetWithSidecarsAnEmptyFolderAndAMissingPathAreWritten) {
   fs::remove_all(root);
 }
 
+TEST(DemoSet, SidecarsAppearWithTheSetAndASummaryAloneIsOurs) {
+  DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("sidecars");
+  const std::string summary = R"({"format": "dicestack-baseline", "version": 1, "best_cost": 1})";
+  write_demo_set(set, root / "out", {{"optimise.json", summary}});
+  EXPECT_EQ(slurp(root / "out" / "optimise.json"), summary);
+  EXPECT_EQ(read_demo_set(root / "out").episodes.size(), 2u);
+  EXPECT_TRUE(is_own_demo_set(root / "out"));
+  // Replaced together: the old summary goes with the old set.
+  set.episodes.clear();
+  write_demo_set(set, root / "out", {{"rrt.json", summary}});
+  EXPECT_FALSE(fs::exists(root / "out" / "optimise.json"));
+  EXPECT_TRUE(read_demo_set(root / "out").episodes.empty()) << "a set may hold no episode (rrt without a path)";
+  for (const std::string bad : {"meta.json", "episode_0000.csv", "../x.json", ""})
+    EXPECT_THAT(test::error_of([&] { write_demo_set(set, root / "out", {{bad, summary}}); }),
+                HasSubstr("cannot be written beside a demonstration set"))
+        << bad;
+  // What rrt left when it found no path, before: only its summary, no meta.json.
+  fs::remove_all(root / "out");
+  fs::create_directories(root / "out");
+  { std::ofstream(root / "out" / "rrt.json") << summary; }
+  EXPECT_TRUE(is_own_demo_set(root / "out"));
+  { std::ofstream(root / "out" / "notes.txt") << "mine"; }
+  EXPECT_FALSE(is_own_demo_set(root / "out"));
+  fs::remove_all(root);
+}
+
 TEST(DemoSet, DeadRunsScratchFoldersAreRemovedLiveOnesKept) {
   const DemoSet set = read_demo_set(kData / "good");
   const fs::path root = unique_dir("scratch");
