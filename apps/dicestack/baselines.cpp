@@ -1,6 +1,5 @@
 #include "baselines.hpp"
 
-#include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
@@ -48,16 +47,6 @@ Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std
   return e;
 }
 
-void write_episode_set(const WorldConfig& world, const Episode& e, const std::string& description,
-                       const std::string& provenance, const std::filesystem::path& out) {
-  DemoSet set;
-  set.world = world;
-  set.description = description;
-  set.provenance = provenance;
-  set.episodes.push_back(e);
-  write_demo_set(set, out);
-}
-
 nlohmann::json outcome_json(const Outcome& o) {
   return {{"dice_in_cup", o.dice_in_cup}, {"stacked", o.stacked}, {"wall_contact", o.wall_contact},
           {"realistic_success", o.realistic_success()}};
@@ -69,16 +58,18 @@ std::string outcome_text(const Outcome& o) {
          yes(o.wall_contact) + ", realistic success " + yes(o.realistic_success());
 }
 
-int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, const std::string& curve_key,
-                    const nlohmann::json& curve, bool json, const std::string& text) {
-  nlohmann::json saved = summary;
+int finish_baseline(const BaselineOutput& o, bool json, const std::string& text) {
+  nlohmann::json saved = o.summary;
   saved["format"] = kBaselineFormat;
   saved["version"] = 1;
-  if (!curve.is_null()) saved[curve_key] = curve;
-  AtomicFile f(file, Ownership::json_object("dicestack baseline summary", kBaselineFormat));
-  f.stream() << saved.dump(1);
-  f.commit();
-  print_line(json ? summary.dump() : text);
+  if (!o.curve.is_null()) saved[o.curve_key] = o.curve;
+  DemoSet set;
+  set.world = o.world;
+  set.description = o.description;
+  set.provenance = o.provenance;
+  if (o.episode) set.episodes.push_back(*o.episode);
+  write_demo_set(set, o.out, {{o.summary_file, saved.dump(1)}});
+  print_line(json ? o.summary.dump() : text);
   return 0;
 }
 

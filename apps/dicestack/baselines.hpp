@@ -4,6 +4,7 @@
 // summary JSON, its line of text).
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,17 +38,25 @@ void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt);
 /// episode (it ends after the last action, or at a held success).
 Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin);
 
-/// Writes one episode as a demonstration set at `out` (ours or new only).
-void write_episode_set(const WorldConfig& world, const Episode& e, const std::string& description,
-                       const std::string& provenance, const std::filesystem::path& out);
-
 /// A baseline's episode outcome, for its JSON summary and its text line.
 nlohmann::json outcome_json(const Outcome& o);
 std::string outcome_text(const Outcome& o);
 
-/// Writes `summary` (with `curve` under `curve_key`) to `file` atomically, then prints the
+/// What a baseline command leaves in its --out folder.
+struct BaselineOutput {
+  std::filesystem::path out;            ///< the folder (--out): ours or new only
+  WorldConfig world;                    ///< the world the episode was played in
+  std::optional<Episode> episode;       ///< the result as an episode; none (an empty set): RRT found no path
+  std::string description, provenance;  ///< for the set's meta.json
+  std::string summary_file;             ///< "optimise.json", "reinforce.json" or "rrt.json"
+  nlohmann::json summary;               ///< saved with the format marker, and printed by --json
+  std::string curve_key;                ///< where `curve` goes in the saved summary (null: none)
+  nlohmann::json curve;
+};
+
+/// Writes the episode as a demonstration set and the summary beside it in one swap
+/// (write_demo_set with a sidecar), so a kill leaves the old folder whole, then prints the
 /// summary as JSON or the text. Returns the exit status.
-int finish_baseline(const std::filesystem::path& file, nlohmann::json summary, const std::string& curve_key,
-                    const nlohmann::json& curve, bool json, const std::string& text);
+int finish_baseline(const BaselineOutput& output, bool json, const std::string& text);
 
 }  // namespace dicestack::cli

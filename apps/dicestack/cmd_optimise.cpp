@@ -29,10 +29,6 @@ int run_optimise(OptimiseCommandOptions opt, Cluster& cluster) {
   if (!cluster.is_root()) return 0;  // the root writes and prints
   // With noise, the first repeat's noise seed.
   const Episode best = replay(problem.world(), problem.actions(r.best.data()), derive_seed(opt.settings.seed, 0), "dicestack optimise");
-  write_episode_set(problem.world(), best, "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method,
-                    "dicestack optimise --method " + opt.optimiser.method + " --steps " + std::to_string(opt.settings.steps) +
-                        " --evaluations " + std::to_string(opt.optimiser.evaluations) + " --seed " + std::to_string(opt.optimiser.seed),
-                    opt.out);
   const double rate = r.evaluations / std::max(r.seconds, 1e-9);
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& [evals, cost] : r.curve) curve.push_back({evals, cost});
@@ -45,8 +41,13 @@ int run_optimise(OptimiseCommandOptions opt, Cluster& cluster) {
   char line[256];
   std::snprintf(line, sizeof line, "%s: best cost %.4g after %d evaluations in %.1f s (%.0f evaluations/s)\n",
                 opt.optimiser.method.c_str(), r.best_cost, r.evaluations, r.seconds, rate);
-  return finish_baseline(opt.out / "optimise.json", j, "curve", curve, opt.json,
-                         line + ("best sequence: " + outcome_text(best.outcome) + " -> " + opt.out.string()));
+  return finish_baseline({opt.out, problem.world(), best,
+                          "best open-loop sequence of dicestack optimise --method " + opt.optimiser.method,
+                          "dicestack optimise --method " + opt.optimiser.method + " --steps " +
+                              std::to_string(opt.settings.steps) + " --evaluations " +
+                              std::to_string(opt.optimiser.evaluations) + " --seed " + std::to_string(opt.optimiser.seed),
+                          "optimise.json", j, "curve", curve},
+                         opt.json, line + ("best sequence: " + outcome_text(best.outcome) + " -> " + opt.out.string()));
 }
 
 }  // namespace

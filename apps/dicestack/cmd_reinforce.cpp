@@ -34,11 +34,6 @@ int run_reinforce(const ReinforceCommandOptions& opt, Cluster& cluster) {
   WorldConfig played = world;
   played.episode.max_steps = std::max(played.episode.max_steps, opt.reinforce.steps);
   const Episode greedy = replay(played, r.greedy_actions, 0, "dicestack reinforce");
-  write_episode_set(played, greedy, "the mean actions of the policy learned by dicestack reinforce",
-                    "dicestack reinforce --iterations " + std::to_string(opt.reinforce.iterations) + " --batch " +
-                        std::to_string(opt.reinforce.batch) + " --steps " + std::to_string(opt.reinforce.steps) + " --seed " +
-                        std::to_string(opt.reinforce.seed),
-                    opt.out);
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& p : r.curve) curve.push_back({p.iteration, p.mean_return, p.greedy_cost});
   nlohmann::json j{{"iterations", opt.reinforce.iterations}, {"episodes", opt.reinforce.iterations * opt.reinforce.batch},
@@ -49,8 +44,12 @@ int run_reinforce(const ReinforceCommandOptions& opt, Cluster& cluster) {
   std::snprintf(line, sizeof line, "reinforce: %d episodes in %.1f s; mean return %.4g -> %.4g, greedy cost %.4g -> %.4g\n",
                 opt.reinforce.iterations * opt.reinforce.batch, r.seconds, r.curve.front().mean_return, r.curve.back().mean_return,
                 r.curve.front().greedy_cost, r.curve.back().greedy_cost);
-  return finish_baseline(opt.out / "reinforce.json", j, "curve (iteration, mean return, greedy cost)", curve, opt.json,
-                         line + ("greedy policy: " + outcome_text(greedy.outcome) + " -> " + opt.out.string()));
+  return finish_baseline({opt.out, played, greedy, "the mean actions of the policy learned by dicestack reinforce",
+                          "dicestack reinforce --iterations " + std::to_string(opt.reinforce.iterations) + " --batch " +
+                              std::to_string(opt.reinforce.batch) + " --steps " + std::to_string(opt.reinforce.steps) +
+                              " --seed " + std::to_string(opt.reinforce.seed),
+                          "reinforce.json", j, "curve (iteration, mean return, greedy cost)", curve},
+                         opt.json, line + ("greedy policy: " + outcome_text(greedy.outcome) + " -> " + opt.out.string()));
 }
 
 }  // namespace

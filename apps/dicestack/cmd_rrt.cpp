@@ -32,14 +32,8 @@ int run_rrt(const RrtCommandOptions& opt, Cluster& cluster) {
   if (!cluster.is_root()) return 0;  // the root writes and prints
   WorldConfig played = world;
   played.episode.max_steps = std::max(played.episode.max_steps, static_cast<int>(r.actions.size()));
-  // When no node got nearer the goal than the start, there is no path: only rrt.json is written.
+  // When no node got nearer the goal than the start, there is no path: the set has no episode.
   const Episode path = r.actions.empty() ? Episode{} : replay(played, r.actions, 0, "dicestack rrt");
-  if (r.actions.empty()) std::filesystem::create_directories(opt.out);
-  else
-    write_episode_set(played, path, "the path to the node nearest the goal in the tree of dicestack rrt",
-                      "dicestack rrt --nodes " + std::to_string(opt.rrt.nodes) + " --extend-steps " +
-                          std::to_string(opt.rrt.extend_steps) + " --seed " + std::to_string(opt.rrt.seed),
-                      opt.out);
   const double rate = static_cast<double>(r.simulated_steps) / std::max(r.seconds, 1e-9);
   nlohmann::json j{{"nodes", r.nodes},          {"simulated_steps", r.simulated_steps}, {"seconds", r.seconds},
                    {"steps_per_second", rate},  {"best_distance", r.best_distance},   {"path_steps", r.actions.size()},
@@ -48,9 +42,14 @@ int run_rrt(const RrtCommandOptions& opt, Cluster& cluster) {
   char line[256];
   std::snprintf(line, sizeof line, "rrt: %d nodes, %lld simulated steps in %.1f s (%.0f steps/s); nearest to the goal %.4g after %zu steps\n",
                 r.nodes, r.simulated_steps, r.seconds, rate, r.best_distance, r.actions.size());
-  return finish_baseline(opt.out / "rrt.json", j, "", nullptr, opt.json,
-                         line + ("path (none if no node got nearer than the start): " + outcome_text(path.outcome) + " -> " +
-                                 opt.out.string()));
+  return finish_baseline({opt.out, played, r.actions.empty() ? std::nullopt : std::optional<Episode>(path),
+                          r.actions.empty() ? "dicestack rrt found no node nearer the goal than the start: no path"
+                                            : "the path to the node nearest the goal in the tree of dicestack rrt",
+                          "dicestack rrt --nodes " + std::to_string(opt.rrt.nodes) + " --extend-steps " +
+                              std::to_string(opt.rrt.extend_steps) + " --seed " + std::to_string(opt.rrt.seed),
+                          "rrt.json", j, "", nullptr},
+                         opt.json, line + ("path (none if no node got nearer than the start): " + outcome_text(path.outcome) +
+                                           " -> " + opt.out.string()));
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/judge.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/core/world.hpp>
 #include <dicestack/datasets/replay.hpp>
 
@@ -33,8 +34,7 @@ constexpr Layout kFinal{CupdiceLayout::final27, 27, 450.0, 190.0 + 220.0 / 3.0};
 constexpr Layout kLegacy{CupdiceLayout::legacy24, 24, 450.0, 185.0 + 220.0 / 3.0};
 
 std::vector<std::vector<double>> read_rows(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open");
+  std::ifstream in = open_for_reading(file);
   std::vector<std::vector<double>> rows;
   std::string line;
   std::size_t line_no = 0, columns = 0;
@@ -68,6 +68,7 @@ std::vector<std::vector<double>> read_rows(const fs::path& file) {
                        " columns, expected " + std::to_string(columns) + " as on line 1");
     rows.push_back(std::move(row));
   }
+  check_read(in, file);
   if (rows.empty()) throw InputError(file.string() + ": no rows");
   return rows;
 }
@@ -198,9 +199,11 @@ Episode import_cupdice_file(const fs::path& file, const WorldConfig& world) {
 DemoSet import_cupdice(const fs::path& src, const WorldConfig& world) {
   if (!fs::is_directory(src)) throw InputError(src.string() + ": not a folder");
   std::vector<std::string> files;
-  for (const auto& entry : fs::recursive_directory_iterator(src))
-    if (entry.is_regular_file() && entry.path().extension() == ".csv")
-      files.push_back(fs::relative(entry.path(), src).generic_string());
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(src, ec), end; it != end; it.increment(ec))
+    if (it->is_regular_file() && it->path().extension() == ".csv")
+      files.push_back(fs::relative(it->path(), src).generic_string());
+  if (ec) throw InputError(src.string() + ": cannot list the folder: " + ec.message());
   if (files.empty()) throw InputError(src.string() + ": no *.csv recordings found");
   std::sort(files.begin(), files.end(), natural_less);
   DemoSet set;

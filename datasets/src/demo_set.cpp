@@ -19,6 +19,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/version.hpp>
 
 namespace dicestack {
@@ -30,14 +31,6 @@ using nlohmann::json;
 constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
 constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
 constexpr std::size_t kNumbers = 1 + kStateDim + kActionDim;         // t, state, action
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 std::string episode_file_name(std::size_t index) {
   std::string digits = std::to_string(index);
@@ -396,9 +389,12 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
 }
 
 DemoSet read_demo_set(const fs::path& dir) {
-  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder of demonstrations");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(dir.string() + ": not a folder of demonstrations");
   const fs::path meta_path = dir / "meta.json";
-  if (!fs::exists(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
+  // Only a file that is not there is "missing"; any other failure is read_file's to explain.
+  auto absent = [&](const fs::path& p) { return fs::status(p, ec).type() == fs::file_type::not_found; };
+  if (absent(meta_path)) meta_error(meta_path, "missing; not a dicestack demonstration folder");
   DemoMeta meta = parse_demo_meta(read_file(meta_path), meta_path);
 
   DemoSet set;
@@ -409,7 +405,7 @@ DemoSet read_demo_set(const fs::path& dir) {
   for (auto& entry : meta.episodes) {
     listed.insert(entry.file);
     const fs::path path = dir / entry.file;
-    if (!fs::exists(path)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
+    if (absent(path)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
     int csv_version = 0;
     Episode e = parse_csv(read_file(path), path.string(), path.stem().string(), csv_version);
     // A version-2 set may hold version-1 files (appended to an old set): episodes without transitions.
@@ -439,11 +435,12 @@ DemoSet read_demo_set(const fs::path& dir) {
                            "] (the world's action.limit)");
     set.episodes.push_back(std::move(e));
   }
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const auto name = entry.path().filename().string();
-    if (entry.path().extension() == ".csv" && !listed.contains(name))
-      throw InputError(entry.path().string() + ": not listed in meta.json");
+  for (fs::directory_iterator it(dir, ec), end; it != end; it.increment(ec)) {
+    const auto name = it->path().filename().string();
+    if (it->path().extension() == ".csv" && !listed.contains(name))
+      throw InputError(it->path().string() + ": not listed in meta.json");
   }
+  if (ec) throw InputError(dir.string() + ": cannot list the folder: " + ec.message());
   std::sort(set.episodes.begin(), set.episodes.end(), [](const Episode& a, const Episode& b) { return a.name < b.name; });
   return set;
 }
@@ -473,11 +470,15 @@ bool is_own_demo_set(const fs::path& dir, std::string* why) {
       if (entry.is_object() && entry.contains("file") && entry["file"].is_string()) listed.insert(entry["file"].get<std::string>());
   const Ownership sidecar = Ownership::json_object("dicestack baseline summary", kBaselineFormat);
   std::vector<std::string> foreign;
+  std::size_t summaries = 0;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     const bool file = it->is_regular_file(ec) && !it->is_symlink(ec);
     if (meta_ok && file && (name == "meta.json" || listed.contains(name))) continue;
-    if (meta_ok && file && it->path().extension() == ".json" && sidecar.recognises(it->path())) continue;
+    if (file && name != "meta.json" && it->path().extension() == ".json" && sidecar.recognises(it->path())) {
+      ++summaries;
+      continue;
+    }
     if (is_scratch_name(name)) continue;
     foreign.push_back(name == "meta.json" ? std::string("a meta.json that is not ours") : name + (it->is_directory(ec) ? "/" : ""));
   }
@@ -486,7 +487,9 @@ bool is_own_demo_set(const fs::path& dir, std::string* why) {
     std::sort(foreign.begin(), foreign.end());
     return no("it holds " + foreign.front() + (foreign.size() > 1 ? " and " + std::to_string(foreign.size() - 1) + " more" : ""));
   }
-  if (!meta_ok) return no("it has no dicestack meta.json");
+  // Only baseline summaries and no meta.json: what rrt wrote when it found no path, before its
+  // folder always held a set.
+  if (!meta_ok && summaries == 0) return no("it has no dicestack meta.json");
   return true;
 }
 
@@ -501,7 +504,13 @@ void check_demo_set_replaceable(const fs::path& dir) {
                    "); refusing to replace it: choose another --out or remove it yourself");
 }
 
-void write_demo_set(const DemoSet& set, const fs::path& dir) {
+void write_demo_set(const DemoSet& set, const fs::path& dir) { write_demo_set(set, dir, {}); }
+
+void write_demo_set(const DemoSet& set, const fs::path& dir, const std::map<std::string, std::string>& sidecars) {
+  for (const auto& [name, bytes] : sidecars)
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name == "meta.json" ||
+        fs::path(name).extension() == ".csv")
+      throw InputError(dir.string() + ": \"" + name + "\" cannot be written beside a demonstration set");
   validate(set.world);
   std::vector<std::string> files;
   for (std::size_t i = 0; i < set.episodes.size(); ++i) {
@@ -514,6 +523,11 @@ void write_demo_set(const DemoSet& set, const fs::path& dir) {
     AtomicFile meta(tmp / "meta.json", meta_ownership());
     meta.stream() << meta_json(set, files).dump(2) << '\n';
     meta.commit();
+    for (const auto& [name, bytes] : sidecars) {
+      AtomicFile f(tmp / name, Ownership::unchecked("sidecar of a demonstration set"), AtomicFile::Leftovers::skip);
+      f.stream() << bytes;
+      f.commit();
+    }
   });
 }
 

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/read_file.hpp>
 
 namespace dicestack::h5 {
 namespace {
@@ -151,9 +152,11 @@ bool is_hdf5(const std::filesystem::path& path) {
 
 ReadFile::ReadFile(const std::filesystem::path& path) : name_(path.string()) {
   quiet();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(name_ + ": does not exist");
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name_ + ": is not a file");
+  {  // the system's reason first: a missing or unreadable file, or a folder, is not "not an HDF5 file"
+    std::ifstream probe = open_for_reading(path);
+    probe.peek();
+    check_read(probe, path);
+  }
   if (!is_hdf5(path)) throw InputError(name_ + ": not an HDF5 file");
   file_ = checked(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), name_, "cannot open");
 }

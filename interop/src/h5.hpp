@@ -56,7 +56,8 @@ class MemoryFile {
   Id file_;
 };
 
-/// A file opened read-only. Throws InputError "FILE: not an HDF5 file" or "cannot open".
+/// A file opened read-only. Throws InputError "FILE: cannot open for reading: <reason>",
+/// "FILE: read failed: Is a directory", "FILE: not an HDF5 file" or "FILE: cannot open" (HDF5's).
 class ReadFile {
  public:
   explicit ReadFile(const std::filesystem::path& path);

@@ -7,6 +7,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/interop/interop.hpp>
 
 #include "common.hpp"
@@ -44,14 +45,6 @@ std::string box_text(const Box<N>& box) {
          "], \"high\": [" + high + "]}";
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 bool is_scratch(const std::string& name) {
   return !name.empty() && name[0] == '.' && (name.find(".tmp-") != std::string::npos || name.find(".old-") != std::string::npos);
 }
@@ -74,7 +67,7 @@ bool is_own_minari_folder(const fs::path& dir, std::string& why) {
     }
   }
   try {
-    const json meta = parse_json_text(read_text(dir / "data" / kMetadataFile), "metadata.json");
+    const json meta = parse_json_text(read_file(dir / "data" / kMetadataFile), "metadata.json");
     if (meta.is_object() && meta.contains("dicestack") && meta["dicestack"].is_object() &&
         meta["dicestack"].value("format", "") == kMinariFormat)
       return true;
@@ -219,8 +212,9 @@ DemoSet import_minari(const fs::path& dir, const WorldConfig& fallback_world) {
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder (a Minari dataset is a folder holding data/)");
   const fs::path meta_path = dir / "data" / kMetadataFile;
   const std::string M = meta_path.string();
-  if (!fs::exists(meta_path)) throw InputError(M + ": missing; not a Minari dataset");
-  const json meta = parse_json_text(read_text(meta_path), M);
+  std::error_code ec;
+  if (fs::status(meta_path, ec).type() == fs::file_type::not_found) throw InputError(M + ": missing; not a Minari dataset");
+  const json meta = parse_json_text(read_file(meta_path), M);
   if (!meta.is_object()) throw InputError(M + ": must be a JSON object");
   if (!meta.contains("data_format") || meta["data_format"] != "hdf5")
     throw InputError(M + ": \"data_format\" must be \"hdf5\" (the only storage dicestack reads)");

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
+#include <functional>
 #include <map>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
@@ -22,8 +23,10 @@ namespace {
 
 constexpr const char* kFormat = "dicestack-checkpoint";
 // 1: the same fields without "version" (and, before the marker, without "format"); 2: adds
-// "version"; 3: "run"'s learner options as an object of key -> value, not one "k=v, k=v" text.
-constexpr int kVersion = 3;
+// "version"; 3: "run"'s learner options as an object of key -> value, not one "k=v, k=v" text;
+// 4: "run"'s regressor settings as "regressor_params", an object of every schema parameter ->
+// its parsed value (JSON number, boolean or string), not the --set text "regressor_sets".
+constexpr int kVersion = 4;
 
 // "data-<digits>" or "best-<digits>.model" (suffix empty or ".model").
 bool numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
@@ -64,9 +67,73 @@ std::string value_before(const std::string& learner, const std::string& key) {
   return "";
 }
 
+// Every parameter of `schema` -> its value in `params`, typed: what a run's regressor settings mean.
+json typed_params(const std::vector<ParamSpec>& schema, const Params& params) {
+  json out = json::object();
+  for (const auto& spec : schema) {
+    switch (spec.type) {
+      case ParamType::integer: out[spec.name] = params.integer(spec.name); break;
+      case ParamType::real: out[spec.name] = params.real(spec.name); break;
+      case ParamType::boolean: out[spec.name] = params.boolean(spec.name); break;
+      case ParamType::choice:
+      case ParamType::text: out[spec.name] = params.choice(spec.name); break;
+    }
+  }
+  return out;
+}
+
+// Versions 1-3 saved the --set assignments joined by spaces: "k=3 metric=l2". A piece without
+// "=" continues the previous value (a text value holding a space).
+std::vector<std::string> split_sets(const std::string& text) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at <= text.size();) {
+    std::size_t end = text.find(' ', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string piece = text.substr(at, end - at);
+    if (!piece.empty() && (piece.find('=') != std::string::npos || out.empty())) out.push_back(piece);
+    else if (!out.empty()) out.back() += " " + piece;
+    at = end + 1;
+  }
+  return out;
+}
+
 std::string excerpt(const json& j) {
   const std::string text = j.dump();
   return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+}
+
+std::string difference(const std::string& what, const json& saved, const json& now) {
+  return what + " " + excerpt(saved) + " in the checkpoint, " + now.dump() + " in this run";
+}
+
+// A checkpoint's regressor settings against this run's (`now`, from run_settings), value by
+// parsed value: version 4's "regressor_params", or the "regressor_sets" text of versions 1-3
+// parsed through this run's schema. A parameter the checkpoint does not name (added to the
+// regressor since) had its default. Each difference is passed to `note`.
+void compare_regressor_params(const json& saved_run, const json& now, const LearnContext& c,
+                              const std::function<void(std::string)>& note) {
+  const auto& schema = c.registry->info(c.regressor).params;
+  json saved;
+  if (saved_run.contains("regressor_params")) {
+    saved = saved_run["regressor_params"];
+    if (!saved.is_object()) return note(difference("regressor_params", saved, now));
+    const json defaults = typed_params(schema, Params(schema, {}, c.regressor));
+    for (const auto& [k, v] : defaults.items())
+      if (!saved.contains(k)) saved[k] = v;
+  } else {
+    const json text = saved_run.value("regressor_sets", json());
+    if (!text.is_string()) return note(difference("regressor_sets", text, now));
+    try {
+      saved = typed_params(schema, Params(schema, split_sets(text.get<std::string>()), c.regressor));
+    } catch (const ConfigError& e) {
+      return note("regressor settings " + excerpt(text) + " in the checkpoint, which this dicestack refuses (" +
+                  e.what() + ")");
+    }
+  }
+  for (const auto& [k, v] : saved.items())
+    if (!now.contains(k)) note(difference("regressor parameter " + k, v, json("(not a parameter now)")));
+  for (const auto& [k, v] : now.items())
+    if (saved.value(k, json()) != v) note(difference("regressor parameter " + k, saved.value(k, json()), v));
 }
 
 }  // namespace
@@ -113,13 +180,12 @@ void remove_old_best_models(const fs::path& dir, const std::string& keep) {
 }
 
 json run_settings(const LearnContext& c, const Params& learner_params, const std::vector<std::string>& extendable) {
-  std::string sets;
   json options = json::object();
-  for (const auto& s : c.regressor_sets) sets += (sets.empty() ? "" : " ") + s;
   for (const auto& [key, value] : learner_params.as_text())
     if (std::find(extendable.begin(), extendable.end(), key) == extendable.end()) options[key] = value;
+  const auto& schema = c.registry->info(c.regressor).params;
   return {{"regressor", c.regressor},
-          {"regressor_sets", sets},
+          {"regressor_params", typed_params(schema, Params(schema, c.regressor_sets, c.regressor))},
           {"features", c.features},
           {"seed", std::to_string(c.seed)},
           {"learner_options", options},
@@ -191,7 +257,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
   const fs::path path = c.checkpoint_dir / state_file;
   json state;
   try {
-    state = parse_json_limited<json>(std::ifstream(path), path.string());
+    state = parse_json_limited<json>(read_file(path), path.string());
   } catch (const json::exception& e) {
     throw InputError(path.string() + ": not a checkpoint state (" + e.what() + ")");
   }
@@ -200,12 +266,17 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
     throw InputError(path.string() + ": field \"run\" must be an object");
   if (state.contains("run")) {  // states written before runs were recorded have none to compare
     std::string differences;
-    auto differ = [&](const std::string& what, const json& saved, const json& now) {
-      differences += (differences.empty() ? "" : "; ") + what + " " + excerpt(saved) + " in the checkpoint, " +
-                     now.dump() + " in this run";
-    };
+    auto note = [&](std::string text) { differences += (differences.empty() ? "" : "; ") + std::move(text); };
+    auto differ = [&](const std::string& what, const json& saved, const json& now) { note(difference(what, saved, now)); };
+    const json& saved_run = state["run"];
+    const bool same_regressor = saved_run.value("regressor", json()) == run.value("regressor", json());
     for (const auto& [key, value] : run.items()) {
-      const json saved = state["run"].value(key, json());
+      const json saved = saved_run.value(key, json());
+      if (key == "regressor_params") {
+        // Parsed values, parameter by parameter (so "08" and "8" agree); only for the same regressor.
+        if (same_regressor) compare_regressor_params(saved_run, value, c, note);
+        continue;
+      }
       if (key != "learner_options") {
         if (saved != value) differ(key, saved, value);
         continue;

@@ -26,9 +26,11 @@ void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::
 /// Removes DaD's earlier best-<integer>.model files in `dir` that are dicestack models, except `keep`.
 void remove_old_best_models(const std::filesystem::path& dir, const std::string& keep);
 
-/// What a run was started with: regressor and its settings, feature map, seed, learner options
-/// but `extendable` (options a resumed run may change, e.g. DAgger's round count: more rounds
-/// continue the same run). Saved in every checkpoint state under "run"; a resumed run must match it.
+/// What a run was started with: regressor and its settings (every schema parameter's parsed value,
+/// so "max_depth=08" and "max_depth=8" are one setting), feature map, seed, learner options but
+/// `extendable` (options a resumed run may change, e.g. DAgger's round count: more rounds continue
+/// the same run). Saved in every checkpoint state under "run"; a resumed run must match it.
+/// Throws ConfigError for an unknown regressor or a bad setting.
 nlohmann::json run_settings(const LearnContext& context, const Params& learner_params,
                             const std::vector<std::string>& extendable = {});
 
@@ -59,8 +61,9 @@ class CheckpointState {
 
 /// The state of the last finished iteration, or nothing when there is none to resume from.
 /// Throws InputError for a state that is not ours, of a newer version or malformed, and naming
-/// each setting that differs from the checkpoint's "run" (with both values): resuming with
-/// other options would give a model that matches neither run.
+/// each setting that differs from the checkpoint's "run" (with both values; regressor parameters
+/// and learner options compared one by one, as parsed values): resuming with other options
+/// would give a model that matches neither run.
 std::optional<CheckpointState> load_checkpoint_state(const LearnContext& context, const std::string& state_file,
                                                      const nlohmann::json& run);
 

@@ -13,6 +13,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 
 namespace dicestack {
 namespace {
@@ -223,11 +224,7 @@ void save_model(const Model& model, const std::filesystem::path& path) {
 }
 
 Model load_model(const std::filesystem::path& path, const RegressorRegistry& registry, const PickleLoader& pickles) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open model file");
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return parse_model_file(bytes.str(), path.string(), registry, pickles);
+  return parse_model_file(read_file(path), path.string(), registry, pickles);
 }
 
 Model parse_model_file(std::string_view bytes, const std::string& path, const RegressorRegistry& registry,
@@ -300,12 +297,16 @@ Model parse_model_file(std::string_view bytes, const std::string& path, const Re
                          "; unpickling runs code, so dicestack reads it only from Python, with "
                          "dicestack.load_model(path, allow_pickle=True) (never from the command line), and only from "
                          "a source you trust");
-      const auto pickle = read_bytes(pkl);
-      if (!pickle) throw InputError(pkl.string() + ": cannot open the pickle of the model " + path);
-      if (!matches(*pickle, *record))
+      std::string pickle;
+      try {
+        pickle = read_file(pkl);
+      } catch (const InputError& e) {
+        throw InputError(std::string(e.what()) + " (the pickle of the model " + path + ")");
+      }
+      if (!matches(pickle, *record))
         throw InputError(pkl.string() + ": does not match the model file " + path +
                          " (its size or FNV-1a differs from the one recorded there): they were not saved together");
-      regressor = pickles(name, sets, *pickle);
+      regressor = pickles(name, sets, pickle);
     } else {
       if (!registry.contains(name))
         throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");

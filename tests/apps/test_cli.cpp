@@ -284,6 +284,14 @@ TEST(CliBaselines, RrtWritesItsResult) {
   EXPECT_EQ(j["nodes"], 5);
   EXPECT_EQ(j["path_steps"].get<int>() % 2, 0);
   EXPECT_TRUE(std::filesystem::exists(out / "rrt.json"));
+  EXPECT_TRUE(std::filesystem::exists(out / "meta.json")) << "a set, with no episode when there is no path";
+  // Its own folder is replaced by the next run, path or none; so is one an older rrt left with
+  // only rrt.json (no path found).
+  ASSERT_EQ(run("rrt --nodes 3 --extend-steps 2 --extend-iterations 2 --seed 2 --out " + out.string()).status, 0);
+  for (const auto& f : {"meta.json", "episode_0000.csv"}) std::filesystem::remove(out / f);
+  const Process again = run("rrt --nodes 3 --extend-steps 2 --extend-iterations 2 --seed 2 --out " + out.string());
+  EXPECT_EQ(again.status, 0) << again.output;
+  EXPECT_TRUE(std::filesystem::exists(out / "meta.json"));
   std::filesystem::remove_all(out);
 }
 

@@ -121,6 +121,11 @@ TEST(Perturbation, JsonRoundTripsAndLoadsByLevelOrFile) {
   EXPECT_EQ(load_perturbation(path.string(), w), p);
   std::filesystem::remove(path);
   EXPECT_THAT(test::error_of([&] { load_perturbation("nowhere.json", w); }), HasSubstr("nowhere.json"));
+  // A folder is neither a level nor a readable file: the system says why.
+  const auto dir = test::scratch_path("dicestack_perturb_folder");
+  std::filesystem::create_directories(dir);
+  EXPECT_EQ(test::error_of([&] { load_perturbation(dir.string(), w); }), dir.string() + ": read failed: Is a directory");
+  std::filesystem::remove(dir);
 }
 
 TEST(Perturbation, BadFilesAreRefusedNamingTheField) {

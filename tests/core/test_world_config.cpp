@@ -1,6 +1,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
@@ -181,6 +184,22 @@ TEST(WorldConfig, LongValuesAreCutInMessages) {
   const std::string msg = error_for(j);
   EXPECT_THAT(msg, HasSubstr("field \"dice.mass\" must be a number"));
   EXPECT_LT(msg.size(), 300u);
+}
+
+TEST(WorldConfig, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
+  namespace fs = std::filesystem;
+  const fs::path path = test::scratch_path("dicestack_world_unreadable.json");
+  fs::remove_all(path);
+  EXPECT_EQ(error_of([&] { load_world_config(path); }), path.string() + ": cannot open for reading: No such file or directory");
+  fs::create_directories(path);
+  EXPECT_EQ(error_of([&] { load_world_config(path); }), path.string() + ": read failed: Is a directory");
+  fs::remove(path);
+  { std::ofstream(path) << to_json(WorldConfig{}); }
+  fs::permissions(path, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return error_of([&] { load_world_config(path); }); });
+  fs::remove(path);
+  if (!denied) GTEST_SKIP() << "cannot drop root's privileges here";
+  EXPECT_EQ(*denied, path.string() + ": cannot open for reading: Permission denied");
 }
 
 TEST(WorldConfig, HashIsTheWorldsIdentityNotItsFileFormat) {

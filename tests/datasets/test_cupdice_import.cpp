@@ -139,5 +139,16 @@ TEST(CupdiceImport, MalformedRecordingsAreRejected) {
   fs::remove_all(dir);
 }
 
+TEST(CupdiceImport, ARecordingThatCannotBeReadIsNamedWithTheSystemsReason) {
+  const fs::path dir = test::scratch_path("dicestack_cupdice_unreadable");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "folder.csv");
+  EXPECT_EQ(test::error_of([&] { import_cupdice_file(dir / "missing.csv", WorldConfig{}); }),
+            (dir / "missing.csv").string() + ": cannot open for reading: No such file or directory");
+  EXPECT_EQ(test::error_of([&] { import_cupdice_file(dir / "folder.csv", WorldConfig{}); }),
+            (dir / "folder.csv").string() + ": read failed: Is a directory");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace dicestack

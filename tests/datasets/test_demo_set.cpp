@@ -285,6 +285,32 @@ fs::path unique_dir(const std::string& name) {
   return dir;
 }
 
+TEST(DemoSetBadInput, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
+  const fs::path dir = unique_dir("unreadable");
+  fs::copy(kData / "good", dir / "set");
+  const fs::path episode = dir / "set" / "episode_0001.csv";
+  // The episode file without read permission (issue 27: "cannot open" said nothing more).
+  fs::permissions(episode, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return test::error_of([&] { read_demo_set(dir / "set"); }); });
+  fs::permissions(episode, fs::perms::owner_read | fs::perms::owner_write);
+  if (denied) {
+    EXPECT_EQ(*denied, episode.string() + ": cannot open for reading: Permission denied");
+  }
+  // A folder where the episode file should be, and where meta.json should be.
+  fs::remove(episode);
+  fs::create_directory(episode);
+  EXPECT_EQ(test::error_of([&] { read_demo_set(dir / "set"); }), episode.string() + ": read failed: Is a directory");
+  EXPECT_EQ(test::error_of([&] { read_episode_csv(episode); }), episode.string() + ": read failed: Is a directory");
+  fs::remove(episode);
+  EXPECT_EQ(test::error_of([&] { read_episode_csv(episode); }),
+            episode.string() + ": cannot open for reading: No such file or directory");
+  fs::remove(dir / "set" / "meta.json");
+  fs::create_directory(dir / "set" / "meta.json");
+  EXPECT_EQ(test::error_of([&] { read_demo_set(dir / "set"); }), (dir / "set" / "meta.json").string() + ": read failed: Is a directory");
+  fs::remove_all(dir);
+  if (!denied) GTEST_SKIP() << "cannot drop root's privileges here: the unreadable file was not tried";
+}
+
 TEST(DemoSet, AUsersFolderIsRefusedAndLeftUntouched) {
   const DemoSet set = read_demo_set(kData / "good");
   const fs::path root = unique_dir("user");
@@ -335,6 +361,33 @@ TEST(DemoSet, OurOwnSetWithSidecarsAnEmptyFolderAndAMissingPathAreWritten) {
   std::string why;
   EXPECT_FALSE(is_own_demo_set(root / "empty", &why));
   EXPECT_EQ(why, "it holds rrt.json");
+  fs::remove_all(root);
+}
+
+TEST(DemoSet, SidecarsAppearWithTheSetAndASummaryAloneIsOurs) {
+  DemoSet set = read_demo_set(kData / "good");
+  const fs::path root = unique_dir("sidecars");
+  const std::string summary = R"({"format": "dicestack-baseline", "version": 1, "best_cost": 1})";
+  write_demo_set(set, root / "out", {{"optimise.json", summary}});
+  EXPECT_EQ(slurp(root / "out" / "optimise.json"), summary);
+  EXPECT_EQ(read_demo_set(root / "out").episodes.size(), 2u);
+  EXPECT_TRUE(is_own_demo_set(root / "out"));
+  // Replaced together: the old summary goes with the old set.
+  set.episodes.clear();
+  write_demo_set(set, root / "out", {{"rrt.json", summary}});
+  EXPECT_FALSE(fs::exists(root / "out" / "optimise.json"));
+  EXPECT_TRUE(read_demo_set(root / "out").episodes.empty()) << "a set may hold no episode (rrt without a path)";
+  for (const std::string bad : {"meta.json", "episode_0000.csv", "../x.json", ""})
+    EXPECT_THAT(test::error_of([&] { write_demo_set(set, root / "out", {{bad, summary}}); }),
+                HasSubstr("cannot be written beside a demonstration set"))
+        << bad;
+  // What rrt left when it found no path, before: only its summary, no meta.json.
+  fs::remove_all(root / "out");
+  fs::create_directories(root / "out");
+  { std::ofstream(root / "out" / "rrt.json") << summary; }
+  EXPECT_TRUE(is_own_demo_set(root / "out"));
+  { std::ofstream(root / "out" / "notes.txt") << "mine"; }
+  EXPECT_FALSE(is_own_demo_set(root / "out"));
   fs::remove_all(root);
 }
 

@@ -251,7 +251,15 @@ TEST_F(BadRobomimic, NotHdf5AndAnotherEnvironment) {
   const fs::path text = scratch("text.hdf5");
   std::ofstream(text) << "not hdf5\n";
   EXPECT_THAT(test::error_of([&] { import_robomimic(text); }), HasSubstr("text.hdf5: not an HDF5 file"));
-  EXPECT_THAT(test::error_of([&] { import_robomimic(scratch("absent.hdf5")); }), HasSubstr("absent.hdf5: does not exist"));
+  const fs::path absent = scratch("absent.hdf5"), folder = scratch("folder.hdf5");
+  EXPECT_EQ(test::error_of([&] { import_robomimic(absent); }), absent.string() + ": cannot open for reading: No such file or directory");
+  fs::create_directories(folder);
+  EXPECT_EQ(test::error_of([&] { import_robomimic(folder); }), folder.string() + ": read failed: Is a directory");
+  fs::permissions(text, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return test::error_of([&] { import_robomimic(text); }); });
+  if (denied) {
+    EXPECT_EQ(*denied, text.string() + ": cannot open for reading: Permission denied") << "not \"not an HDF5 file\"";
+  }
   EXPECT_THAT(import_error("lift", [](hid_t f) {
                 const hid_t g = H5Gopen2(f, "data", H5P_DEFAULT);
                 H5Adelete(g, "env_args");
@@ -290,6 +298,18 @@ TEST(BadMinari, MissingAndWrongFieldsAreNamed) {
   };
   EXPECT_THAT(edited("m_no_meta", [](const fs::path& d) { fs::remove(d / "data" / "metadata.json"); }),
               HasSubstr("data/metadata.json: missing; not a Minari dataset"));
+  EXPECT_EQ(edited("m_meta_folder",
+                   [](const fs::path& d) {
+                     fs::remove(d / "data" / "metadata.json");
+                     fs::create_directory(d / "data" / "metadata.json");
+                   }),
+            (scratch("m_meta_folder") / "data" / "metadata.json").string() + ": read failed: Is a directory");
+  EXPECT_EQ(edited("m_main_folder",
+                   [](const fs::path& d) {
+                     fs::remove(d / "data" / "main_data.hdf5");
+                     fs::create_directory(d / "data" / "main_data.hdf5");
+                   }),
+            (scratch("m_main_folder") / "data" / "main_data.hdf5").string() + ": read failed: Is a directory");
   EXPECT_THAT(edited("m_no_obs", h5edit([](hid_t f) { H5Ldelete(f, "episode_2/observations", H5P_DEFAULT); })),
               HasSubstr("main_data.hdf5: episode_2/observations: missing"));
   EXPECT_THAT(edited("m_short_obs", h5edit([](hid_t f) { replace_f64(f, "episode_0/observations", {4, 24}, 0.0); })),

@@ -46,10 +46,13 @@ def test_bad_world_dict_field():
 
 
 def test_missing_files(tmp_path):
-    with pytest.raises(FileNotFoundError, match="cannot open model file"):
+    with pytest.raises(FileNotFoundError, match="missing.dsm: cannot open for reading: No such file or directory"):
         dicestack.load_model(tmp_path / "missing.dsm")
-    with pytest.raises(FileNotFoundError, match="cannot open world config"):
+    with pytest.raises(FileNotFoundError, match="missing.json: cannot open for reading: No such file or directory"):
         dicestack.DiceStackEnv(world=tmp_path / "missing.json")
+    (tmp_path / "folder.dsm").mkdir()
+    with pytest.raises(ValueError, match="folder.dsm: read failed: Is a directory"):
+        dicestack.load_model(tmp_path / "folder.dsm")
 
 
 def test_damaged_model_file(tmp_path):

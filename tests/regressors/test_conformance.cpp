@@ -254,7 +254,17 @@ TEST(ModelFile, TruncatedCorruptedOrForeignFilesAreRejected) {
   unknown.replace(unknown.find("\"regressor\":\"knn\""), 17, "\"regressor\":\"zzz\"");
   rewrite(unknown);
   EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("the header's checksum does not match"));
-  EXPECT_THAT(test::error_of([&] { load_model("/nonexistent/model.dsm"); }), HasSubstr("cannot open model file"));
+  EXPECT_EQ(test::error_of([&] { load_model("/nonexistent/model.dsm"); }),
+            "/nonexistent/model.dsm: cannot open for reading: No such file or directory");
+  rewrite(bytes);
+  fs::permissions(path, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return test::error_of([&] { load_model(path); }); });
+  if (denied) {
+    EXPECT_EQ(*denied, path.string() + ": cannot open for reading: Permission denied");
+  }
+  fs::remove(path);
+  fs::create_directory(path);
+  EXPECT_EQ(test::error_of([&] { load_model(path); }), path.string() + ": read failed: Is a directory");
   fs::remove(path);
 }
 

@@ -307,8 +307,12 @@ TEST(ModelFile, PickledRegressorsKeepTheirPickleBesideTheModel) {
   // ... nor replaced: it is no longer the one the model file names.
   EXPECT_THAT(test::error_of([&] { save_model(m, path); }), HasSubstr("refusing to replace it"));
   fs::remove(pkl);
+  EXPECT_EQ(test::error_of([&] { load_model(path, RegressorRegistry::global(), mean_loader(&calls)); }),
+            pkl.string() + ": cannot open for reading: No such file or directory (the pickle of the model " + path.string() + ")");
+  fs::create_directory(pkl);
   EXPECT_THAT(test::error_of([&] { load_model(path, RegressorRegistry::global(), mean_loader(&calls)); }),
-              HasSubstr("cannot open the pickle"));
+              HasSubstr(pkl.string() + ": read failed: Is a directory (the pickle of the model"));
+  fs::remove(pkl);
   fs::remove(path);
 }
 

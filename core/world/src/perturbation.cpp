@@ -8,6 +8,7 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/core/rng.hpp>
 
 namespace dicestack {
@@ -209,13 +210,10 @@ Perturbation load_perturbation(const std::string& level_or_file, const WorldConf
   for (const auto& level : perturbation_levels())
     if (level_or_file == level) return perturbation_level(level);
   const std::filesystem::path path(level_or_file);
-  if (!std::filesystem::is_regular_file(path))
+  std::error_code ec;
+  if (std::filesystem::status(path, ec).type() == std::filesystem::file_type::not_found)
     throw InputError(level_or_file + ": not a perturbation level (none, easy, medium, hard) nor a file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(level_or_file + ": cannot read");
-  return perturbation_from_json(text.str(), level_or_file, world);
+  return perturbation_from_json(read_file(path), level_or_file, world);
 }
 
 const State& observation_spread() {

@@ -12,6 +12,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 
 namespace dicestack {
 namespace {
@@ -378,11 +379,7 @@ std::string to_json(const WorldConfig& config) {
 std::uint64_t world_hash(const WorldConfig& config) { return fnv1a(fields_json(config).dump(2) + "\n"); }
 
 WorldConfig load_world_config(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open world config");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return world_config_from_json(text.str(), path.string());
+  return world_config_from_json(read_file(path), path.string());
 }
 
 void save_world_config(const WorldConfig& config, const std::filesystem::path& path) {

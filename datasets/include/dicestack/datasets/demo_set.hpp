@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -82,7 +83,8 @@ DemoMeta parse_demo_meta(std::string_view text, const std::filesystem::path& whe
 /// True when `dir` is a demonstration set dicestack wrote, so one of our writers may replace or
 /// remove it: meta.json parses with "format": "dicestack-demos" and every entry is meta.json, an
 /// episode CSV it lists, a sidecar JSON with "format": "dicestack-baseline", or one of our
-/// scratch files. Otherwise false, with the reason in `why` ("it holds notes.txt").
+/// scratch files; or (what rrt wrote when it found no path, before) it has no meta.json and holds
+/// only such sidecars. Otherwise false, with the reason in `why` ("it holds notes.txt").
 bool is_own_demo_set(const std::filesystem::path& dir, std::string* why = nullptr);
 
 /// Throws InputError unless `dir` is missing, an empty folder, or is_own_demo_set: "DIR: exists and
@@ -94,6 +96,12 @@ void check_demo_set_replaceable(const std::filesystem::path& dir);
 /// never leaves half a set. Dead runs' scratch folders of `dir` are removed first (a live run's
 /// never). Throws InputError.
 void write_demo_set(const DemoSet& set, const std::filesystem::path& dir);
+
+/// write_demo_set with sidecar files (file name -> bytes: a baseline's summary JSON with
+/// kBaselineFormat, which is_own_demo_set accepts beside a set) written into the temporary folder
+/// too, so the set and its sidecars replace `dir` together: a kill never leaves a new set beside
+/// an old summary, or none. A name must be a plain file name, not meta.json nor a .csv. Throws InputError.
+void write_demo_set(const DemoSet& set, const std::filesystem::path& dir, const std::map<std::string, std::string>& sidecars);
 
 /// Receives the episodes of write_demo_set_streaming, in order.
 using EpisodeSink = std::function<void(const Episode&)>;

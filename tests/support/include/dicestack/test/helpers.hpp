@@ -1,11 +1,13 @@
 #pragma once
 // Small helpers shared by the test suites of every folder: target dicestack_test_support
 // (tests/CMakeLists.txt), which every suite links.
+#include <grp.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +61,36 @@ std::string error_of(F&& f) {
     return e.what();
   }
   return {};
+}
+
+/// What `f` returns (a string) when run without the right to read others' files: here when this
+/// process is not root, else in a child that drops to user and group nobody (65534) first, since
+/// root reads a file whatever its mode. Nothing when the child cannot drop them (the caller skips).
+template <class F>
+std::optional<std::string> unprivileged(F&& f) {
+  if (geteuid() != 0) return f();
+  int fds[2];
+  if (pipe(fds) != 0) return std::nullopt;
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    if (setgroups(0, nullptr) != 0 || setgid(65534) != 0 || setuid(65534) != 0) _exit(3);
+    const std::string text = f();
+    for (std::size_t at = 0; at < text.size();) {
+      const ssize_t n = write(fds[1], text.data() + at, text.size() - at);
+      if (n <= 0) _exit(4);
+      at += static_cast<std::size_t>(n);
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  if (child < 0 || waitpid(child, &status, 0) != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return std::nullopt;
+  return text;
 }
 
 /// The pid of a child that has exited and been reaped: a process that no longer runs.
