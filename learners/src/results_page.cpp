@@ -18,7 +18,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using page::check_marked_folder;
 using page::is_marked_folder;
-using page::script_safe;
 using page::write_marker;
 
 namespace {
@@ -81,17 +80,9 @@ std::string preview_file(std::size_t index, std::size_t rows, const char* kind) 
   return "previews/" + row_name(index, rows) + "-" + kind + ".gif";
 }
 
-// The page's script: builds the facts and the table from the inlined data (as text nodes), and
-// sorts by the column whose header is clicked (again: the other way).
-constexpr const char* kScript = R"JS(
-"use strict";
-const data = JSON.parse(document.getElementById("page-data").textContent);
-const pct = (v) => Math.round(100 * v) + "%";
-const fixed = (digits) => (v) => (v < 0 ? "-" : v.toFixed(digits));
-const rate = (key) => ({
-  value: (r) => r[key + "_rate"],
-  text: (r) => pct(r[key + "_rate"]) + " [" + pct(r[key + "_ci95"][0]).slice(0, -1) + "-" + pct(r[key + "_ci95"][1]).slice(0, -1) + "]",
-});
+// The leaderboard's columns and its extra cells (previews, per-episode results); the table
+// itself is the shared one (kTableScript).
+constexpr const char* kLeaderboardScript = R"JS(
 const columns = [
   { key: "rank", label: "#", value: (r) => r.rank, text: (r) => String(r.rank) },
   { key: "regressor", label: "regressor" },
@@ -107,6 +98,42 @@ const columns = [
   { key: "fit_s", label: "fit s", value: (r) => r.fit_s, text: (r) => fixed(2)(r.fit_s) },
   { key: "us_per_step", label: "us/step", value: (r) => r.us_per_step, text: (r) => fixed(1)(r.us_per_step) },
 ];
+function preview(row, kind) {
+  const p = row.previews && row.previews[kind];
+  if (!p) return el("span", { class: "none" }, "no " + (kind === "success" ? "success" : "failure"));
+  const img = el("img", { src: p.src, loading: "lazy", width: data.preview.width, height: data.preview.height,
+                          alt: kind + ": training seed " + p.training_seed + ", start seed " + p.seed, class: "preview " + kind });
+  return el("figure", {}, img, el("figcaption", {}, kind + ", rollout " + p.index + " (seed " + p.training_seed + ")"));
+}
+sortableTable(columns, {
+  heads: ["previews", "results"],
+  cells: (r) => {
+    const media = el("div", { class: "media" });
+    if (r.has_rollouts) media.append(preview(r, "success"), preview(r, "failure"));
+    const link = el("td", {});
+    if (r.eval_info) link.append(el("a", { href: r.eval_info }, "per episode"));
+    return [el("td", {}, media), link];
+  },
+});
+)JS";
+
+}  // namespace
+
+namespace page {
+namespace {
+
+// The script every table page shares: reads the inlined data, shows the title, header and facts
+// (as text nodes), and sortableTable() builds the table from data.rows and sorts it by the
+// column whose header is clicked (again: the other way).
+constexpr const char* kTableScript = R"JS(
+"use strict";
+const data = JSON.parse(document.getElementById("page-data").textContent);
+const pct = (v) => Math.round(100 * v) + "%";
+const fixed = (digits) => (v) => (v < 0 ? "-" : v.toFixed(digits));
+const rate = (key) => ({
+  value: (r) => r[key + "_rate"],
+  text: (r) => pct(r[key + "_rate"]) + " [" + pct(r[key + "_ci95"][0]).slice(0, -1) + "-" + pct(r[key + "_ci95"][1]).slice(0, -1) + "]",
+});
 function el(tag, attrs, ...children) {
   const e = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
@@ -118,59 +145,52 @@ document.getElementById("title").textContent = data.title;
 document.getElementById("header").textContent = data.header;
 const facts = document.getElementById("facts");
 for (const [k, v] of data.facts) facts.append(el("dt", {}, k), el("dd", {}, typeof v === "string" ? v : JSON.stringify(v)));
-const head = document.querySelector("#board thead tr");
-const body = document.querySelector("#board tbody");
-function preview(row, kind) {
-  const p = row.previews && row.previews[kind];
-  if (!p) return el("span", { class: "none" }, "no " + (kind === "success" ? "success" : "failure"));
-  const img = el("img", { src: p.src, loading: "lazy", width: data.preview.width, height: data.preview.height,
-                          alt: kind + ": training seed " + p.training_seed + ", start seed " + p.seed, class: "preview " + kind });
-  return el("figure", {}, img, el("figcaption", {}, kind + ", rollout " + p.index + " (seed " + p.training_seed + ")"));
-}
-function render(rows) {
-  body.replaceChildren();
-  for (const r of rows) {
-    const tr = el("tr", { "data-rank": r.rank });
-    for (const c of columns) {
-      const td = el("td", { "data-key": c.key }, c.text ? c.text(r) : r[c.key]);
-      if (c.value) { td.dataset.value = c.value(r); td.className = "num"; }
-      tr.append(td);
+// columns: {key, label, value(row), text(row), className}: value (a number, kept in data-value)
+// sorts, text shows (default: the row's field), className styles valued cells (default "num");
+// extra: {heads: [labels], cells: (row) => [td, ...]}, after the columns.
+function sortableTable(columns, extra) {
+  const head = document.querySelector("#board thead tr");
+  const body = document.querySelector("#board tbody");
+  function render(rows) {
+    body.replaceChildren();
+    for (const r of rows) {
+      const tr = el("tr", { "data-rank": r.rank });
+      for (const c of columns) {
+        const td = el("td", { "data-key": c.key }, c.text ? c.text(r) : r[c.key]);
+        if (c.value) { td.dataset.value = c.value(r); td.className = c.className || "num"; }
+        tr.append(td);
+      }
+      tr.append(...extra.cells(r));
+      body.append(tr);
     }
-    const media = el("div", { class: "media" });
-    if (r.has_rollouts) media.append(preview(r, "success"), preview(r, "failure"));
-    tr.append(el("td", {}, media));
-    const link = el("td", {});
-    if (r.eval_info) link.append(el("a", { href: r.eval_info }, "per episode"));
-    tr.append(link);
-    body.append(tr);
   }
-}
-let sorted = { key: null, dir: 1 };
-for (const c of columns) {
-  const th = el("th", { scope: "col", "data-key": c.key, "aria-sort": "none" }, el("button", { type: "button" }, c.label));
-  th.querySelector("button").addEventListener("click", () => {
-    sorted = { key: c.key, dir: sorted.key === c.key ? -sorted.dir : 1 };
-    for (const h of head.children) h.setAttribute("aria-sort", "none");
-    th.setAttribute("aria-sort", sorted.dir > 0 ? "ascending" : "descending");
-    const value = c.value || ((r) => r[c.key]);
-    const rows = data.rows.slice().sort((a, b) => {
-      const x = value(a), y = value(b);
-      const missing = (v) => typeof v === "number" && v < 0;  // "-": always last
-      if (missing(x) !== missing(y)) return missing(x) ? 1 : -1;
-      const order = typeof x === "number" ? x - y : String(x).localeCompare(String(y));
-      return order !== 0 ? sorted.dir * order : a.rank - b.rank;
+  let sorted = { key: null, dir: 1 };
+  for (const c of columns) {
+    const th = el("th", { scope: "col", "data-key": c.key, "aria-sort": "none" }, el("button", { type: "button" }, c.label));
+    th.querySelector("button").addEventListener("click", () => {
+      sorted = { key: c.key, dir: sorted.key === c.key ? -sorted.dir : 1 };
+      for (const h of head.children) h.setAttribute("aria-sort", "none");
+      th.setAttribute("aria-sort", sorted.dir > 0 ? "ascending" : "descending");
+      const value = c.value || ((r) => r[c.key]);
+      const rows = data.rows.slice().sort((a, b) => {
+        const x = value(a), y = value(b);
+        const missing = (v) => typeof v === "number" && v < 0;  // "-": always last
+        if (missing(x) !== missing(y)) return missing(x) ? 1 : -1;
+        const order = typeof x === "number" ? x - y : String(x).localeCompare(String(y));
+        return order !== 0 ? sorted.dir * order : a.rank - b.rank;
+      });
+      render(rows);
     });
-    render(rows);
-  });
-  head.append(th);
+    head.append(th);
+  }
+  for (const label of extra.heads) head.append(el("th", { scope: "col" }, label));
+  render(data.rows);
+  document.body.dataset.readyAt = String(performance.now());
+  document.body.dataset.ready = "true";
 }
-head.append(el("th", { scope: "col" }, "previews"), el("th", { scope: "col" }, "results"));
-render(data.rows);
-document.body.dataset.readyAt = String(performance.now());
-document.body.dataset.ready = "true";
 )JS";
 
-constexpr const char* kStyle = R"CSS(
+constexpr const char* kTableStyle = R"CSS(
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; color: #222; }
 h1 { font-size: 1.4em; margin: 0 0 .3em; }
 #header { color: #555; font-size: .9em; max-width: 80em; }
@@ -192,7 +212,24 @@ img.success { outline: 2px solid #2a8; } img.failure { outline: 2px solid #c44; 
 
 }  // namespace
 
-namespace page {
+std::string table_page_html(const std::string& data_json, const char* script) {
+  std::string html;
+  html += "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  html += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
+  html += "<meta name=\"generator\" content=\"dicestack " DICESTACK_VERSION "\">\n";
+  html += "<title>dicestack results</title>\n<style>";
+  html += kTableStyle;
+  html += "</style>\n</head>\n<body>\n<h1 id=\"title\"></h1>\n<p id=\"header\"></p>\n<dl id=\"facts\"></dl>\n";
+  html += "<table id=\"board\"><thead><tr></tr></thead><tbody></tbody></table>\n";
+  html += "<noscript>This page builds its table with JavaScript; the same rows are in the JSON below.</noscript>\n";
+  html += "<script type=\"application/json\" id=\"page-data\">";
+  html += script_safe(data_json);
+  html += "</script>\n<script>";
+  html += kTableScript;
+  html += script;
+  html += "</script>\n</body>\n</html>\n";
+  return html;
+}
 
 // JSON that may sit inside <script>: no "<", ">" or "&" (only strings can hold them; \u escapes
 // read back the same).
@@ -332,21 +369,7 @@ std::string results_page_html(const Leaderboard& board, const std::string& media
                   {"facts", facts},
                   {"preview", {{"width", kPreviewWidth}, {"height", static_cast<int>(std::lround(kPreviewWidth * aspect))}}},
                   {"rows", rows}};
-  std::string page;
-  page += "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  page += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
-  page += "<meta name=\"generator\" content=\"dicestack " DICESTACK_VERSION "\">\n";
-  page += "<title>dicestack results</title>\n<style>";
-  page += kStyle;
-  page += "</style>\n</head>\n<body>\n<h1 id=\"title\"></h1>\n<p id=\"header\"></p>\n<dl id=\"facts\"></dl>\n";
-  page += "<table id=\"board\"><thead><tr></tr></thead><tbody></tbody></table>\n";
-  page += "<noscript>This page builds its table with JavaScript; the same rows are in the JSON below.</noscript>\n";
-  page += "<script type=\"application/json\" id=\"page-data\">";
-  page += script_safe(data.dump());
-  page += "</script>\n<script>";
-  page += kScript;
-  page += "</script>\n</body>\n</html>\n";
-  return page;
+  return page::table_page_html(data.dump(), kLeaderboardScript);
 }
 
 void check_page_media_replaceable(const fs::path& folder) {
