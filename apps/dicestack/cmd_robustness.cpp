@@ -3,6 +3,8 @@
 // (learners/robustness.hpp): this parses, calls it and prints.
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/demo_set.hpp>
@@ -33,7 +35,10 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
   if (!opt.out.empty() && cluster.is_root()) check_robustness_out(opt.out, opt.format);  // before any work
   PolicyFactory factory;
-  std::string subject;
+  RobustnessRun run;
+  run.world = opt.world.path.empty() ? "default" : opt.world.path.string();
+  run.episodes = opt.episodes;
+  run.seed = opt.seed;
   RobustnessRequest request;
   request.episodes = opt.episodes;
   request.seed = opt.seed;
@@ -41,7 +46,8 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
-    subject = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
+    run.policy = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
+    run.record = model->record;
   } else {
     ExpertConfig config;
     if (opt.expert == "tracker") {
@@ -51,25 +57,33 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     }
     make_expert(opt.expert, config);  // an unknown name fails here, before any row
     factory = [name = opt.expert, config] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config)); };
-    subject = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")");
+    run.policy = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")");
     request.reads_world = true;
   }
+  run.reads_world = request.reads_world;
   if (cluster.is_root())
     request.progress = [&](int row, int rows, const std::string& factor, const std::string& level) {
       std::cerr << "[" << row + 1 << "/" << rows << "] " << factor << " " << level << '\n' << std::flush;
     };
-  const auto rows = robustness(factory, world, request, cluster);
+  const RobustnessTable table = robustness_table(robustness(factory, world, request, cluster), run);
   if (!cluster.is_root()) return;
-  const std::string header = "dicestack robustness: " + subject + "; " + std::to_string(opt.episodes) +
-                             " rollouts per row from evaluation starts (seed " + std::to_string(opt.seed) +
-                             "); rates with 95% Wilson intervals (successes)" +
-                             (request.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "");
-  const std::string table = render_robustness(rows, opt.format, header);
-  std::cout << table << std::flush;
+  const RobustnessFormat& format = robustness_format(opt.format);
+  // A page is for the file; the terminal gets its Markdown (as the leaderboard's html does).
+  const bool echo = !opt.out.empty() && !format.echo.empty();
+  std::cout << render_robustness(table, echo ? format.echo : format.name) << std::flush;
   if (!opt.out.empty()) {
-    write_robustness(rows, opt.format, header, opt.out);
+    write_robustness(table, opt.format, opt.out);
     std::cout << "wrote " << opt.out.string() << '\n' << std::flush;
   }
+}
+
+std::vector<std::string> robustness_format_names(std::string* help) {
+  std::vector<std::string> names;
+  for (const RobustnessFormat& f : robustness_formats()) {
+    names.push_back(f.name);
+    *help += (help->empty() ? "" : "; ") + f.name + ": " + f.description;
+  }
+  return names;
 }
 
 }  // namespace
@@ -84,10 +98,12 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts and the draws")->check(seed_check())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
-  cmd->add_option("--format", opt->format, "md, csv or json")
-      ->check(CLI::IsMember({"md", "csv", "json"}))
-      ->capture_default_str();
-  cmd->add_option("--out", opt->out, "Also write the table to this file (atomically; only a table of ours is replaced)");
+  std::string formats_help;
+  const std::vector<std::string> formats = robustness_format_names(&formats_help);
+  cmd->add_option("--format", opt->format, formats_help)->check(CLI::IsMember(formats))->capture_default_str();
+  cmd->add_option("--out", opt->out,
+                  "Also write the table to this file (atomically; only a table of ours, or for html a page of ours, is "
+                  "replaced)");
   cmd->callback([opt, &cluster] { run_robustness(*opt, cluster); });
 }
 

@@ -7,6 +7,10 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/learners/results_page.hpp>
+#include <dicestack/version.hpp>
+
+#include "page_files.hpp"
 
 namespace dicestack {
 namespace {
@@ -15,12 +19,6 @@ constexpr const char* kMarker = "<!-- dicestack robustness -->";
 constexpr const char* kCsvHeader =
     "factor,level,realistic_success,realistic_success_low,realistic_success_high,wall_contact,dice_in_cup_mean,episodes";
 constexpr const char* kJsonFormat = "dicestack-robustness";
-
-Ownership robustness_ownership(const std::string& format) {
-  if (format == "json") return Ownership::json_object("dicestack robustness table (json)", kJsonFormat);
-  if (format == "csv") return Ownership::first_line("dicestack robustness table (csv)", {kCsvHeader});
-  return Ownership::first_line("dicestack robustness table (md)", {kMarker});
-}
 
 bool sensing(const std::string& factor) { return factor == "observation_noise" || factor == "observation_delay"; }
 
@@ -62,55 +60,150 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
   return rows;
 }
 
-std::string render_robustness(const std::vector<RobustnessRow>& rows, const std::string& format, const std::string& header) {
+RobustnessTable robustness_table(std::vector<RobustnessRow> rows, const RobustnessRun& run) {
+  RobustnessTable t;
+  t.rows = std::move(rows);
+  t.header = "dicestack robustness: " + run.policy + "; " + std::to_string(run.episodes) +
+             " rollouts per row from evaluation starts (seed " + std::to_string(run.seed) +
+             "); rates with 95% Wilson intervals (successes)" +
+             (run.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "");
+  nlohmann::json meta{{"policy", run.policy},
+                      {"world", run.world},
+                      {"rollouts_per_row", run.episodes},
+                      {"seed", run.seed},
+                      {"dicestack_version", DICESTACK_VERSION}};
+  if (run.reads_world) meta["sensing_factors"] = "left out (an expert reads the world itself)";
+  if (!run.record.empty()) meta["model_record"] = run.record;
+  t.meta_json = meta.dump();
+  return t;
+}
+
+namespace {
+
+nlohmann::json rate_triple(const Rate& r) { return {r.value, r.low, r.high}; }
+
+nlohmann::json robustness_row_json(const RobustnessRow& r) {
+  return {{"factor", r.factor},
+          {"level", r.level},
+          {"episodes", r.stats.episodes},
+          {"realistic_success_rate", r.stats.realistic_success.value},
+          {"realistic_success_rate_ci95", rate_triple(r.stats.realistic_success)},
+          {"wall_contact_rate", r.stats.wall_contact.value},
+          {"wall_contact_rate_ci95", rate_triple(r.stats.wall_contact)},
+          {"dice_in_cup_mean", r.stats.dice_in_cup_mean}};
+}
+
+std::string robustness_md(const RobustnessTable& t) {
   std::ostringstream out;
-  if (format == "md") {
-    out << kMarker << '\n' << header << "\n\n| factor | level | realistic success | wall contact | dice in cup | episodes |\n"
-        << "|---|---|---:|---:|---:|---:|\n";
-    for (const auto& r : rows) {
-      char cup[32];
-      std::snprintf(cup, sizeof cup, "%.2f", r.stats.dice_in_cup_mean);
-      out << "| " << r.factor << " | " << r.level << " | " << percent(r.stats.realistic_success, r.stats.episodes)
-          << " | " << percent(r.stats.wall_contact, r.stats.episodes) << " | " << cup << " | " << r.stats.episodes
-          << " |\n";
-    }
-  } else if (format == "csv") {
-    out << kCsvHeader << '\n';
-    for (const auto& r : rows) {
-      const Rate& s = r.stats.realistic_success;
-      out << r.factor << ',' << r.level << ',' << s.value << ',' << s.low << ',' << s.high << ','
-          << r.stats.wall_contact.value << ',' << r.stats.dice_in_cup_mean << ',' << r.stats.episodes << '\n';
-    }
-  } else if (format == "json") {
-    nlohmann::json j{{"format", kJsonFormat}, {"version", 1}, {"header", header}, {"rows", nlohmann::json::array()}};
-    for (const auto& r : rows) {
-      const Rate& s = r.stats.realistic_success;
-      j["rows"].push_back({{"factor", r.factor},
-                           {"level", r.level},
-                           {"episodes", r.stats.episodes},
-                           {"realistic_success_rate", s.value},
-                           {"realistic_success_rate_ci95", {s.value, s.low, s.high}},
-                           {"wall_contact_rate", r.stats.wall_contact.value},
-                           {"dice_in_cup_mean", r.stats.dice_in_cup_mean}});
-    }
-    out << j.dump(2) << '\n';
-  } else {
-    throw ConfigError("robustness: format \"" + format + "\" is not one of md, csv, json");
+  out << kMarker << '\n' << t.header << "\n\n| factor | level | realistic success | wall contact | dice in cup | episodes |\n"
+      << "|---|---|---:|---:|---:|---:|\n";
+  for (const auto& r : t.rows) {
+    char cup[32];
+    std::snprintf(cup, sizeof cup, "%.2f", r.stats.dice_in_cup_mean);
+    out << "| " << r.factor << " | " << r.level << " | " << percent(r.stats.realistic_success, r.stats.episodes) << " | "
+        << percent(r.stats.wall_contact, r.stats.episodes) << " | " << cup << " | " << r.stats.episodes << " |\n";
   }
   return out.str();
 }
 
-void check_robustness_out(const std::filesystem::path& out, const std::string& format) {
-  render_robustness({}, format, "");  // an unknown format fails here, before any work
-  check_replaceable(out, robustness_ownership(format));
+std::string robustness_csv(const RobustnessTable& t) {
+  std::ostringstream out;
+  out << kCsvHeader << '\n';
+  for (const auto& r : t.rows) {
+    const Rate& s = r.stats.realistic_success;
+    out << r.factor << ',' << r.level << ',' << s.value << ',' << s.low << ',' << s.high << ','
+        << r.stats.wall_contact.value << ',' << r.stats.dice_in_cup_mean << ',' << r.stats.episodes << '\n';
+  }
+  return out.str();
 }
 
-void write_robustness(const std::vector<RobustnessRow>& rows, const std::string& format, const std::string& header,
-                      const std::filesystem::path& out) {
-  const std::string table = render_robustness(rows, format, header);
-  AtomicFile f(out, robustness_ownership(format));
-  f.stream() << table;
-  f.commit();
+std::string robustness_json(const RobustnessTable& t) {
+  nlohmann::json j = t.meta_json.empty() ? nlohmann::json::object() : nlohmann::json::parse(t.meta_json);
+  j["format"] = kJsonFormat;
+  j["version"] = 1;
+  j["header"] = t.header;
+  j["rows"] = nlohmann::json::array();
+  for (const auto& r : t.rows) j["rows"].push_back(robustness_row_json(r));
+  return j.dump(2) + '\n';
+}
+
+// The page's columns (the table and its sorting are the shared page's, page_files.hpp). Levels
+// sort by severity, not by name.
+constexpr const char* kRobustnessPageScript = R"JS(
+const levels = ["none", "easy", "medium", "hard"];
+sortableTable([
+  { key: "rank", label: "#", value: (r) => r.rank, text: (r) => String(r.rank) },
+  { key: "factor", label: "factor" },
+  { key: "level", label: "level", value: (r) => levels.indexOf(r.level), text: (r) => r.level, className: "level" },
+  Object.assign({ key: "realistic_success_rate", label: "realistic success" }, rate("realistic_success")),
+  { key: "successes", label: "successes", value: (r) => r.successes, text: (r) => r.successes + " of " + r.episodes },
+  Object.assign({ key: "wall_contact_rate", label: "wall contact" }, rate("wall_contact")),
+  { key: "dice_in_cup_mean", label: "dice in cup", value: (r) => r.dice_in_cup_mean, text: (r) => fixed(2)(r.dice_in_cup_mean) },
+  { key: "episodes", label: "rollouts", value: (r) => r.episodes, text: (r) => String(r.episodes) },
+], { heads: [], cells: () => [] });
+)JS";
+
+// The page's data: the json format's settings as facts, and its rows with what the shared
+// table reads (rank, and each rate's interval as [low, high] under KEY_ci95).
+std::string robustness_html(const RobustnessTable& t) {
+  const nlohmann::json meta = t.meta_json.empty() ? nlohmann::json::object() : nlohmann::json::parse(t.meta_json);
+  nlohmann::json facts = nlohmann::json::array();
+  for (auto it = meta.begin(); it != meta.end(); ++it) facts.push_back({it.key(), it.value()});
+  nlohmann::json rows = nlohmann::json::array();
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const RobustnessRow& r = t.rows[i];
+    nlohmann::json row = robustness_row_json(r);
+    row["rank"] = i + 1;
+    row["successes"] = static_cast<int>(r.stats.realistic_success.value * r.stats.episodes + 0.5);
+    row["realistic_success_ci95"] = {r.stats.realistic_success.low, r.stats.realistic_success.high};
+    row["wall_contact_ci95"] = {r.stats.wall_contact.low, r.stats.wall_contact.high};
+    rows.push_back(std::move(row));
+  }
+  std::string title = "dicestack robustness";
+  if (meta.contains("policy")) title += ": " + meta.at("policy").get<std::string>();
+  const nlohmann::json data{{"title", title}, {"header", t.header}, {"facts", facts}, {"rows", rows}};
+  return std::string(kResultsPageMarker) + '\n' + page::table_page_html(data.dump(), kRobustnessPageScript);
+}
+
+}  // namespace
+
+const std::vector<RobustnessFormat>& robustness_formats() {
+  static const std::vector<RobustnessFormat> formats{
+      {"md", ".md", "the header line, then a Markdown table", robustness_md,
+       [] { return Ownership::first_line("dicestack robustness table (md)", {kMarker}); }},
+      {"csv", ".csv", "a row per line, realistic success with its interval", robustness_csv,
+       [] { return Ownership::first_line("dicestack robustness table (csv)", {kCsvHeader}); }},
+      {"json", ".json", "the settings, the header line and a \"rows\" array", robustness_json,
+       [] { return Ownership::json_object("dicestack robustness table (json)", kJsonFormat); }},
+      {"html", ".html", "a page for a browser: the table sortable by any column, the settings (docs/results-pages.md)",
+       robustness_html, [] { return results_page_ownership(); }, "md"},
+  };
+  return formats;
+}
+
+const RobustnessFormat& robustness_format(const std::string& name) {
+  std::string names;
+  for (const RobustnessFormat& f : robustness_formats()) {
+    if (f.name == name) return f;
+    names += (names.empty() ? "" : ", ") + f.name;
+  }
+  throw ConfigError("robustness: format \"" + name + "\" is not one of " + names);
+}
+
+std::string render_robustness(const RobustnessTable& table, const std::string& format) {
+  return robustness_format(format).render(table);
+}
+
+void check_robustness_out(const std::filesystem::path& out, const std::string& format) {
+  check_replaceable(out, robustness_format(format).ownership());  // an unknown format fails first
+}
+
+void write_robustness(const RobustnessTable& table, const std::string& format, const std::filesystem::path& out) {
+  const RobustnessFormat& f = robustness_format(format);
+  const std::string text = f.render(table);
+  AtomicFile file(out, f.ownership());
+  file.stream() << text;
+  file.commit();
 }
 
 }  // namespace dicestack

@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -160,13 +164,51 @@ TEST(Robustness, RendersTheLeaderboardsFormats) {
   RobustnessRow row{"friction", "hard", {}};
   row.stats.episodes = 10;
   row.stats.realistic_success = wilson(7, 10);
-  const std::vector<RobustnessRow> rows{row};
-  EXPECT_THAT(render_robustness(rows, "md", "head"), HasSubstr("| friction | hard | 70% ["));
-  EXPECT_THAT(render_robustness(rows, "csv", ""), HasSubstr("\nfriction,hard,0.7,"));
-  const auto j = nlohmann::json::parse(render_robustness(rows, "json", "head"));
+  RobustnessRun run;
+  run.policy = "model m.dsm (knn, state)";
+  run.episodes = 10;
+  run.seed = 3;
+  const RobustnessTable table = robustness_table({row}, run);
+  EXPECT_THAT(table.header, HasSubstr("dicestack robustness: model m.dsm (knn, state); 10 rollouts per row"));
+  EXPECT_THAT(render_robustness(table, "md"), HasSubstr("| friction | hard | 70% ["));
+  EXPECT_THAT(render_robustness(table, "csv"), HasSubstr("\nfriction,hard,0.7,"));
+  const auto j = nlohmann::json::parse(render_robustness(table, "json"));
   EXPECT_EQ(j["format"], "dicestack-robustness");
   EXPECT_EQ(j["rows"][0]["realistic_success_rate"], 0.7);
-  EXPECT_THAT(test::error_of([&] { render_robustness(rows, "html", ""); }), HasSubstr("md, csv, json"));
+  EXPECT_EQ(j["header"], table.header);
+  EXPECT_EQ(j["policy"], "model m.dsm (knn, state)");
+  EXPECT_EQ(j["world"], "default");
+  EXPECT_EQ(j["seed"], 3);
+  EXPECT_FALSE(j.contains("sensing_factors")) << "a model reads the observations";
+  EXPECT_THAT(render_robustness(table, "html"), HasSubstr("<!doctype html>"));
+  EXPECT_THAT(test::error_of([&] { render_robustness(table, "pdf"); }), HasSubstr("md, csv, json, html"));
+}
+
+TEST(Robustness, EachFormatHasOneEntryAndReplacesOnlyItsOwnFiles) {
+  const auto dir = test::scratch_path("dicestack_robustness_formats");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  RobustnessRow row{"none", "none", {}};
+  row.stats.episodes = 2;
+  const RobustnessTable table = robustness_table({row}, {});
+  std::set<std::string> names, suffixes;
+  for (const RobustnessFormat& f : robustness_formats()) {
+    EXPECT_TRUE(names.insert(f.name).second) << f.name;
+    EXPECT_TRUE(suffixes.insert(f.suffix).second) << f.name;
+    const auto out = dir / ("table" + f.suffix);
+    write_robustness(table, f.name, out);
+    EXPECT_TRUE(f.ownership().recognises(out)) << f.name;
+    check_robustness_out(out, f.name);  // ours: may be replaced
+    std::ofstream(out) << "my notes\n";
+    EXPECT_THROW(check_robustness_out(out, f.name), InputError) << f.name;
+    EXPECT_THROW(write_robustness(table, f.name, out), InputError) << f.name;
+    std::ifstream in(out);
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "my notes") << f.name;
+  }
+  EXPECT_EQ(names, (std::set<std::string>{"md", "csv", "json", "html"}));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

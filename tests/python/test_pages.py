@@ -1,9 +1,11 @@
 """Results pages (issue 26) loaded in headless Chromium as a person would open them, from
 file:// with no network: the rows shown are the rows of the JSON, sorting works, a preview
-loads, text from the demonstrations shows as text, and the console has no errors.
+loads, text from the demonstrations and models shows as text, and the console has no errors.
+Pages: the leaderboard's, evaluate --report's, the episode viewer and the robustness table's.
 
 With DICESTACK_SCREENSHOTS=DIR set, each page's screenshot is saved there (docs/images/)."""
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -12,6 +14,7 @@ import time
 import pytest
 
 import dicestack
+from conftest import short_world
 
 webdriver = pytest.importorskip("selenium.webdriver")
 from selenium.webdriver.common.by import By  # noqa: E402
@@ -264,3 +267,85 @@ def test_the_episode_viewer_lists_the_set_and_its_cursor_follows_the_playback(br
     browser.find_elements(By.CSS_SELECTOR, "#list tbody tr")[1].click()
     WebDriverWait(browser, 10).until(lambda d: "is missing" in d.find_element(By.ID, "name").text)
     browser.get_log("browser")  # the failed load is reported there, as it should be
+
+
+def rate_text(rate, low, high):
+    """What the page shows for a rate and its interval (JavaScript's Math.round)."""
+    pc = lambda v: math.floor(100 * v + 0.5)  # noqa: E731
+    return f"{pc(rate)}% [{pc(low)}-{pc(high)}]"
+
+
+@pytest.mark.skipif(not os.environ.get("DICESTACK_EXE"), reason="the command line is not built")
+def test_the_robustness_page_shows_the_json_rows_and_sorts(browser, tmp_path):
+    exe = os.environ["DICESTACK_EXE"]
+    # The scripted expert in the paper's world, 2 rollouts per row: a few seconds, rates that differ.
+    args = [exe, "robustness", "--expert", "scripted", "--episodes", "2", "--seed", "1"]
+    table = json.loads(subprocess.run(args + ["--format", "json"], check=True, capture_output=True, text=True).stdout)
+    page = tmp_path / "robust.html"
+    done = subprocess.run(args + ["--format", "html", "--out", str(page)], check=True, capture_output=True, text=True)
+    assert done.stdout.startswith("<!-- dicestack robustness -->")  # the terminal gets the Markdown
+    assert page.read_text().startswith("<!-- dicestack results page -->\n<!doctype html>")
+    assert list(tmp_path.iterdir()) == [page]  # one file: data, style and script inside
+    open_page(browser, page)
+    rows = table["rows"]
+    shown = shown_rows(browser)
+    assert len(shown) == len(rows) == 1 + 3 * 7 + 3  # nominal, the 7 factors an expert meets, all
+    for s, r in zip(shown, rows):
+        assert s["factor"][0] == r["factor"] and s["level"][0] == r["level"]
+        for key in ("realistic_success_rate", "wall_contact_rate", "dice_in_cup_mean", "episodes"):
+            assert s[key][1] == pytest.approx(r[key], rel=1e-12, abs=1e-12), key
+        assert s["realistic_success_rate"][0] == rate_text(*r["realistic_success_rate_ci95"])
+        assert s["wall_contact_rate"][0] == rate_text(*r["wall_contact_rate_ci95"])
+        assert s["successes"][0] == f"{round(r['realistic_success_rate'] * r['episodes'])} of {r['episodes']}"
+    facts = browser.find_element(By.ID, "facts").text
+    for text in ("expert scripted", "rollouts_per_row", "default", table["dicestack_version"], "sensing_factors"):
+        assert text in facts
+    assert browser.find_element(By.ID, "title").text == "dicestack robustness: expert scripted"
+    # Sorting: by realistic success up, then down; by level in order of severity; # restores.
+    header = browser.find_element(By.CSS_SELECTOR, "th[data-key='realistic_success_rate'] button")
+    header.click()
+    values = [s["realistic_success_rate"][1] for s in shown_rows(browser)]
+    assert values == sorted(values) and len(set(values)) > 1
+    header.click()
+    assert [s["realistic_success_rate"][1] for s in shown_rows(browser)] == sorted(values, reverse=True)
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='level'] button").click()
+    levels = [s["level"][0] for s in shown_rows(browser)]
+    assert levels == sorted(levels, key=["none", "easy", "medium", "hard"].index)
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='factor'] button").click()
+    factors = [s["factor"][0] for s in shown_rows(browser)]
+    assert factors == sorted(factors)
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='rank'] button").click()
+    assert [(s["factor"][0], s["level"][0]) for s in shown_rows(browser)] == [(r["factor"], r["level"]) for r in rows]
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='realistic_success_rate'] button").click()
+    browser.find_element(By.CSS_SELECTOR, "th[data-key='realistic_success_rate'] button").click()
+    screenshot(browser, "robustness-page.png")
+    assert no_console_errors(browser) == []
+    # Ours is replaced; a user's page is not.
+    subprocess.run(args + ["--format", "html", "--out", str(page)], check=True, capture_output=True)
+    mine = tmp_path / "mine.html"
+    mine.write_text("<p>my notes</p>")
+    refused = subprocess.run(args + ["--format", "html", "--out", str(mine)], capture_output=True, text=True)
+    assert refused.returncode != 0 and "refusing to replace" in refused.stderr
+    assert mine.read_text() == "<p>my notes</p>"
+
+
+@pytest.mark.skipif(not os.environ.get("DICESTACK_EXE"), reason="the command line is not built")
+def test_text_from_the_model_shows_as_text_on_the_robustness_page(browser, demos, tmp_path):
+    exe = os.environ["DICESTACK_EXE"]
+    folder = tmp_path / "<img src=x onerror=window.pwned=1>"
+    folder.mkdir()
+    model, world = folder / "m.dsm", tmp_path / "short.json"
+    subprocess.run([exe, "train", "--demos", str(demos), "--regressor", "knn", "--split", "none", "--out", str(model)],
+                   check=True, capture_output=True)
+    world.write_text(json.dumps(short_world(20)))
+    page = tmp_path / "robust.html"
+    subprocess.run([exe, "robustness", "--model", str(model), "--world", str(world), "--episodes", "1",
+                    "--format", "html", "--out", str(page)], check=True, capture_output=True)
+    open_page(browser, page)
+    assert len(shown_rows(browser)) == 1 + 3 * 9 + 3
+    facts = browser.find_element(By.ID, "facts").text
+    assert str(model) in facts and str(demos) in facts and str(world) in facts
+    assert str(model) in browser.find_element(By.ID, "title").text
+    assert browser.execute_script("return window.pwned") is None
+    assert len(browser.find_elements(By.CSS_SELECTOR, "img, #facts b")) == 0
+    assert no_console_errors(browser) == []
