@@ -6,7 +6,7 @@ learners and its regressors or Python ones (register_regressor). See docs/python
 """
 from . import _dicestack
 from ._world import default_world
-from .demos import Episode, load_demos, save_demos
+from .demos import Episode, load_demos, save_demos, view_dataset
 from .env import DiceStackEnv
 from .models import Expert, Model, Policy, evaluate, expert, leaderboard, load_model, train
 from .regressors import register_regressor, regressor_names
@@ -33,6 +33,7 @@ __all__ = [
     "regressor_names",
     "save_demos",
     "train",
+    "view_dataset",
 ]
 
 ENV_ID = "dicestack/DiceStack-v0"

@@ -1,6 +1,6 @@
 """Demonstrations: episodes with numpy arrays, read from and written to dicestack's folder format
 (one CSV per episode plus meta.json; docs/datasets.md) by the C++ library, which checks every
-value and never replaces a folder that is not a dicestack set."""
+value and never replaces a folder that is not a dicestack set; and the episode viewer page."""
 import os
 from dataclasses import dataclass
 
@@ -127,3 +127,25 @@ def save_demos(episodes, path, world=None, description="", provenance=""):
         description or "episodes saved from Python",
         provenance or "dicestack.save_demos",
     )
+
+
+def view_dataset(demos, out, *, world=None):
+    """Writes the episode viewer of `dicestack dataset view DEMOS --out OUT`: the page `out` (an
+    .html file) lists the episodes with their outcomes and plays the chosen one beside plots of
+    its states and actions; each episode's numbers go to `<stem>_files/` beside it
+    (docs/results-pages.md). Returns the page's path.
+
+    demos: "builtin", "human", a folder, or a list of dicestack.Episode (shown as
+    "<episodes from Python>", drawn in `world`). `world` is the world the built-in and human sets
+    are made for and the one Episodes are drawn in (None: the paper's); a folder carries its own.
+    An existing page or folder is replaced only if dicestack wrote it: anything else at `out` or
+    `<stem>_files` is refused with ValueError (the command line's message) and left untouched;
+    a missing folder is FileNotFoundError."""
+    if isinstance(demos, (str, os.PathLike)):
+        source = os.fspath(demos)
+    else:
+        source = _records(list(demos))
+    if not isinstance(out, (str, os.PathLike)):
+        raise TypeError(f"out must be a path, got {type(out).__name__}")
+    _dicestack.view_dataset(source, os.fspath(out), resolve_world(world))
+    return os.fspath(out)

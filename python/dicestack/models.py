@@ -93,15 +93,23 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
 
 
 def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None, initial_push="none",
-             perturb=None, progress=None):
+             perturb=None, report=None, progress=None):
     """Rolls `model` out from `episodes` random starts, as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
     given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
     a perturbation file or a dict of its fields; docs/robustness.md). progress: a progress bar on
-    stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt."""
+    stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt.
+
+    report: a folder to write the results page of `dicestack evaluate --report DIR` into:
+    index.html (the row, previews of a successful and a failed rollout), index_files/ (per-episode
+    results as LeRobot's eval_info.json) and dicestack-report.json (docs/results-pages.md). It is
+    written whole, replacing only a report dicestack wrote; anything else there is refused with
+    ValueError before any rollout, and left untouched."""
     if not isinstance(model, Model):
         raise TypeError(f"model must be a dicestack.Model, got {type(model).__name__}")
+    if report is not None and not isinstance(report, (str, os.PathLike)):
+        raise TypeError(f"report must be a folder path, got {type(report).__name__}")
     w = resolve_world(world)
     perturbation = resolve_perturbation(perturb, w)
     return json.loads(
@@ -116,6 +124,7 @@ def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None
             progress_bar(progress),
             perturbation,
             perturbation_name(perturb),
+            os.fspath(report) if report is not None else "",
         )
     )
 

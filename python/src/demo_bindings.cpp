@@ -1,9 +1,11 @@
 // Demonstration sets: read and written by the library (its checks and its ownership rule), seen
-// from Python as dicts of numpy arrays (dicestack.Episode wraps them).
+// from Python as dicts of numpy arrays (dicestack.Episode wraps them), and the episode viewer
+// (`dicestack dataset view`).
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/results_page.hpp>
 #include <dicestack/learners/train.hpp>
 
 #include "bindings.hpp"
@@ -106,6 +108,25 @@ void bind_demos(py::module_& m) {
         write_demo_set(set, path);
       },
       py::arg("path"), py::arg("episodes"), py::arg("world"), py::arg("description"), py::arg("provenance"));
+  m.def(
+      "view_dataset",
+      [](const py::handle& demos, const std::filesystem::path& out, const WorldConfig& world) {
+        DemoSet set;
+        std::string name;
+        if (py::isinstance<py::str>(demos)) {  // as `dicestack dataset view SET --out PAGE`
+          name = demos.cast<std::string>();
+          const std::filesystem::path dir = demo_folder(name, world);
+          set = reading(dir, [&] { return read_demo_set(dir); });
+        } else {
+          name = "<episodes from Python>";
+          set.world = world;
+          set.episodes = episodes_from(demos.cast<py::iterable>());
+        }
+        py::gil_scoped_release nogil;
+        write_dataset_viewer(set, name, out);
+      },
+      py::arg("demos"), py::arg("out"), py::arg("world"),
+      "The episode viewer of `dicestack dataset view`: a name or folder (str), or episode records");
 }
 
 }  // namespace dicestack::python

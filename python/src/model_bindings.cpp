@@ -1,6 +1,6 @@
 // Models (load, predict, save), the policy a model gives (it keeps its episode's history for the
-// feature map), the automatic experts, and train() / evaluate() / leaderboard() as the command
-// line runs them, with a progress bar and Ctrl-C (LongCall).
+// feature map), the automatic experts, and train() / evaluate() (with its report page) /
+// leaderboard() as the command line runs them, with a progress bar and Ctrl-C (LongCall).
 #include <memory>
 #include <optional>
 
@@ -14,6 +14,7 @@
 #include <dicestack/learners/leaderboard.hpp>
 #include <dicestack/learners/policy.hpp>
 #include <dicestack/learners/report.hpp>
+#include <dicestack/learners/results_page.hpp>
 #include <dicestack/learners/train.hpp>
 #include <dicestack/regressors/model.hpp>
 
@@ -160,29 +161,36 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
 
 std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episodes, const py::handle& seed,
                            const py::handle& threads, const std::string& push, const py::handle& demos, py::object bar,
-                           const Perturbation& perturbation, const std::string& perturb) {
+                           const Perturbation& perturbation, const std::string& perturb, const std::filesystem::path& report) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
   const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push,
                           perturbation.nominal() ? "none" : perturb};
   const InitialPush initial_push = initial_push_from(push);
   const int t = threads_from(threads);
+  if (!report.empty()) check_report_replaceable(report);  // before any work, as `evaluate --report`
   std::optional<std::vector<Episode>> demo_episodes;
   if (!demos.is_none()) demo_episodes = demos_from(demos, world, nullptr);
   std::shared_ptr<const Model> model = m.model;
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
+  std::vector<Episode> rollouts;
+  std::vector<EpisodeResult> results;
   EvalRequest request;
   request.episodes = episodes;
   request.seed = run.seed;
   request.threads = t;
   request.push = initial_push;
   request.perturbation = perturbation;
+  request.rollouts = report.empty() ? nullptr : &rollouts;  // the report's previews and per-episode results
+  request.results = report.empty() ? nullptr : &results;
   request.progress = [&](int finished, int of) {
     call.poll(static_cast<double>(finished) / of, "evaluate: " + std::to_string(finished) + "/" + std::to_string(of) + " rollouts");
   };
   const EvalStats stats = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request);
   std::optional<Score> errors;
   if (demo_episodes) errors = score(*model, DemoSplit(*demo_episodes, "episodes"));
+  if (!report.empty())
+    write_report_folder(evaluation_board(run, *model, stats, results, rollouts, world, errors ? &*errors : nullptr), report);
   return evaluation_json(run, *model, stats, errors ? &*errors : nullptr);
 }
 
@@ -284,7 +292,8 @@ void bind_models(py::module_& m) {
         py::arg("bar"));
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
         py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"),
-        py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none");
+        py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none",
+        py::arg("report") = std::filesystem::path());
   m.def(
       "leaderboard_formats",
       [] {
