@@ -4,13 +4,15 @@
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
 //       [--recordings K [--subset-seed S]] [--probes P] [--paths N] [--no-optimise]
 //       [--noise F [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path] [--json]
+//       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
 // --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
 // from each start instead, with and without that noise, and lists them by successes.
 // --rescue N runs the tracker expert with rescue_interval N (closed loop on the dice) instead of
-// the chosen path's follower.
+// the chosen path's follower. --robust K makes robust choices (TrackerConfig::robust_trials);
+// --choices writes each start's dice x, chosen recording, warp and outcome.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -39,6 +41,7 @@ struct Options {
   TrackerConfig tracker;
   double noise = 0.0, noise_from = 0.0, noise_to = 1e9;
   bool per_path = false, json = false;
+  std::string choices;  // --choices FILE: one CSV line per start
 };
 
 Options parse(int argc, char** argv) {
@@ -64,12 +67,14 @@ Options parse(int argc, char** argv) {
     else if (a == "--robust-noise") o.tracker.robust_noise = std::stod(next());
     else if (a == "--robust-warp") o.tracker.robust_warp = std::stod(next());
     else if (a == "--keep-extremes") o.tracker.keep_extremes = true;
+    else if (a == "--shrink") o.tracker.shrink_steps = std::stoi(next());
     else if (a == "--noise") o.noise = std::stod(next());
     else if (a == "--noise-window") {
       const std::string v = next();
       if (std::sscanf(v.c_str(), "%lf,%lf", &o.noise_from, &o.noise_to) != 2) throw std::runtime_error("--noise-window FROM,TO");
     } else if (a == "--per-path") o.per_path = true;
     else if (a == "--json") o.json = true;
+    else if (a == "--choices") o.choices = next();
     else throw std::runtime_error("unknown argument " + a);
   }
   if (o.starts < 1) throw std::runtime_error("--starts must be >= 1");
@@ -160,6 +165,20 @@ int main(int argc, char** argv) try {
     r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);
   });
   const double seconds = std::chrono::duration<double>(clock::now() - t1).count();
+  if (!o.choices.empty()) {
+    std::FILE* f = std::fopen(o.choices.c_str(), "w");
+    if (!f) throw std::runtime_error(o.choices + ": cannot write");
+    std::fprintf(f, "start,dice_mean_x,path,time_scale,offset,amplitude,chosen_success,realistic_success,wall_contact\n");
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const State s0 = random_start_state(world, evaluation_start_seed(o.seed, i));
+      const double x = (s0[3] + s0[9] + s0[15]) / 3.0;
+      const Result& r = results[i];
+      std::fprintf(f, "%zu,%.4f,%s,%.4f,%.4f,%.4f,%d,%d,%d\n", i, x, recordings->paths()[r.choice.path].name.c_str(),
+                   r.choice.warp.time_scale, r.choice.warp.offset, r.choice.warp.amplitude, r.choice.success ? 1 : 0,
+                   r.outcome.realistic_success() ? 1 : 0, r.outcome.wall_contact ? 1 : 0);
+    }
+    std::fclose(f);
+  }
 
   int success = 0, wall = 0, found = 0, warped = 0, sims_total = 0, sims_max = 0;
   std::map<std::string, int> chosen;

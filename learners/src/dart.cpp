@@ -29,6 +29,7 @@ class Dart final : public Learner {
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
+    expert.robust_trials = static_cast<int>(params().integer("mpc_robust"));
     RecordRequest request;
     request.episodes = episodes;
     request.seed = c.seed;
@@ -75,6 +76,8 @@ class Dart final : public Learner {
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
+            {"mpc_robust", ParamType::integer, "0", 0, 1000,
+             "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},
             {"replan", ParamType::boolean, "false", 0, 1,
              "mpc: replan when the noise pushes the world off its prediction (its labels then depend on the noise so far)", {}},
             {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},

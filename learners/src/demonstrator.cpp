@@ -79,7 +79,9 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_robust_warp", ParamType::real, number_text(d.robust_warp), 0, 1,
            "tracker: std of each noisy trial's random warp (time scale, offset m, amplitude; 0: none)", {}},
           {"tracker_keep_extremes", ParamType::boolean, d.keep_extremes ? "true" : "false", 0, 1,
-           "tracker: narrow a moved path's swing to reach no further than the recording's", {}}};
+           "tracker: narrow a moved path's swing to reach no further than the recording's", {}},
+          {"tracker_shrink", ParamType::integer, std::to_string(d.shrink_steps), 0, 100,
+           "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}}};
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
@@ -97,6 +99,7 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     tracker.robust_noise = params.real("tracker_robust_noise");
     tracker.robust_warp = params.real("tracker_robust_warp");
     tracker.keep_extremes = params.boolean("tracker_keep_extremes");
+    tracker.shrink_steps = static_cast<int>(params.integer("tracker_shrink"));
     const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
     config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);

@@ -63,6 +63,21 @@ TEST(Expert, MpcWithoutReplanningKeepsTheFirstPlan) {
   EXPECT_NE(a, mpc_labels_under_noise(ExpertConfig{}));  // replanning under noise answers otherwise
 }
 
+TEST(Expert, MpcRobustTrialsWithoutNoiseKeepThePlanAndWithNoiseAreSeeded) {
+  ExpertConfig once;
+  once.replan = false;
+  const auto plain = mpc_labels_under_noise(once);
+  ExpertConfig noiseless = once;  // trials that replay the plan exactly all succeed: the same plan
+  noiseless.robust_trials = 3;
+  noiseless.robust_noise = 0.0;
+  EXPECT_EQ(mpc_labels_under_noise(noiseless), plain);
+  ExpertConfig robust = once;
+  robust.robust_trials = 3;
+  EXPECT_EQ(mpc_labels_under_noise(robust), mpc_labels_under_noise(robust));  // the trials' noise is seeded
+  robust.robust_trials = -1;
+  EXPECT_THAT(test::error_of([&] { make_expert("mpc", robust); }), testing::HasSubstr("robust_trials"));
+}
+
 TEST(Expert, MpcStacksFromRandomStarts) {
   const WorldConfig c;
   int successes = 0;

@@ -164,6 +164,38 @@ TEST(ChoosePath, RobustTrialsKeepTheChoiceWhenTheyAreNoiselessAndPickTheMostRobu
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust_warp\""), std::string::npos);
 }
 
+TEST(ChoosePath, WhenNoRecordingSucceedsAsRecordedTheLeastNarrowingComesBeforeCmaes) {
+  // Scripted paths moved to starts further right than they were recorded at: where none succeeds
+  // as recorded, the shrink stage's choice is a narrowing on its grid (no offset, no time warp).
+  const WorldConfig w;
+  const std::vector<CupPath> paths = successful_scripted_paths(2);
+  TrackerConfig c;
+  c.probes = 0;
+  c.shrink_steps = 4;
+  TrackerConfig as_recorded = c;
+  as_recorded.optimise = false;
+  const Recordings r(paths, w, c, 0), plain(paths, w, as_recorded, 0);
+  DiceEnv env(w), sim(w);
+  int narrowed = 0;
+  for (const double shift : {0.6, 0.8, 1.0, 1.2, 1.4, 1.6}) {
+    State start = paths[0].states.front();
+    start[si::kCupX] += shift;
+    for (std::size_t i = 0; i < kDiceCount; ++i) start[si::die(i)] += shift;
+    env.reset_to(start);
+    if (choose_path(plain, env, sim, 1).success) continue;
+    const TrackerChoice a = choose_path(r, env, sim, 1);
+    if (!a.success || a.warp.offset != 0.0) continue;  // CMA-ES's, after the grid failed
+    EXPECT_EQ(a.warp.time_scale, 1.0);
+    const double k = (1.0 - a.warp.amplitude) / c.amplitude_range * c.shrink_steps;
+    EXPECT_NEAR(k, std::round(k), 1e-9) << shift;
+    EXPECT_GE(std::round(k), 1.0);
+    ++narrowed;
+  }
+  EXPECT_GE(narrowed, 1) << "no start needed (and found) a narrowing";
+  c.shrink_steps = 101;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"shrink_steps\""), std::string::npos);
+}
+
 TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
   const WorldConfig w = test::short_world(200);
   std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};

@@ -49,6 +49,8 @@ void validate(const ExpertConfig& c) {
   require_config(c.search_spread >= 0.0, "search_spread", ">= 0", c.search_spread);
   require_config(c.replan_budget >= 1, "replan_budget", ">= 1", c.replan_budget);
   require_config(c.replan_interval >= 1, "replan_interval", ">= 1", c.replan_interval);
+  require_config(c.robust_trials >= 0 && c.robust_trials <= 1000, "robust_trials", "in [0, 1000]", c.robust_trials);
+  require_config(c.robust_noise >= 0.0 && c.robust_noise <= 10.0, "robust_noise", "in [0, 10]", c.robust_noise);
 }
 
 bool same_state(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
@@ -129,15 +131,21 @@ class MpcExpert final : public Expert {
     return plan_.act(s, t);
   }
 
-  Trial simulate(SwingPlan plan, const EnvSnapshot& start) {
+  // `noise` > 0: executed-action noise of that std (x action.scale), drawn from `noise_seed`.
+  Trial simulate(SwingPlan plan, const EnvSnapshot& start, double noise = 0.0, std::uint64_t noise_seed = 0) {
     sim_->restore(start);
     Trial trial;
     trial.states.push_back(sim_->get_state());
     const bool clean = !sim_->outcome().wall_contact;
     StepResult r;
     r.observation = sim_->get_state();
+    Rng rng(noise_seed);
+    const Action& scale = sim_->config().action.scale;
     while (sim_->t() < sim_->config().episode.max_steps) {
-      r = sim_->step(plan.act(r.observation, sim_->t()));
+      Action a = plan.act(r.observation, sim_->t());
+      if (noise > 0.0)
+        for (std::size_t k = 0; k < kActionDim; ++k) a[k] += noise * scale[k] * rng.normal();
+      r = sim_->step(a);
       trial.states.push_back(r.observation);
       if (r.terminated) {
         trial.score = 1000.0 - static_cast<double>(r.info.t);
@@ -178,10 +186,22 @@ class MpcExpert final : public Expert {
     const State s = env.get_state();
     const int t = env.t();
     Rng rng(derive_seed(seed_, static_cast<std::uint64_t>(t)));
-    std::optional<SwingPlan> best_plan;
-    Trial best;
+    const std::uint64_t robust_seed = derive_seed(derive_seed(seed_, static_cast<std::uint64_t>(t)), 0x726f62757374ULL);
+    std::optional<SwingPlan> best_plan, robust_plan;
+    Trial best, robust;
+    int robust_wins = -1, trials = 0;
+    // A success ends the search; with robust_trials, only one whose noisy trials all succeed too
+    // (the success with most is kept in case none does).
     auto consider = [&](const SwingPlan& plan) {
       Trial trial = simulate(plan, start);
+      if (trial.score >= 0.0 && config_.robust_trials > 0) {
+        int wins = 0;
+        for (int k = 0; k < config_.robust_trials; ++k)
+          wins += simulate(plan, start, config_.robust_noise, derive_seed(robust_seed, static_cast<std::uint64_t>(++trials)))
+                      .score >= 0.0;
+        if (wins > robust_wins) robust_wins = wins, robust_plan = plan, robust = trial;
+        if (wins < config_.robust_trials) return false;
+      }
       if (!best_plan || trial.score > best.score) {
         best = std::move(trial);
         best_plan = plan;
@@ -204,6 +224,10 @@ class MpcExpert final : public Expert {
     for (int c = 0; !done && c < std::max(1, budget); ++c) {
       const SwingParams p = c == 0 ? config_.swing : perturbed(config_.swing, rng, t > 0);
       done = consider(SwingPlan(p, config_, env.config(), s, t));
+    }
+    if (robust_plan && !(best_plan && best.score >= 0.0)) {
+      best_plan = robust_plan;
+      best = std::move(robust);
     }
     plan_ = *best_plan;
     predicted_ = std::move(best.states);

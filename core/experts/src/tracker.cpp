@@ -196,6 +196,16 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
   if (!c.optimise || robust_best) return finish();
   std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
+  // First the least narrowing of the swing that succeeds, in even steps, the closest paths at
+  // each step: alike for neighbouring starts, where CMA-ES's warps scatter.
+  for (int step = 1; step <= c.shrink_steps; ++step) {
+    for (const auto& [score, k] : near) {
+      PathWarp w = candidates[k].warp;
+      w.amplitude *= 1.0 - c.amplitude_range * static_cast<double>(step) / static_cast<double>(c.shrink_steps);
+      if (consider(candidates[k].path, w).success) return choice;
+    }
+    if (robust_best) return finish();
+  }
   for (const auto& [score, k] : near) {
     const Candidate& base = candidates[k];
     CmaesOptions o;
@@ -255,6 +265,7 @@ void validate(const TrackerConfig& c) {
   require(c.robust_trials >= 0 && c.robust_trials <= 1000, "robust_trials", "in [0, 1000]", c.robust_trials);
   require(c.robust_noise >= 0.0 && c.robust_noise <= 10.0, "robust_noise", "in [0, 10]", c.robust_noise);
   require(c.robust_warp >= 0.0 && c.robust_warp <= 1.0, "robust_warp", "in [0, 1]", c.robust_warp);
+  require(c.shrink_steps >= 0 && c.shrink_steps <= 100, "shrink_steps", "in [0, 100]", c.shrink_steps);
   require(c.rescue_evaluations >= 1 && c.rescue_evaluations <= 100000, "rescue_evaluations", "in [1, 100000]",
           c.rescue_evaluations);
 }

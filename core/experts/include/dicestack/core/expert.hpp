@@ -59,6 +59,11 @@ struct ExpertConfig {
   /// its actions are then a function of the start, the step and the state (DART's labels).
   bool replan = true;
   double search_spread = 0.03;    ///< "mpc": std of a plan's perturbation, as a fraction of each parameter's range
+  /// "mpc": a plan that succeeds is also simulated this many times with executed-action noise of
+  /// std robust_noise x action.scale, and chosen only if all of these succeed too (else the
+  /// success with most): plans robust to a learner's errors. 0: the first success.
+  int robust_trials = 0;
+  double robust_noise = 0.1;
   /// "tracker": the recordings it follows (required; built once and shared by every copy). Its
   /// TrackerConfig is the one the Recordings were built with.
   std::shared_ptr<const Recordings> recordings;

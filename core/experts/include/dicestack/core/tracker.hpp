@@ -66,6 +66,11 @@ struct TrackerConfig {
   /// recordings swing the cup ~3 m either side of the dice, up to the walls. With this, its swing
   /// is narrowed (about the dice) to reach no further than the recording's did.
   bool keep_extremes = false;
+  /// When no recording succeeds as recorded, before CMA-ES: the swing narrowed about the dice in
+  /// even steps (amplitude 1 - k amplitude_range / shrink_steps, k = 1..shrink_steps), the
+  /// closest recordings at each step: the least change that succeeds, alike for neighbouring
+  /// starts. 0: straight to CMA-ES. In [0, 100].
+  int shrink_steps = 0;
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
