@@ -141,8 +141,9 @@ struct Candidate {
 };
 
 // Simulates `candidates` in turn from env's state (each moved into the frame of `frame`); the
-// first success wins. Failing that, CMA-ES over warps of the `optimise_paths` closest, with
-// `evaluations` each; failing all, the closest.
+// first success wins (with robust_trials, the first whose noisy trials all succeed too, else the
+// success with most). Failing that, the `optimise_paths` closest narrowed in shrink_steps even
+// steps, then CMA-ES over their warps, `evaluations` each; failing all, the closest.
 TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
                      const std::vector<Candidate>& candidates, int evaluations, std::uint64_t seed) {
   const TrackerConfig& c = recordings.config();

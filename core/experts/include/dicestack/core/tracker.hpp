@@ -143,10 +143,11 @@ struct TrackerChoice {
 };
 
 /// Searches `recordings` from env's current state, simulating in `sim` (an environment of the
-/// same world): the first path in order() whose simulated episode is a realistic success; if
-/// none and config.optimise, warps (CMA-ES, seeded by `seed`) of the paths that came closest;
-/// failing all, the closest (fewest judge tolerances from a stack, no wall). Deterministic in
-/// the state, the recordings and `seed`.
+/// same world): the first path in order() whose simulated episode is a realistic success (with
+/// robust_trials: whose noisy trials succeed too, else the success with most); if none and
+/// config.optimise, the paths that came closest narrowed (shrink_steps), then warped (CMA-ES,
+/// seeded by `seed`); failing all, the closest (fewest judge tolerances from a stack, no wall).
+/// Deterministic in the state, the recordings and `seed`.
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed);
 
 /// Whether `follower`, followed from env's current state, simulates to a realistic success
