@@ -26,6 +26,7 @@ struct RobustnessOptions {
   int episodes = 100;
   std::uint64_t seed = 0;
   int threads = 0;
+  std::vector<std::string> factors;
 };
 
 void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
@@ -33,6 +34,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   if (opt.model.empty() == opt.expert.empty()) throw ConfigError("robustness: give one of --model M or --expert NAME");
   if (!opt.demos.empty() && opt.expert != "tracker")
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
+  check_robustness_factors(opt.factors);
   if (!opt.out.empty() && cluster.is_root()) check_robustness_out(opt.out, opt.format);  // before any work
   PolicyFactory factory;
   RobustnessRun run;
@@ -43,6 +45,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   request.episodes = opt.episodes;
   request.seed = opt.seed;
   request.threads = opt.threads;
+  request.factors = opt.factors;
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
@@ -97,6 +100,9 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts and the draws")->check(seed_check())->capture_default_str();
+  cmd->add_option("--factors", opt->factors,
+                  "Only these rows, comma-separated: none (nominal), all (every factor at once) or factor names (default: every one)")
+      ->delimiter(',');
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
   std::string formats_help;
   const std::vector<std::string> formats = robustness_format_names(&formats_help);

@@ -3,10 +3,21 @@
 #include <cmath>
 #include <random>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 
 namespace dicestack {
 namespace {
+
+// The action delay an episode ran under (its perturbation's "action_delay"; 0 when nominal).
+std::size_t action_delay_of(const Episode& e) {
+  if (e.perturbation.empty()) return 0;
+  const auto j = nlohmann::json::parse(e.perturbation, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("action_delay") || !j["action_delay"].is_number_unsigned())
+    throw InputError("episode \"" + e.name + "\": its perturbation has no \"action_delay\" (a whole number of steps)");
+  return j["action_delay"].get<std::size_t>();
+}
 
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features) {
   std::size_t n = 0;
@@ -20,10 +31,17 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
     check_episode(*e);
     d.episode_begin.push_back(static_cast<std::size_t>(row));
     d.episode_names.push_back(e->name);
+    // Under an action delay, the actions recorded at the `delay` steps before t run before
+    // the one recorded at t (zeros before the first): what an "/ahead" map moves the cup through.
+    const std::size_t delay = features.ahead() ? action_delay_of(*e) : 0;
+    std::vector<Action> pending(delay);
     for (std::size_t t = 0; t < e->size(); ++t, ++row) {
-      const History h{std::span<const State>(e->states.data(), t + 1), std::span<const Action>(e->actions.data(), t)};
+      for (std::size_t k = 0; k < delay; ++k)
+        pending[k] = t + k >= delay ? e->actions[t + k - delay] : Action{0.0, 0.0, 0.0};
+      const History h{std::span<const State>(e->states.data(), t + 1), std::span<const Action>(e->actions.data(), t),
+                      pending};
       features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
-      features.label(e->states[t], e->actions[t], {d.y.row(row).data(), kActionDim});
+      features.label(h, e->actions[t], {d.y.row(row).data(), kActionDim});
     }
   }
   return d;

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/world_config.hpp>
 
 namespace dicestack {
 namespace {
@@ -28,13 +29,14 @@ struct Blocks {
 class BuiltinFeatureMap final : public FeatureMap {
  public:
   BuiltinFeatureMap(std::string name, std::string description, Blocks blocks,
-                    ActionTarget target = ActionTarget::impulse)
-      : name_(std::move(name)), description_(std::move(description)), blocks_(blocks), target_(target) {}
+                    ActionTarget target = ActionTarget::impulse, bool ahead = false)
+      : name_(std::move(name)), description_(std::move(description)), blocks_(blocks), target_(target), ahead_(ahead) {}
 
   std::string name() const override { return name_; }
   int version() const override { return 1; }
   std::string description() const override { return description_; }
   ActionTarget target() const override { return target_; }
+  bool ahead() const override { return ahead_; }
   const Blocks& blocks() const { return blocks_; }
 
   std::size_t width() const override {
@@ -58,7 +60,7 @@ class BuiltinFeatureMap final : public FeatureMap {
   }
 
   void compute(const History& h, std::span<double> out) const override {
-    const State& s = h.current();
+    const State s = ahead_ ? cup_ahead(h) : h.current();
     std::size_t at = 0;
     if (blocks_.current == Current::state) std::copy(s.begin(), s.end(), out.begin());
     if (blocks_.current == Current::cup)
@@ -88,6 +90,7 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string name_, description_;
   Blocks blocks_;
   ActionTarget target_;
+  bool ahead_;
 };
 
 constexpr std::size_t kCupVelocity[kActionDim] = {si::kCupVx, si::kCupVy, si::kCupW};
@@ -120,6 +123,15 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
           m.description() + "; answers the cup velocity to set (the action is its difference from the cup's velocity)",
           m.blocks(), ActionTarget::velocity));
     }
+    // Every map again, acting for the moment its action lands (delays).
+    const std::size_t targets = v->size();
+    for (std::size_t i = 0; i < targets; ++i) {
+      const BuiltinFeatureMap& m = *(*v)[i];
+      v->push_back(std::make_unique<BuiltinFeatureMap>(
+          m.name() + std::string(kAheadSuffix),
+          m.description() + "; under delays, the cup moved ahead to where it is when the action lands",
+          m.blocks(), m.target(), true));
+    }
     return v;
   }();
   return *maps;
@@ -127,15 +139,38 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
 
 }  // namespace
 
-void FeatureMap::label(const State& current, const Action& action, std::span<double> out) const {
-  const bool velocity = target() == ActionTarget::velocity;
-  for (std::size_t k = 0; k < kActionDim; ++k) out[k] = action[k] + (velocity ? current[kCupVelocity[k]] : 0.0);
+State cup_ahead(const History& h) {
+  State s = h.current();
+  if (h.unseen.empty() && h.pending.empty()) return s;
+  static const WorldConfig nominal{};
+  const double dt = nominal.physics.control_dt, g = nominal.physics.gravity.y;
+  const double n = nominal.physics.substeps, sub = dt / n;
+  // Box2D's semi-implicit Euler over the substeps: v += g sub, then p += v sub, n times.
+  auto run = [&](const Action& a) {
+    s[si::kCupVx] += a[0];
+    s[si::kCupVy] += a[1];
+    s[si::kCupW] += a[2];
+    s[si::kCupX] += s[si::kCupVx] * dt;
+    s[si::kCupY] += s[si::kCupVy] * dt + g * sub * sub * n * (n + 1.0) / 2.0;
+    s[si::kCupAngle] += s[si::kCupW] * dt;
+    s[si::kCupVy] += g * dt;
+  };
+  for (const Action& a : h.unseen) run(a);
+  for (const Action& a : h.pending) run(a);
+  return s;
 }
 
-Action FeatureMap::action(const State& current, std::span<const double> output) const {
+void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {
   const bool velocity = target() == ActionTarget::velocity;
+  const State s = ahead() ? cup_ahead(h) : h.current();
+  for (std::size_t k = 0; k < kActionDim; ++k) out[k] = action[k] + (velocity ? s[kCupVelocity[k]] : 0.0);
+}
+
+Action FeatureMap::action(const History& h, std::span<const double> output) const {
+  const bool velocity = target() == ActionTarget::velocity;
+  const State s = ahead() ? cup_ahead(h) : h.current();
   Action a;
-  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = output[k] - (velocity ? current[kCupVelocity[k]] : 0.0);
+  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = output[k] - (velocity ? s[kCupVelocity[k]] : 0.0);
   return a;
 }
 

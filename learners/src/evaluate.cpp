@@ -40,14 +40,18 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
   std::optional<PerturbedChannel> perturbed;
   std::vector<State> seen;  // what the policy was shown, when that is not the true states
   if (options.perturbation && options.perturbation->acts) perturbed.emplace(*options.perturbation);
-  std::vector<Action> applied;
+  std::vector<Action> applied, pending, unseen;
   policy.attach(env);
   e.states.push_back(env.reset_to(start, seed));
   policy.reset(seed);
   while (true) {
     if (options.before_step) options.before_step(env, applied.size());
-    if (perturbed) seen.push_back(perturbed->observe(e.states.back()));
-    Action a = policy.act(History{perturbed ? seen : e.states, applied});
+    if (perturbed) {
+      seen.push_back(perturbed->observe(e.states.back()));
+      pending.assign(perturbed->pending().begin(), perturbed->pending().end());
+      unseen.assign(perturbed->unseen().begin(), perturbed->unseen().end());
+    }
+    Action a = policy.act(History{perturbed ? seen : e.states, applied, pending, unseen});
     if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
     for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
     Action executed = perturbed ? perturbed->execute(a) : a;

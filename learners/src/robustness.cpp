@@ -1,5 +1,7 @@
 #include <dicestack/learners/robustness.hpp>
 
+#include <algorithm>
+
 #include <cstdio>
 #include <sstream>
 
@@ -31,14 +33,31 @@ std::string percent(const Rate& r, int n) {
 
 }  // namespace
 
+void check_robustness_factors(const std::vector<std::string>& factors) {
+  const auto& known = perturbation_factors();
+  for (const auto& f : factors)
+    if (f != "none" && f != "all" && std::find(known.begin(), known.end(), f) == known.end()) {
+      std::string names = "none, all";
+      for (const auto& k : known) names += ", " + k;
+      throw ConfigError("robustness: unknown factor \"" + f + "\"; known: " + names);
+    }
+}
+
 std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const WorldConfig& world,
                                       const RobustnessRequest& request, Cluster& cluster) {
-  std::vector<std::pair<std::string, std::string>> plan{{"none", "none"}};
-  for (const auto& f : perturbation_factors()) {
-    if (request.reads_world && sensing(f)) continue;
+  check_robustness_factors(request.factors);
+  const auto& known = perturbation_factors();
+  auto wanted = [&](const std::string& f) {
+    return request.factors.empty() || std::find(request.factors.begin(), request.factors.end(), f) != request.factors.end();
+  };
+  std::vector<std::pair<std::string, std::string>> plan;
+  if (wanted("none")) plan.emplace_back("none", "none");
+  for (const auto& f : known) {
+    if ((request.reads_world && sensing(f)) || !wanted(f)) continue;
     for (const char* level : {"easy", "medium", "hard"}) plan.emplace_back(f, level);
   }
-  for (const char* level : {"easy", "medium", "hard"}) plan.emplace_back("all", level);
+  if (wanted("all"))
+    for (const char* level : {"easy", "medium", "hard"}) plan.emplace_back("all", level);
   // Every perturbation is checked against the world before any row runs.
   auto perturbation = [&](const std::string& f, const std::string& level) {
     Perturbation p = f == "none" ? Perturbation{} : f == "all" ? perturbation_level(level) : perturbation_factor(f, level);

@@ -139,6 +139,19 @@ class DiceStackEnv(_EnvBase):
         return self._env.t
 
     @property
+    def pending(self):
+        """Under an action delay of d steps, the (d, 3) actions that run before the next one chosen,
+        in order (zeros before the first choice lands); (0, 3) without a delay. A policy on an
+        "/ahead" feature map takes it: policy.act(obs, pending=env.pending, unseen=env.unseen)."""
+        return self._env.pending
+
+    @property
+    def unseen(self):
+        """Under an observation delay, the actions that ran (as chosen) since the state the last
+        observation shows, in order; (0, 3) without a delay."""
+        return self._env.unseen
+
+    @property
     def world(self):
         """The world config as a dict (`dicestack config`'s format)."""
         return world_dict(self._world)

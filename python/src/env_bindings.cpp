@@ -359,6 +359,8 @@ void bind_env(py::module_& m) {
       .def("action_bounds", [](const EnvCore& c) { return bounds(c.env().action_space()); })
       .def_property_readonly("state", [](const EnvCore& c) { return to_array(c.env().get_state()); })
       .def_property_readonly("t", [](const EnvCore& c) { return c.env().t(); })
+      .def_property_readonly("pending", [](const EnvCore& c) { return rows_to_array(c.pending()); })
+      .def_property_readonly("unseen", [](const EnvCore& c) { return rows_to_array(c.unseen()); })
       .def_property_readonly("info", [](const EnvCore& c) { return info_dict(c.info()); })
       .def_property_readonly("world", [](const EnvCore& c) { return c.env().config(); })
       .def_property_readonly("world_hash", &EnvCore::world_hash)

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include <memory>
+#include <vector>
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/perturbation.hpp>
@@ -48,6 +49,16 @@ class EnvCore {
   /// True when the current episode's actuation or sensing is perturbed (its delays and noise
   /// stream are not in a snapshot).
   bool channelled() const { return channel_.has_value(); }
+  /// What runs before the next action under the episode's action delay (History::pending):
+  /// an expert acting here simulates through it. Empty without a delay.
+  std::vector<Action> pending() const {
+    return channel_ ? std::vector<Action>(channel_->pending().begin(), channel_->pending().end()) : std::vector<Action>{};
+  }
+  /// What ran since the state the last observation showed, under an observation delay
+  /// (History::unseen). Empty without a delay.
+  std::vector<Action> unseen() const {
+    return channel_ ? std::vector<Action>(channel_->unseen().begin(), channel_->unseen().end()) : std::vector<Action>{};
+  }
 
   /// The info of the episode's latest state (what reset reports; step's own is in StepResult).
   StepInfo info() const;

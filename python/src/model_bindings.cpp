@@ -39,10 +39,12 @@ class PyPolicy {
  public:
   explicit PyPolicy(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
   void reset() { states_.clear(); }
-  Action act(const py::handle& observation) {
+  Action act(const py::handle& observation, const py::handle& pending, const py::handle& unseen) {
+    const auto ahead = pending.is_none() ? std::vector<Action>{} : rows_from<kActionDim>(pending, "pending");
+    const auto since = unseen.is_none() ? std::vector<Action>{} : rows_from<kActionDim>(unseen, "unseen");
     states_.push_back(state_from(observation, "observation"));
     // The world's applied actions are not known here; no built-in feature map reads them.
-    return model_->act(History{states_, {}});
+    return model_->act(History{states_, {}, ahead, since});
   }
   std::size_t t() const { return states_.empty() ? 0 : states_.size() - 1; }
 
@@ -94,7 +96,7 @@ class PyExpert {
       episodes_ = core.episodes();
       world_hash_ = core.world_hash();
     }
-    return expert_->act(core.env());
+    return expert_->act(core.env(), core.pending());
   }
   std::string name() const { return expert_->name(); }
 
@@ -238,9 +240,20 @@ void bind_models(py::module_& m) {
             p.reset();
           },
           py::arg("seed") = py::none(), "Starts a new episode")
-      .def("act", [](PyPolicy& p, const py::handle& obs) { return to_array(p.act(obs)); }, py::arg("observation"),
-           "The action (dvx, dvy, dw) after this observation")
-      .def("__call__", [](PyPolicy& p, const py::handle& obs) { return to_array(p.act(obs)); }, py::arg("observation"))
+      .def(
+          "act",
+          [](PyPolicy& p, const py::handle& obs, const py::handle& pending, const py::handle& unseen) {
+            return to_array(p.act(obs, pending, unseen));
+          },
+          py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none(),
+          "The action (dvx, dvy, dw) after this observation; under delays, an \"/ahead\" map also reads the "
+          "environment's pending and unseen actions (DiceStackEnv.pending, .unseen)")
+      .def(
+          "__call__",
+          [](PyPolicy& p, const py::handle& obs, const py::handle& pending, const py::handle& unseen) {
+            return to_array(p.act(obs, pending, unseen));
+          },
+          py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none())
       .def_property_readonly("t", &PyPolicy::t);
 
   py::class_<PyModel>(m, "Model", "A trained model: a feature map, a regressor and their standardisers")

@@ -142,7 +142,7 @@ Action Model::act(const History& history) const {
   regressor_->predict_row({z.data(), width}, out);
   std::array<double, kActionDim> answer;
   y_.invert_row(out, answer);
-  return features_->action(history.current(), answer);
+  return features_->action(history, answer);
 }
 
 Action Model::act(const State& state) const { return act(History{{&state, 1}, {}}); }

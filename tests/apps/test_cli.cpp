@@ -758,6 +758,12 @@ TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable)
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("nobody"));
   EXPECT_NE(run("robustness --world " + world.string()).status, 0) << "a model or an expert";
+  p = run(cmd + "--factors none,action_delay --format csv", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(std::count(p.output.begin(), p.output.end(), '\n'), 1 + 1 + 3) << p.output;
+  p = run(cmd + "--factors none,wind");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("unknown factor \"wind\""));
   std::filesystem::remove(out);
   std::filesystem::remove(world);
   std::filesystem::remove(model);

@@ -4,9 +4,13 @@
 #include <array>
 #include <vector>
 
+#include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/features.hpp>
+
+#include <dicestack/test/helpers.hpp>
 
 namespace dicestack {
 namespace {
@@ -131,13 +135,14 @@ TEST(Features, AVelocityMapSeesTheSameRowAndAnswersTheCupVelocityToSet) {
   // numbered(200): cup vx, vy, w = 221, 222, 223.
   const Action a{0.5, -1.0, 2.0};
   std::array<double, kActionDim> label{};
-  v.label(states[1], a, label);
+  const History h{states, {}};
+  v.label(h, a, label);
   EXPECT_EQ(label, (std::array<double, kActionDim>{221.5, 221.0, 225.0}));
-  EXPECT_EQ(v.action(states[1], label), a) << "answer and label invert each other";
-  base.label(states[1], a, label);
+  EXPECT_EQ(v.action(h, label), a) << "answer and label invert each other";
+  base.label(h, a, label);
   EXPECT_EQ(label, (std::array<double, kActionDim>{0.5, -1.0, 2.0})) << "an impulse map answers the action";
   for (const auto& n : feature_map_names()) {
-    if (n.ends_with(kVelocityTargetSuffix)) continue;
+    if (n.ends_with(kVelocityTargetSuffix) || n.ends_with(kAheadSuffix)) continue;
     EXPECT_EQ(feature_map(n + std::string(kVelocityTargetSuffix)).width(), feature_map(n).width()) << n;
   }
 }
@@ -153,6 +158,83 @@ TEST(Features, DatasetLabelsOfAVelocityMapAreTheCupVelocityEachStepSets) {
     for (Eigen::Index k = 0; k < 3; ++k)
       EXPECT_DOUBLE_EQ(d.y(t, k), e.states[static_cast<std::size_t>(t)][21 + static_cast<std::size_t>(k)] +
                                       e.actions[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]);
+}
+
+TEST(Features, AnAheadMapWithNothingPendingIsItsBaseMap) {
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const History h{states, {}};
+  int maps = 0;
+  for (const auto& n : feature_map_names()) {
+    if (!n.ends_with(kAheadSuffix)) continue;
+    const FeatureMap& ahead = feature_map(n);
+    const FeatureMap& base = feature_map(n.substr(0, n.size() - kAheadSuffix.size()));
+    EXPECT_TRUE(ahead.ahead()) << n;
+    EXPECT_FALSE(base.ahead()) << n;
+    EXPECT_EQ(ahead.target(), base.target()) << n;
+    EXPECT_EQ(row_of(ahead, h), row_of(base, h)) << n;
+    ++maps;
+  }
+  EXPECT_EQ(maps * 2, static_cast<int>(feature_map_names().size())) << "every map has its /ahead twin";
+}
+
+TEST(Features, AnAheadMapShowsTheCupWhereThePendingActionsTakeIt) {
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const std::vector<Action> pending{{1.0, 0.0, 0.0}, {0.0, 2.0, 0.5}};
+  const History h{states, {}, pending};
+  const FeatureMap& m = feature_map("state+clock/velocity/ahead");
+  const State s = cup_ahead(h);
+  EXPECT_EQ(row_of(m, h)[kStateDim], 1.0) << "the clock counts the choices made so far";
+  for (std::size_t k = 0; k < kStateDim; ++k) EXPECT_EQ(row_of(m, h)[k], s[k]) << k;
+  EXPECT_EQ(s[state_index::kCupVx], 221.0 + 1.0);
+  EXPECT_EQ(s[state_index::kCupW], 223.0 + 0.5);
+  EXPECT_NE(s[state_index::kCupX], states[1][state_index::kCupX]);
+  for (std::size_t i = 0; i < kDiceCount; ++i) EXPECT_EQ(s[state_index::die(i)], states[1][state_index::die(i)]);
+  // Its velocity target is the velocity set where the action lands.
+  std::array<double, kActionDim> label{};
+  const Action a{0.5, -1.0, 2.0};
+  m.label(h, a, label);
+  EXPECT_DOUBLE_EQ(label[0], s[state_index::kCupVx] + 0.5);
+  EXPECT_EQ(m.action(h, label), a);
+}
+
+TEST(Features, CupAheadIsWhereTheSimulatorTakesACupInTheAir) {
+  const WorldConfig w;
+  State s = random_start_state(w, 3);
+  s[state_index::kCupY] += 0.3;  // clear of the table and the dice
+  DiceEnv env(w);
+  env.reset_to(s, 1);
+  const std::vector<Action> run{{0.2, 0.1, 0.0}, {-0.1, 0.3, 0.05}, {0.0, 0.0, -0.05}};
+  for (const Action& a : run) env.step(a);
+  const std::vector<State> shown{s};
+  const State ahead = cup_ahead(History{shown, {}, run});
+  const State real = env.get_state();
+  for (auto k : {state_index::kCupX, state_index::kCupY, state_index::kCupAngle, state_index::kCupVx,
+                 state_index::kCupVy, state_index::kCupW})
+    EXPECT_NEAR(ahead[k], real[k], 1e-4) << k;
+}
+
+TEST(Features, DatasetRowsOfAnAheadMapRunThroughTheEpisodesOwnDelay) {
+  Episode e;
+  e.name = "episode_0000";
+  e.states = {numbered(0), numbered(1), numbered(2)};
+  e.actions = {{0.1, 0.2, 0.3}, {0.4, 0.5, 0.6}, {0.7, 0.8, 0.9}};
+  e.sources.assign(3, StepSource::expert);
+  e.perturbation = R"({"action_delay": 2})";
+  const FeatureMap& m = feature_map("state+clock/ahead");
+  const Dataset d = make_dataset({e}, m);
+  for (std::size_t t = 0; t < 3; ++t) {
+    std::vector<Action> pending;
+    for (std::size_t k = 0; k < 2; ++k) pending.push_back(t + k >= 2 ? e.actions[t + k - 2] : Action{0.0, 0.0, 0.0});
+    const History h{std::span<const State>(e.states.data(), t + 1), {}, pending};
+    EXPECT_EQ(d.x(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(kStateDim)), static_cast<double>(t));
+    const State s = cup_ahead(h);
+    for (std::size_t k = 0; k < kStateDim; ++k)
+      EXPECT_EQ(d.x(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(k)), s[k]) << t << " " << k;
+  }
+  EXPECT_NE(make_dataset({e}, m).x(2, 0), make_dataset({e}, feature_map("state+clock")).x(2, 0))
+      << "the base map shows the cup as recorded";
+  e.perturbation = R"({"dice_mass": 0.5})";
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"action_delay\""));
 }
 
 }  // namespace

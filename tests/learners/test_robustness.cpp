@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,79 @@ TEST(Perturbed, ActionDelayExecutesNothingUntilTheFirstChoiceArrives) {
   EXPECT_TRUE(test::bit_equal(s, late.states[4]));
 }
 
+// Chooses a different action each step and remembers what it was told runs before it.
+class PendingWatcher final : public Policy {
+ public:
+  Action act(const History& h) override {
+    pending.emplace_back(h.pending.begin(), h.pending.end());
+    return {0.01 * static_cast<double>(h.t() + 1), 0.0, 0.0};
+  }
+  std::string name() const override { return "pending watcher"; }
+  std::vector<std::vector<Action>> pending;
+};
+
+TEST(Perturbed, PendingHoldsWhatRunsBeforeTheChoiceInOrder) {
+  const WorldConfig w = test::short_world(12);
+  PerturbationDraw d = bare_draw(w);
+  d.action_delay = 3;
+  RolloutOptions o;
+  o.perturbation = &d;
+  DiceEnv env(w);
+  PendingWatcher p;
+  const Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::policy, o);
+  ASSERT_EQ(p.pending.size(), e.actions.size());
+  for (std::size_t t = 0; t < p.pending.size(); ++t) {
+    ASSERT_EQ(p.pending[t].size(), 3u) << t;
+    for (std::size_t k = 0; k < 3; ++k) {  // the choice of step t - 3 + k, zeros before step 0
+      const double chosen = t + k >= 3 ? 0.01 * static_cast<double>(t + k - 3 + 1) : 0.0;
+      EXPECT_EQ(p.pending[t][k][0], chosen) << t << " " << k;
+    }
+  }
+  PendingWatcher q;  // no delay: nothing pending
+  rollout(env, q, random_start_state(w, 1), 1, StepSource::policy);
+  for (const auto& v : q.pending) EXPECT_TRUE(v.empty());
+}
+
+// Does nothing for `idle` steps, then lets the expert act with no delay.
+class IdleThenExpert final : public Policy {
+ public:
+  IdleThenExpert(std::unique_ptr<Expert> expert, std::size_t idle) : expert_(std::move(expert)), idle_(idle) {}
+  void attach(const DiceEnv& env) override { expert_.attach(env); }
+  void reset(std::uint64_t seed) override { expert_.reset(seed); }
+  Action act(const History& h) override { return h.t() < idle_ ? Action{0.0, 0.0, 0.0} : expert_.act(h); }
+  std::string name() const override { return "idle then expert"; }
+
+ private:
+  OwnedExpertPolicy expert_;
+  std::size_t idle_;
+};
+
+TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
+  // With the simulator as its model (a Smith predictor), an expert whose actions run 4 steps
+  // late moves the world exactly as the same expert with no delay does once 4 idle steps have
+  // passed: the same states, bit for bit, and the same outcome.
+  const WorldConfig w = test::short_world(40);
+  ExpertConfig c;
+  c.search_budget = 8;
+  c.replan_budget = 4;
+  PerturbationDraw d = bare_draw(w);
+  d.action_delay = 4;
+  RolloutOptions o;
+  o.perturbation = &d;
+  for (std::uint64_t seed : {1, 2}) {
+    const State start = random_start_state(w, seed);
+    DiceEnv env(w), plain(w);
+    OwnedExpertPolicy late(make_expert("mpc", c));
+    IdleThenExpert idle(make_expert("mpc", c), 4);
+    const Episode a = rollout(env, late, start, seed, StepSource::expert, o);
+    const Episode b = rollout(plain, idle, start, seed, StepSource::expert);
+    ASSERT_EQ(a.states.size(), b.states.size()) << seed;
+    for (std::size_t t = 0; t < a.states.size(); ++t) ASSERT_TRUE(test::bit_equal(a.states[t], b.states[t])) << seed << " " << t;
+    EXPECT_EQ(a.outcome.realistic_success(), b.outcome.realistic_success());
+    EXPECT_EQ(a.outcome.wall_contact, b.outcome.wall_contact);
+  }
+}
+
 TEST(Perturbed, AnInvalidPerturbationIsRefusedBeforeAnyRollout) {
   std::atomic<int> made{0};
   EvalRequest r = test::eval_request(3, 0, 1);
@@ -158,6 +232,34 @@ TEST(Robustness, RowsCoverEveryFactorAndLevelAndAreThreadIndependent) {
   }
   r.reads_world = true;  // an expert: the sensing factors are left out
   EXPECT_EQ(robustness(watcher, w, r).size(), 1 + 3 * (perturbation_factors().size() - 2) + 3);
+}
+
+TEST(Robustness, FactorsChooseTheRowsInTheTablesOrderAndAnUnknownOneIsRefusedFirst) {
+  RobustnessRequest r;
+  r.episodes = 2;
+  r.seed = 3;
+  r.threads = 1;
+  const WorldConfig w = test::short_world(25);
+  const auto all = robustness(watcher, w, r);
+  r.factors = {"action_delay", "none"};
+  const auto some = robustness(watcher, w, r);
+  ASSERT_EQ(some.size(), 4u);
+  EXPECT_EQ(some[0].factor, "none");
+  for (std::size_t i = 1; i < 4; ++i) {
+    EXPECT_EQ(some[i].factor, "action_delay");
+    const auto same = std::find_if(all.begin(), all.end(), [&](const RobustnessRow& row) {
+      return row.factor == some[i].factor && row.level == some[i].level;
+    });
+    ASSERT_NE(same, all.end());
+    EXPECT_EQ(same->stats.dice_in_cup_mean, some[i].stats.dice_in_cup_mean) << "a row does not depend on the others";
+  }
+  std::atomic<int> made{0};
+  r.factors = {"none", "wind"};
+  EXPECT_THAT(test::error_of([&] {
+                robustness([&] { ++made; return std::make_unique<Watcher>(); }, w, r);
+              }),
+              HasSubstr("unknown factor \"wind\""));
+  EXPECT_EQ(made, 0);
 }
 
 TEST(Robustness, RendersTheLeaderboardsFormats) {

@@ -114,3 +114,37 @@ def test_the_leaderboard_rolls_out_in_perturbed_worlds(builtin_episodes, tmp_pat
     dicestack.leaderboard(perturb="hard", **args)
     with pytest.raises(ValueError, match="none, easy, medium, hard"):
         dicestack.leaderboard(perturb="sideways", **args)
+
+
+def test_an_expert_acts_through_the_action_delay_and_stacks():
+    env = dicestack.DiceStackEnv(perturb={"action_delay": 3})
+    env.reset(seed=2)
+    assert env.pending.shape == (3, 3) and not env.pending.any()
+    assert env.unseen.shape == (0, 3)
+    expert = dicestack.expert("mpc")
+    chosen, done, info = [], False, {}
+    while not done:
+        chosen.append(expert(env))
+        _, _, terminated, truncated, info = env.step(chosen[-1])
+        done = terminated or truncated
+        if not done and len(chosen) >= 3:
+            assert np.array_equal(env.pending, np.array(chosen[-3:])), "the last three choices, in order"
+    assert info["realistic_success"], "a one-step-late controller that does not predict hits a wall"
+
+
+def test_a_policy_on_an_ahead_map_reads_what_is_pending(builtin_episodes):
+    model = dicestack.train("knn", demos=builtin_episodes[:2], features="state+clock/ahead", params={"k": 1},
+                            split="none")
+    assert dicestack.DiceStackEnv().pending.shape == (0, 3)
+    env = dicestack.DiceStackEnv(perturb={"action_delay": 2, "observation_delay": 1})
+    obs, _ = env.reset(seed=1)
+    reading, blind = model.policy(), model.policy()
+    differ = 0
+    for _ in range(15):
+        assert env.unseen.shape[0] <= 1
+        a = reading.act(obs, pending=env.pending, unseen=env.unseen)
+        differ += not np.array_equal(a, blind.act(obs))
+        obs, *_ = env.step(a)
+    assert differ > 0
+    with pytest.raises(ValueError, match="pending"):
+        model.policy().act(obs, pending=np.zeros((2, 4)))

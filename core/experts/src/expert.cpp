@@ -298,9 +298,18 @@ class TrackerExpert final : public Expert {
 
 void Expert::reset(std::uint64_t seed) { do_reset(seed); }
 
-Action Expert::act(const DiceEnv& env) {
+Action Expert::act(const DiceEnv& env, std::span<const Action> pending) {
   require_finite(env.get_state(), "expert: state");
-  Action a = do_act(env);
+  const DiceEnv* at = &env;
+  if (!pending.empty()) {
+    DiceEnv& ahead = planning_sim(ahead_, env);
+    ahead.restore(env.snapshot());
+    for (const Action& p : pending)
+      if (ahead.t() >= ahead.config().episode.max_steps || ahead.step(p).terminated) return Action{0.0, 0.0, 0.0};
+    if (ahead.t() >= ahead.config().episode.max_steps) return Action{0.0, 0.0, 0.0};
+    at = &ahead;
+  }
+  Action a = do_act(*at);
   require_finite(a, name() + " expert: action");
   const auto& limit = env.config().action.limit;
   for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);

@@ -277,7 +277,8 @@ std::string draw_to_json(const PerturbationDraw& d) {
   return j.dump();
 }
 
-PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw) : draw_(draw), noise_(draw.noise_seed) {}
+PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw)
+    : draw_(draw), noise_(draw.noise_seed), chosen_(static_cast<std::size_t>(draw.action_delay), Action{0.0, 0.0, 0.0}) {}
 
 State PerturbedChannel::observe(const State& state) {
   states_.push_back(state);
@@ -289,10 +290,11 @@ State PerturbedChannel::observe(const State& state) {
 }
 
 Action PerturbedChannel::execute(const Action& chosen) {
-  chosen_.push_back(chosen);
-  const auto delay = static_cast<std::size_t>(draw_.action_delay);
-  if (chosen_.size() > delay + 1) chosen_.pop_front();
-  Action a = chosen_.size() > delay ? chosen_.front() : Action{0.0, 0.0, 0.0};
+  chosen_.push_back(chosen);  // holds action_delay zeros from the start: nothing runs before then
+  Action a = chosen_.front();
+  chosen_.pop_front();
+  ran_.push_back(a);
+  if (ran_.size() > static_cast<std::size_t>(draw_.observation_delay)) ran_.pop_front();
   for (std::size_t k = 0; k < kActionDim; ++k) {
     a[k] += draw_.action_bias[k];
     if (draw_.action_noise[k] > 0.0) a[k] += draw_.action_noise[k] * noise_.normal();

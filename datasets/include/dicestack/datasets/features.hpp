@@ -22,6 +22,13 @@ struct History {
   /// world applied; in training rows (make_dataset) the recorded labels, which differ under DART
   /// noise and DAgger: no built-in map reads them for that reason.
   std::span<const Action> actions;
+  /// Under an action delay (issue 25), what was chosen earlier and runs before the action chosen
+  /// now, in the order it runs (zeros for the steps before the first choice lands); empty
+  /// without a delay. An expert simulates through it to the state its action lands in.
+  std::span<const Action> pending = {};
+  /// Under an observation delay, what ran (as chosen, before noise) since the state shown:
+  /// states.back() is that many steps old. Empty without a delay.
+  std::span<const Action> unseen = {};
   /// Step index of the current state (0 at the start).
   std::size_t t() const { return states.size() - 1; }
   const State& current() const { return states.back(); }
@@ -57,11 +64,20 @@ class FeatureMap {
   /// What the regressor's kActionDim outputs are (default: the action).
   virtual ActionTarget target() const { return ActionTarget::impulse; }
 
-  /// The regressor's answer for `action` taken in state `current`: a training label.
-  void label(const State& current, const Action& action, std::span<double> out) const;
-  /// The action for the regressor's answer `output` in state `current`. Hot path.
-  Action action(const State& current, std::span<const double> output) const;
+  /// True for a map that acts for the moment its action lands (kAheadSuffix).
+  virtual bool ahead() const { return false; }
+
+  /// The regressor's answer for `action` taken after `history`: a training label.
+  void label(const History& history, const Action& action, std::span<double> out) const;
+  /// The action for the regressor's answer `output` after `history`. Hot path.
+  Action action(const History& history, std::span<const double> output) const;
 };
+
+/// The state the world is in when an action chosen after `history` lands: the current state
+/// with the cup moved on through history.unseen then history.pending as it moves free in the
+/// nominal world (each action a velocity change, then gravity, no contact). The dice stay as
+/// shown. The current state itself when nothing is unseen or pending.
+State cup_ahead(const History& history);
 
 /// The built-in maps, by name:
 ///  - "state": the 24 state numbers (the paper's input; what every model before format 2 used)
@@ -73,11 +89,19 @@ class FeatureMap {
 ///  - "clock+start_state", "cup+clock+start_state": open loop, and feedback on the cup alone
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
 /// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default).
+/// Each of these also as NAME + "/ahead" (kAheadSuffix): under delays, the row shows
+/// cup_ahead() instead of the current cup (with no delay, the same rows as NAME). The clock
+/// stays t, the choices made so far: a policy's episode is then the nominal one, d steps late.
+/// (Shown the step its action lands at, a policy trained without delay meets at t = d a cup
+/// that has not moved yet, which it never saw: measured, docs/robustness.md.)
 /// Throws ConfigError for another name, listing these.
 const FeatureMap& feature_map(std::string_view name);
 
 /// The suffix of a map whose regressor answers the cup velocity to set (ActionTarget::velocity).
 inline constexpr std::string_view kVelocityTargetSuffix = "/velocity";
+
+/// The suffix of a map that acts for the moment its action lands (FeatureMap::ahead()).
+inline constexpr std::string_view kAheadSuffix = "/ahead";
 
 /// Names feature_map() accepts, in listing order.
 std::vector<std::string> feature_map_names();

@@ -72,7 +72,7 @@ class ExpertPolicy final : public Policy {
   ExpertPolicy(Expert& expert, const DiceEnv& env) : expert_(expert), env_(&env) {}
   void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_.reset(seed); }
-  Action act(const History&) override { return expert_.act(*env_); }
+  Action act(const History& h) override { return expert_.act(*env_, h.pending); }
   std::string name() const override { return "expert " + expert_.name(); }
 
  private:
@@ -87,9 +87,9 @@ class OwnedExpertPolicy final : public Policy {
   explicit OwnedExpertPolicy(std::unique_ptr<Expert> expert) : expert_(std::move(expert)) {}
   void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_->reset(seed); }
-  Action act(const History&) override {
+  Action act(const History& h) override {
     if (!env_) throw std::logic_error("expert " + expert_->name() + ": no environment attached (roll it out with rollout())");
-    return expert_->act(*env_);
+    return expert_->act(*env_, h.pending);
   }
   std::string name() const override { return "expert " + expert_->name(); }
 

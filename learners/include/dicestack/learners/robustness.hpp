@@ -28,9 +28,15 @@ struct RobustnessRequest {
   /// Leave out the sensing factors (observation noise and delay): an expert reads the world
   /// itself, not the observations, so they would measure nothing.
   bool reads_world = false;
+  /// The factors to measure ("none", "all" and perturbation_factors()), in the table's order;
+  /// empty: every one. An unknown name is refused before any row runs.
+  std::vector<std::string> factors;
   /// Called as each row starts with (row index, rows in all, factor, level).
   std::function<void(int, int, const std::string&, const std::string&)> progress;
 };
+
+/// Throws ConfigError naming a factor that is none of "none", "all" and perturbation_factors().
+void check_robustness_factors(const std::vector<std::string>& factors);
 
 /// The rows: nominal, then every factor at easy, medium and hard, then all factors at once at
 /// each level. Each row is an evaluation (collective over `cluster`; the same rows on any number

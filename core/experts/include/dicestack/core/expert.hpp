@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -79,8 +81,11 @@ class Expert {
   void reset(std::uint64_t seed);
 
   /// The action (dvx, dvy, dw) for env's current state, within config.action.limit.
-  /// Throws InputError if the environment's state is not finite.
-  Action act(const DiceEnv& env);
+  /// Under an action delay, `pending` holds what runs before this action lands (History's
+  /// pending): the expert then acts for the state the simulator says they lead to, as a Smith
+  /// predictor does (zeros if the episode ends first). Throws InputError if the environment's
+  /// state is not finite.
+  Action act(const DiceEnv& env, std::span<const Action> pending = {});
 
   /// The name make_expert() knows it by.
   virtual std::string name() const = 0;
@@ -88,6 +93,8 @@ class Expert {
  private:
   virtual void do_reset(std::uint64_t seed) = 0;
   virtual Action do_act(const DiceEnv& env) = 0;
+
+  std::optional<DiceEnv> ahead_;  // where `pending` leads (act with a delay)
 };
 
 /// Names make_expert() accepts, with a one-line description each.

@@ -102,12 +102,19 @@ class PerturbedChannel {
   /// What runs at this step, given what the policy chose now: its choice action_delay steps ago
   /// (nothing before then), plus the bias and this step's noise.
   Action execute(const Action& chosen);
+  /// What runs at the next action_delay steps before the next choice does (before bias and
+  /// noise), in order: the choices not yet run, zeros before the first. Empty without a delay.
+  const std::deque<Action>& pending() const { return chosen_; }
+  /// What ran (as chosen, before bias and noise) since the state observe() last showed, in
+  /// order. Empty without an observation delay.
+  const std::deque<Action>& unseen() const { return ran_; }
 
  private:
   PerturbationDraw draw_;
   Rng noise_;
   std::deque<State> states_;
   std::deque<Action> chosen_;
+  std::deque<Action> ran_;
 };
 
 /// The typical spread of each state component (positions m, angles rad, velocities), the unit
