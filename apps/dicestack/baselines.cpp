@@ -27,7 +27,7 @@ void add_problem_options(CLI::App& cmd, OptimiseCommandOptions& opt) {
       ->capture_default_str();
   cmd.add_option("--repeats", opt.settings.repeats, "Noisy runs averaged per evaluation")->check(CLI::PositiveNumber)->capture_default_str();
   cmd.add_option("--discount", opt.discount, "Discount gamma of eq. 6 (default: the world's, 0.1)")->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--threads", opt.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd.add_option("--threads", opt.threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
 }
 
 Episode replay(const WorldConfig& world, const std::vector<Action>& actions, std::uint64_t seed, const std::string& origin) {

@@ -224,7 +224,7 @@ void add_bench_command(CLI::App& app) {
   auto sim = std::make_shared<SimOptions>();
   CLI::App* cmd = bench->add_subcommand("sim", "Simulator throughput against a bare Box2D loop, 1 and N threads");
   sim->world.add_to(*cmd);
-  cmd->add_option("--threads", sim->threads, "Threads for the parallel run (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", sim->threads, "Threads for the parallel run (0 = all cores)")->check(threads_check())->capture_default_str();
   cmd->add_option("--episodes", sim->episodes, "Episodes per measurement")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--steps", sim->steps, "Control steps per episode")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--repeats", sim->repeats, "Measurements per figure (the median is reported)")

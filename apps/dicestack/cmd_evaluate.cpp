@@ -114,7 +114,7 @@ void add_evaluate_command(CLI::App& app, Cluster& cluster) {
                   "Also report train and test error (eq. 9) on this set: a folder, `builtin` or `human`");
   cmd->add_option("--episodes", opt->episodes, "Rollouts from random starts")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->check(seed_check())->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--initial-push", opt->push, "The paper's jump-start: none, left or right")
       ->check(CLI::IsMember({"none", "left", "right"}))
       ->capture_default_str();

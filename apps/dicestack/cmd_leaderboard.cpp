@@ -100,7 +100,7 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   const std::vector<std::string> formats = format_names(&formats_help);
   cmd->add_option("--format", r.format, formats_help)->check(CLI::IsMember(formats))->capture_default_str();
   cmd->add_option("--out", r.out, "Also write the table to this file (atomically)");
-  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--perturb", r.perturb,
                   "Roll out in perturbed worlds: none, easy, medium, hard or a perturbation file (docs/robustness.md); "
                   "training stays nominal")

@@ -142,7 +142,7 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--out", opt->out, "Demonstration folder to write (missing, empty, or a dicestack set, which is replaced whole)")->required();
   cmd->add_option("--demos", opt->demos,
                   "tracker: the recordings it follows (a demonstration folder, builtin or human)");
-  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--perturb", opt->perturb,
                   "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "
                   "medium, hard or a perturbation file (docs/robustness.md)")

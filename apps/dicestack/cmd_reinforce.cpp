@@ -70,7 +70,7 @@ void add_reinforce_command(CLI::App& app, Cluster& cluster) {
       ->capture_default_str();
   cmd->add_option("--learning-rate", r.learning_rate, "Adam step size")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", r.seed, "Seed")->check(seed_check())->capture_default_str();
-  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the greedy episode (a demonstration set) and reinforce.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt, &cluster] { run_reinforce(*opt, cluster); });

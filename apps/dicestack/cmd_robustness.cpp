@@ -35,6 +35,12 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   if (!opt.demos.empty() && opt.expert != "tracker")
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
   check_robustness_factors(opt.factors);
+  {
+    EvalRequest rows;  // the rollouts' count, checked before any recordings are read
+    rows.episodes = opt.episodes;
+    rows.threads = opt.threads;
+    check_evaluation(world, rows);
+  }
   if (!opt.out.empty() && cluster.is_root()) check_robustness_out(opt.out, opt.format);  // before any work
   PolicyFactory factory;
   RobustnessRun run;
@@ -103,7 +109,7 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--factors", opt->factors,
                   "Only these rows, comma-separated: none (nominal), all (every factor at once) or factor names (default: every one)")
       ->delimiter(',');
-  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   std::string formats_help;
   const std::vector<std::string> formats = robustness_format_names(&formats_help);
   cmd->add_option("--format", opt->format, formats_help)->check(CLI::IsMember(formats))->capture_default_str();

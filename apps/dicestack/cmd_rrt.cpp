@@ -65,7 +65,7 @@ void add_rrt_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--goal-bias", r.goal_bias, "Probability of growing towards the goal")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   cmd->add_option("--max-depth", r.max_depth_steps, "Nodes this many steps deep are not extended")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", r.seed, "Seed")->check(seed_check())->capture_default_str();
-  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", r.threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--out", opt->out, "Folder for the best path (a demonstration set) and rrt.json")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt, &cluster] { run_rrt(*opt, cluster); });

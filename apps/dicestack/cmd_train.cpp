@@ -95,7 +95,7 @@ void add_train_command(CLI::App& app, Cluster& cluster) {
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Model file to write")->required();
   cmd->add_option("--seed", opt->seed, "Seed of every random choice")->check(seed_check())->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--checkpoint", opt->checkpoint,
                   "Folder for an iterative learner's checkpoints (default: MODEL.checkpoint); kept after the run");
   cmd->add_flag("--resume", opt->resume, "Continue from the checkpoint's last finished iteration");

@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <dicestack/core/parallel.hpp>
 #include <dicestack/learners/train.hpp>
 
 namespace dicestack::cli {
@@ -73,6 +74,21 @@ std::filesystem::path DemosOption::resolve(const WorldConfig& world) const { ret
 
 std::filesystem::path DemosOption::resolve(const WorldConfig& world, Cluster& cluster) const {
   return on_root(cluster, [&] { return resolve(world).string(); });
+}
+
+CLI::Validator threads_check() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const long long n = std::stoll(text, &used);
+          if (used == text.size() && n >= 0 && n <= kMaxThreads) return "";
+        } catch (const std::exception&) {
+        }
+        return "threads is a whole number in [0, " + std::to_string(kMaxThreads) +
+               "] (0: all cores; results do not depend on it), got \"" + text.substr(0, 40) + "\"";
+      },
+      "THREADS");
 }
 
 CLI::Validator seed_check() {

@@ -24,6 +24,9 @@ struct WorldOption {
 /// alone reads -1 and 2^64 as 2^64 - 1, and "010" as octal).
 CLI::Validator seed_check();
 
+/// `--threads`: a whole number in [0, kMaxThreads] (0: all cores).
+CLI::Validator threads_check();
+
 /// Prints a JSON object or a human-readable text on stdout.
 void print_line(const std::string& text);
 

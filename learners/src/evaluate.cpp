@@ -165,11 +165,16 @@ Episode unpack_one(std::string_view bytes) { return episode_from_bytes(bytes); }
 
 }  // namespace
 
-EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,
-                   Cluster& cluster) {
+void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   validate(request.perturbation, world);
   require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "rollouts");
+  check_threads(request.threads, "evaluate: threads");
+}
+
+EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,
+                   Cluster& cluster) {
+  check_evaluation(world, request);
   RolloutOptions options;
   options.push = request.push;
   options.max_steps = request.max_steps;

@@ -1,6 +1,7 @@
 #include <dicestack/learners/leaderboard.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
@@ -641,8 +643,20 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   plan.learners = opt.learners.empty() ? plan.profile->learners : opt.learners;
   check_request(plan);
   plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
+  {
+    EvalRequest rollouts;
+    rollouts.episodes = plan.episodes;
+    rollouts.threads = opt.threads;
+    rollouts.perturbation = plan.perturbation;
+    check_evaluation(opt.world, rollouts);
+  }
   plan.set = read_demo_set(opt.demos);
   plan.combos = row_combos(plan, say);
+  // The table keeps every row's rollouts of every seed (the pages' per-episode results).
+  const long double rollouts = static_cast<long double>(plan.combos.size()) * opt.seeds * plan.episodes;
+  require_memory("leaderboard",
+                 rollouts >= 1.8e19L ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(rollouts),
+                 episode_memory_bound(opt.world.episode.max_steps), "rollouts (rows x seeds x episodes)");
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.
   const DemoSplit split(plan.set.episodes, opt.split);

@@ -64,7 +64,13 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
     if (request.reads_world) p.observation_noise = 0.0, p.observation_delay = 0;
     return p;
   };
-  for (const auto& [f, level] : plan) validate(perturbation(f, level), world);
+  for (const auto& [f, level] : plan) {
+    EvalRequest row;
+    row.episodes = request.episodes;
+    row.threads = request.threads;
+    row.perturbation = perturbation(f, level);
+    check_evaluation(world, row);
+  }
   std::vector<RobustnessRow> rows;
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const auto& [f, level] = plan[i];

@@ -287,9 +287,11 @@ std::optional<std::uint64_t> seed_from(const py::handle& seed, const char* what)
 
 int threads_from(const py::handle& threads) {
   if (threads.is_none()) return 0;
-  const int t = threads.cast<int>();
-  if (t < 0) throw py::value_error("threads must be >= 0 (0 or None: all cores), got " + std::to_string(t));
-  return t;
+  const long long t = threads.cast<long long>();
+  if (t < 0 || t > kMaxThreads)
+    throw py::value_error("threads must be in [0, " + std::to_string(kMaxThreads) + "] (0 or None: all cores), got " +
+                          std::to_string(t));
+  return static_cast<int>(t);
 }
 
 py::dict info_dict(const StepInfo& i) {

@@ -667,6 +667,28 @@ TEST(CliLearning, HugeCountsAreRefusedSayingWhatTheyWouldNeed) {
   p = run("evaluate --model " + model.string() + " --episodes 2000000000");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("evaluate: 2000000000 rollouts would need up to"));
+  // Thread counts: each thread holds a world; a count beyond the bound is refused at the edge.
+  for (const std::string& cmd : {"evaluate --model " + model.string() + " --episodes 2", "record --expert scripted --episodes 2 --out " + out.string(),
+                                "robustness --model " + model.string() + " --episodes 2"}) {
+    p = run(cmd + " --threads 100000000");
+    EXPECT_NE(p.status, 0) << cmd;
+    EXPECT_THAT(p.output, HasSubstr("threads is a whole number in [0, 1024]")) << cmd;
+    EXPECT_THAT(p.output, Not(HasSubstr("internal error"))) << cmd;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The leaderboard and the robustness table refuse their rollouts' count before training or
+  // any row.
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 1000000000");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("rollouts would need up to"));
+  EXPECT_THAT(p.output, Not(HasSubstr("[1/1]"))) << "refused before the first row";
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --episodes 2 --seeds 1000000000");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("rollouts (rows x seeds x episodes) would need up to"));
+  p = run("robustness --model " + model.string() + " --episodes 1000000000");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("rollouts would need up to"));
+  EXPECT_THAT(p.output, Not(HasSubstr("[1/"))) << "refused before the first row";
   std::filesystem::remove(model);
 }
 

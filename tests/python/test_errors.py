@@ -94,3 +94,9 @@ def test_bad_seeds_and_counts(started, builtin_episodes):
         model.predict(np.zeros((2, 23)))
     with pytest.raises(ValueError, match="observation"):
         model.policy().act(np.zeros(5))
+
+
+@pytest.mark.parametrize("threads", [-1, 1025, 10**8])
+def test_thread_counts_out_of_range_are_refused_before_any_work(threads):
+    with pytest.raises(ValueError, match=r"threads must be in \[0, 1024\]"):
+        dicestack.DiceStackVectorEnv(2, threads=threads)

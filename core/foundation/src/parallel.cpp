@@ -1,7 +1,9 @@
 #include <dicestack/core/parallel.hpp>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/core/interrupt.hpp>
 
+#include <string>
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -11,7 +13,14 @@
 
 namespace dicestack {
 
+void check_threads(int threads, std::string_view what) {
+  if (threads < 0 || threads > kMaxThreads)
+    throw ConfigError(std::string(what) + ": " + std::to_string(threads) + " is not in [0, " + std::to_string(kMaxThreads) +
+                      "] (0: all cores; results do not depend on the count)");
+}
+
 int resolve_threads(int threads) {
+  check_threads(threads);
   if (threads > 0) return threads;
   const unsigned hw = std::thread::hardware_concurrency();
   return hw == 0 ? 1 : static_cast<int>(hw);

@@ -114,6 +114,12 @@ struct EvalRequest {
   RolloutProgress progress;
 };
 
+/// Throws ConfigError, before any work, for an evaluation that could not run: a perturbation
+/// the world cannot take, more rollouts than this machine's memory holds, a thread count out of
+/// range. evaluate() calls it, and so does every command that evaluates after other work (the
+/// leaderboard, the robustness table), so that it refuses before that work.
+void check_evaluation(const WorldConfig& world, const EvalRequest& request);
+
 /// Rolls a policy out from request.episodes random starts (evaluation_start_seed(seed, i), in
 /// the episode's perturbed world), in parallel on `threads` threads with one world each; the
 /// result does not depend on the thread count.

@@ -3,10 +3,19 @@
 // slot i, and callers reduce the slots in index order afterwards (STYLE 15).
 #include <cstddef>
 #include <functional>
+#include <string_view>
 
 namespace dicestack {
 
+/// The most threads dicestack runs at once: each holds a world and a policy, and results do
+/// not depend on the count.
+inline constexpr int kMaxThreads = 1024;
+
+/// Throws ConfigError unless 0 <= threads <= kMaxThreads (0: all cores), naming `what`.
+void check_threads(int threads, std::string_view what = "threads");
+
 /// Number of threads `threads` stands for: itself if > 0, else the hardware's core count.
+/// Throws as check_threads does.
 int resolve_threads(int threads);
 
 /// Calls fn(i, worker) for every i in [0, n), on up to `threads` threads (0 = all cores).
