@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <new>
 #include <numeric>
@@ -16,47 +17,27 @@
 namespace dicestack {
 namespace {
 
-// Rounding slack of every bound: a node or row is skipped only when it is farther than the
-// k-th found by more than float arithmetic over 64 terms can be off, so the search stays exact.
+// Rounding slack of every bound: a box is skipped only when it lies farther than the k-th row
+// found by more than float arithmetic over 64 terms can be off, so the search stays exact.
 // Relative only: knn's rows are standardised, so no square underflows.
 constexpr float kSlack = 1e-4f;
 
 // 2-means steps that move each split plane after the median one.
 constexpr int kRefinements = 10;
 
-// Nodes waiting in the best-first queue; a node that finds it full is searched depth first.
-constexpr std::size_t kQueue = 512;
+// Nodes and leaves waiting in the best-first queue; a child that finds it full is searched
+// depth first at once.
+constexpr std::size_t kQueue = 1024;
 
 // Rows of a leaf measured in one call of the distance kernel.
 constexpr std::size_t kBlock = 64;
 
-bool beyond(float lower_bound, float bound, float scale) { return lower_bound > bound + kSlack * (scale + bound); }
-
 // Distances in 8 lanes (GCC vector extensions: two SSE halves or one AVX register, the same
-// arithmetic lane by lane), summed lane by lane over the columns in order, then the lanes
-// pairwise in one fixed order; no fused multiply-add (the build passes -ffp-contract=off and
-// the clones target AVX2 without FMA). So every CPU gets the same bits.
+// arithmetic lane by lane); no fused multiply-add (the build passes -ffp-contract=off and the
+// clones target AVX2 without FMA). So every CPU gets the same bits.
 using V8 = float __attribute__((vector_size(32)));
 using I8 = std::int32_t __attribute__((vector_size(32)));
-using H8 = std::uint16_t __attribute__((vector_size(16)));
 constexpr std::size_t kLanes = 8;
-
-// Boxes are stored as bfloat16 (a float's upper half), rounded outwards: half the memory the
-// search reads, and a box that only grows keeps every bound a bound.
-std::uint16_t bf16_down(float x) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  auto h = static_cast<std::uint16_t>(bits >> 16);
-  if ((bits & 0xffffu) != 0 && (bits >> 31) != 0) ++h;  // a negative value truncated towards zero: one step away
-  return h;
-}
-std::uint16_t bf16_up(float x) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  auto h = static_cast<std::uint16_t>(bits >> 16);
-  if ((bits & 0xffffu) != 0 && (bits >> 31) == 0) ++h;
-  return h;
-}
 
 inline V8 load(const float* p) {
   V8 v;
@@ -70,16 +51,9 @@ inline V8 vabs(V8 v) {
   std::memcpy(&v, &bits, sizeof v);
   return v;
 }
-inline V8 load_bf16(const std::uint16_t* p) {
-  H8 h;
-  std::memcpy(&h, p, sizeof h);
-  const I8 bits = __builtin_convertvector(h, I8) << 16;
-  V8 v;
-  std::memcpy(&v, &bits, sizeof v);
-  return v;
-}
 inline float reduce(V8 a) { return ((a[0] + a[4]) + (a[2] + a[6])) + ((a[1] + a[5]) + (a[3] + a[7])); }
 
+// One row against another: the columns in 8 lanes, each lane in column order, then the lanes.
 inline float sum_l2(const float* a, const float* b, std::size_t stride) {
   V8 acc = {};
   for (std::size_t j = 0; j < stride; j += kLanes) {
@@ -96,46 +70,39 @@ inline float sum_l1(const float* a, const float* b, std::size_t stride) {
 
 #define DICESTACK_CLONES __attribute__((target_clones("avx2", "default")))
 
-// Distances from `q` to the picked rows (squared under l2).
-DICESTACK_CLONES void rows_l2(const float* rows, std::size_t stride, const std::uint32_t* pick, std::size_t n, const float* q,
-                              float* out) {
-  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l2(rows + pick[m] * stride, q, stride);
+// Distances from `q` to n consecutive rows (squared under l2).
+DICESTACK_CLONES void rows_l2(const float* rows, std::size_t stride, std::size_t n, const float* q, float* out) {
+  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l2(rows + m * stride, q, stride);
 }
-DICESTACK_CLONES void rows_l1(const float* rows, std::size_t stride, const std::uint32_t* pick, std::size_t n, const float* q,
-                              float* out) {
-  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l1(rows + pick[m] * stride, q, stride);
+DICESTACK_CLONES void rows_l1(const float* rows, std::size_t stride, std::size_t n, const float* q, float* out) {
+  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l1(rows + m * stride, q, stride);
 }
-
-// How far `q` lies outside each of two boxes, stored as least then greatest values of each
-// column, one box after the other (squared under l2).
-DICESTACK_CLONES void boxes_l2(const std::uint16_t* boxes, const float* q, std::size_t stride, float* out) {
-  for (int b = 0; b < 2; ++b, boxes += 2 * stride) {
-    V8 acc = {};
-    const V8 zero = {};
-    for (std::size_t j = 0; j < stride; j += kLanes) {
-      const V8 x = load(q + j), below = load_bf16(boxes + j) - x, above = x - load_bf16(boxes + stride + j);
-      V8 t = below > above ? below : above;
-      t = t > zero ? t : zero;
-      acc += t * t;
-    }
-    out[b] = reduce(acc);
-  }
-}
-DICESTACK_CLONES void boxes_l1(const std::uint16_t* boxes, const float* q, std::size_t stride, float* out) {
-  for (int b = 0; b < 2; ++b, boxes += 2 * stride) {
-    V8 acc = {};
-    const V8 zero = {};
-    for (std::size_t j = 0; j < stride; j += kLanes) {
-      const V8 x = load(q + j), below = load_bf16(boxes + j) - x, above = x - load_bf16(boxes + stride + j);
-      V8 t = below > above ? below : above;
-      acc += t > zero ? t : zero;
-    }
-    out[b] = reduce(acc);
-  }
-}
-
 DICESTACK_CLONES float pair_l2(const float* a, const float* b, std::size_t stride) { return sum_l2(a, b, stride); }
 DICESTACK_CLONES float pair_l1(const float* a, const float* b, std::size_t stride) { return sum_l1(a, b, stride); }
+
+// How far `q` lies outside each of eight boxes, stored column by column: the eight least
+// values, then the eight greatest (squared under l2). A lane without a box holds +inf and -inf.
+DICESTACK_CLONES void boxes_l2(const float* boxes, const float* q, std::size_t cols, float* out) {
+  V8 acc = {};
+  const V8 zero = {};
+  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) {
+    const V8 below = load(boxes) - q[j], above = q[j] - load(boxes + kLanes);
+    V8 t = below > above ? below : above;
+    t = t > zero ? t : zero;
+    acc += t * t;
+  }
+  std::memcpy(out, &acc, sizeof acc);
+}
+DICESTACK_CLONES void boxes_l1(const float* boxes, const float* q, std::size_t cols, float* out) {
+  V8 acc = {};
+  const V8 zero = {};
+  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) {
+    const V8 below = load(boxes) - q[j], above = q[j] - load(boxes + kLanes);
+    const V8 t = below > above ? below : above;
+    acc += t > zero ? t : zero;
+  }
+  std::memcpy(out, &acc, sizeof acc);
+}
 
 template <class T>
 T* allocate(std::size_t n) {
@@ -146,18 +113,24 @@ T* allocate(std::size_t n) {
   return p;
 }
 
-void prefetch(const void* p, std::size_t bytes) {
-  for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(static_cast<const char*>(p) + at);
-}
-
 }  // namespace
 
+struct ClusterTree::Split {
+  std::uint32_t begin, end;  // rows [begin, end) in order_
+  std::uint32_t left = 0, right = 0;  // children (0: a leaf; the root is never a child)
+};
+
 // The k best so far, nearest first, in reported distances (squared under l2), equal distances
-// by input row; bound() is the k-th's metric distance, what a node's box and a leaf's ball are compared with.
+// by input row. limit(): a box farther than this (in reported distances) holds no better row.
 class ClusterTree::Best {
  public:
   Best(std::size_t k, bool squared, const std::vector<std::size_t>& order, std::size_t* index, float* distance)
-      : k_(k), squared_(squared), order_(order), index_(index), distance_(distance) {}
+      : k_(k), order_(order), index_(index), distance_(distance) {
+    // Metric distances b and a bound l: skip when l > b + kSlack (l + b), that is l (1 - kSlack)
+    // > b (1 + kSlack); squared under l2.
+    const float ratio = (1.0f + kSlack) / (1.0f - kSlack);
+    stretch_ = squared ? ratio * ratio : ratio;
+  }
 
   void offer(float d, std::size_t i) {
     if (n_ == k_ && !before(d, i, k_ - 1)) return;
@@ -170,9 +143,9 @@ class ClusterTree::Best {
     distance_[at] = d;
     index_[at] = i;
     if (n_ < k_) ++n_;
-    if (n_ == k_) bound_ = squared_ ? std::sqrt(distance_[k_ - 1]) : distance_[k_ - 1];
+    if (n_ == k_) limit_ = distance_[k_ - 1] * stretch_;
   }
-  float bound() const { return bound_; }
+  float limit() const { return limit_; }
   std::size_t size() const { return n_; }
 
  private:
@@ -181,11 +154,11 @@ class ClusterTree::Best {
   }
 
   std::size_t k_, n_ = 0;
-  bool squared_;
   const std::vector<std::size_t>& order_;
   std::size_t* index_;
   float* distance_;
-  float bound_ = std::numeric_limits<float>::infinity();
+  float stretch_;
+  float limit_ = std::numeric_limits<float>::infinity();
 };
 
 ClusterTree::ClusterTree(Rows rows, Metric metric, std::size_t leaf_size)
@@ -198,22 +171,13 @@ ClusterTree::ClusterTree(Rows rows, Metric metric, std::size_t leaf_size)
   order_.resize(static_cast<std::size_t>(rows.rows()));
   std::iota(order_.begin(), order_.end(), std::size_t{0});
   if (order_.empty()) return;
-  to_centre_.resize(order_.size());
-  std::vector<float> centres, boxes;
-  build(rows, 0, static_cast<std::uint32_t>(order_.size()), centres, boxes);
-  centres_.reset(allocate<float>(centres.size()));
-  std::copy(centres.begin(), centres.end(), centres_.get());
-  // Each inner node holds its children's boxes side by side: one run of memory per step down.
-  boxes_.reset(allocate<std::uint16_t>(nodes_.size() * 4 * stride_));
-  for (std::size_t id = 0; id < nodes_.size(); ++id) {
-    if (nodes_[id].left == 0) continue;
-    std::uint16_t* out = boxes_.get() + id * 4 * stride_;
-    for (const std::uint32_t child : {nodes_[id].left, nodes_[id].right}) {
-      const float* lo = boxes.data() + 2 * static_cast<std::size_t>(child) * stride_;
-      for (std::size_t j = 0; j < stride_; ++j) out[j] = bf16_down(lo[j]), out[stride_ + j] = bf16_up(lo[stride_ + j]);
-      out += 2 * stride_;
-    }
-  }
+  std::vector<Split> splits;
+  std::vector<float> boxes, wide_boxes;
+  split(rows, 0, static_cast<std::uint32_t>(order_.size()), splits, boxes);
+  if (splits[0].left == 0) leaves_.push_back({splits[0].begin, splits[0].end});
+  else widen(splits, boxes, 0, wide_boxes);
+  boxes_.reset(allocate<float>(wide_boxes.size()));
+  std::copy(wide_boxes.begin(), wide_boxes.end(), boxes_.get());
   // The rows of a leaf together: one cache-friendly run per leaf.
   rows_.reset(allocate<float>(order_.size() * stride_));
   for (std::size_t i = 0; i < order_.size(); ++i)
@@ -227,11 +191,7 @@ float ClusterTree::row_distance(const float* a, const float* b) const {
   return metric_ == Metric::l2 ? pair_l2(pa, pb, stride_) : pair_l1(pa, pb, stride_);
 }
 
-float ClusterTree::distance(const float* a, const float* b) const {
-  return metric_ == Metric::l2 ? std::sqrt(pair_l2(a, b, stride_)) : pair_l1(a, b, stride_);
-}
-
-std::uint32_t ClusterTree::build(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<float>& centres,
+std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits,
                                  std::vector<float>& boxes) {
   const std::size_t d = cols_;
   const auto row = [&](std::uint32_t i) { return rows.row(static_cast<Eigen::Index>(order_[i])).data(); };
@@ -240,29 +200,26 @@ std::uint32_t ClusterTree::build(Rows& rows, std::uint32_t begin, std::uint32_t 
     for (std::size_t j = 0; j < d; ++j) mean[j] += row(i)[j];
   for (double& m : mean) m /= static_cast<double>(end - begin);
 
-  const auto id = static_cast<std::uint32_t>(nodes_.size());
-  nodes_.push_back({begin, end});
-  centres.resize(centres.size() + stride_, 0.0f);
-  boxes.resize(boxes.size() + 2 * stride_, 0.0f);
-  float* c = centres.data() + static_cast<std::size_t>(id) * stride_;
-  for (std::size_t j = 0; j < d; ++j) c[j] = static_cast<float>(mean[j]);
-  float* lo = boxes.data() + 2 * static_cast<std::size_t>(id) * stride_;
-  float* hi = lo + stride_;
+  const auto id = static_cast<std::uint32_t>(splits.size());
+  splits.push_back({begin, end});
+  boxes.resize(boxes.size() + 2 * d);
+  float* lo = boxes.data() + 2 * static_cast<std::size_t>(id) * d;
+  float* hi = lo + d;
   std::copy_n(row(begin), d, lo);
   std::copy_n(row(begin), d, hi);
   for (std::uint32_t i = begin + 1; i < end; ++i)
     for (std::size_t j = 0; j < d; ++j) lo[j] = std::min(lo[j], row(i)[j]), hi[j] = std::max(hi[j], row(i)[j]);
-  float radius = 0.0f;
+  double radius = 0.0;  // the farthest row from the mean (metric distance)
   std::uint32_t farthest = begin;
-  alignas(64) float padded[kMaxCols] = {};
   for (std::uint32_t i = begin; i < end; ++i) {
-    std::copy_n(row(i), d, padded);
-    const float t = distance(padded, c);
-    to_centre_[i] = t;  // a leaf's rows keep their positions: this is final once the node is a leaf
+    double t = 0.0;
+    for (std::size_t j = 0; j < d; ++j) {
+      const double x = row(i)[j] - mean[j];
+      t += metric_ == Metric::l2 ? x * x : std::abs(x);
+    }
     if (t > radius) radius = t, farthest = i;
   }
-  nodes_[id].radius = radius;
-  if (end - begin <= leaf_size_ || radius == 0.0f) return id;
+  if (end - begin <= leaf_size_ || radius == 0.0) return id;
 
   // The principal direction by a few power iterations, from the farthest row's direction.
   std::vector<double> v(d), w(d);
@@ -334,56 +291,88 @@ std::uint32_t ClusterTree::build(Rows& rows, std::uint32_t begin, std::uint32_t 
     if (!on_right[i]) order_[begin + half++] = sides[i];
   for (std::uint32_t i = 0, r = half; i < n; ++i)
     if (on_right[i]) order_[begin + r++] = sides[i];
-  const std::uint32_t left = build(rows, begin, begin + half, centres, boxes);
-  const std::uint32_t right = build(rows, begin + half, end, centres, boxes);
-  nodes_[id].left = left;
-  nodes_[id].right = right;
+  const std::uint32_t left = split(rows, begin, begin + half, splits, boxes);
+  const std::uint32_t right = split(rows, begin + half, end, splits, boxes);
+  splits[id].left = left;
+  splits[id].right = right;
   return id;
 }
 
-void ClusterTree::children_bounds(std::uint32_t node, const float* query, float* bounds) const {
-  const std::uint16_t* boxes = children_boxes(node);
-  if (metric_ == Metric::l1) return boxes_l1(boxes, query, stride_, bounds);
-  boxes_l2(boxes, query, stride_, bounds);
-  bounds[0] = std::sqrt(bounds[0]);
-  bounds[1] = std::sqrt(bounds[1]);
-}
-
-void ClusterTree::scan_leaf(std::uint32_t id, const float* query, Best& best) const {
-  const Node& node = nodes_[id];
-  prefetch(row(node.begin), (node.end - node.begin) * stride_ * sizeof(float));
-  const float to_centre = distance(query, centre(id));
-  if (beyond(to_centre - node.radius, best.bound(), to_centre + node.radius)) return;
-  std::uint32_t pick[kBlock];
-  float found[kBlock];
-  for (std::uint32_t from = node.begin; from < node.end; from += kBlock) {
-    const std::uint32_t to = std::min<std::uint32_t>(node.end, from + kBlock);
-    const float bound = best.bound();  // stale within the block: it only skips fewer rows
-    std::size_t n = 0;
-    for (std::uint32_t i = from; i < to; ++i) {
-      const float t = to_centre_[i];
-      if (!beyond(std::abs(to_centre - t), bound, to_centre + t)) pick[n++] = i;
+std::uint32_t ClusterTree::widen(const std::vector<Split>& splits, const std::vector<float>& boxes, std::uint32_t top,
+                                 std::vector<float>& wide_boxes) {
+  // The children: the top split's, then the largest inner split among them replaced by its two,
+  // until there are eight (three levels of a balanced tree). Kept in row order.
+  std::vector<std::uint32_t> members = {splits[top].left, splits[top].right};
+  while (members.size() < kFan) {
+    std::size_t largest = members.size();
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      const Split& s = splits[members[m]];
+      if (s.left != 0 && (largest == members.size() || s.end - s.begin > splits[members[largest]].end - splits[members[largest]].begin))
+        largest = m;
     }
-    if (metric_ == Metric::l2) rows_l2(rows_.get(), stride_, pick, n, query, found);
-    else rows_l1(rows_.get(), stride_, pick, n, query, found);
-    for (std::size_t m = 0; m < n; ++m) best.offer(found[m], pick[m]);
+    if (largest == members.size()) break;
+    const Split& s = splits[members[largest]];
+    members[largest] = s.right;
+    members.insert(members.begin() + static_cast<std::ptrdiff_t>(largest), s.left);
+  }
+  const auto id = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.push_back({});
+  nodes_[id].children = static_cast<std::uint32_t>(members.size());
+  const std::size_t at = wide_boxes.size(), d = cols_;
+  wide_boxes.resize(at + 2 * kLanes * d);
+  for (std::size_t j = 0; j < d; ++j)
+    for (std::size_t lane = 0; lane < kLanes; ++lane) {
+      wide_boxes[at + 2 * kLanes * j + lane] = std::numeric_limits<float>::infinity();
+      wide_boxes[at + 2 * kLanes * j + kLanes + lane] = -std::numeric_limits<float>::infinity();
+    }
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const Split& s = splits[members[m]];
+    const float* lo = boxes.data() + 2 * static_cast<std::size_t>(members[m]) * d;
+    for (std::size_t j = 0; j < d; ++j) {
+      wide_boxes[at + 2 * kLanes * j + m] = lo[j];
+      wide_boxes[at + 2 * kLanes * j + kLanes + m] = lo[d + j];
+    }
+    std::uint32_t child;
+    if (s.left == 0) {
+      child = kLeaf | static_cast<std::uint32_t>(leaves_.size());
+      leaves_.push_back({s.begin, s.end});
+    } else {
+      child = widen(splits, boxes, members[m], wide_boxes);
+    }
+    nodes_[id].child[m] = child;
+  }
+  return id;
+}
+
+void ClusterTree::bounds(std::uint32_t node, const float* query, float* out) const {
+  const float* boxes = boxes_.get() + static_cast<std::size_t>(node) * 2 * kLanes * cols_;
+  if (metric_ == Metric::l2) boxes_l2(boxes, query, cols_, out);
+  else boxes_l1(boxes, query, cols_, out);
+}
+
+void ClusterTree::scan(const Leaf& leaf, const float* query, Best& best) const {
+  float found[kBlock];
+  for (std::uint32_t from = leaf.begin; from < leaf.end; from += kBlock) {
+    const std::size_t n = std::min<std::size_t>(leaf.end - from, kBlock);
+    if (metric_ == Metric::l2) rows_l2(row(from), stride_, n, query, found);
+    else rows_l1(row(from), stride_, n, query, found);
+    for (std::size_t m = 0; m < n; ++m) best.offer(found[m], from + m);
   }
 }
 
-void ClusterTree::visit(std::uint32_t id, float lower_bound, const float* query, Best& best) const {
-  if (beyond(lower_bound, best.bound(), lower_bound)) return;
-  const Node& node = nodes_[id];
-  if (node.left == 0) return scan_leaf(id, query, best);
-  float bounds[2];
-  children_bounds(id, query, bounds);
-  const float l = bounds[0], r = bounds[1];
-  if (l <= r) {
-    visit(node.left, l, query, best);
-    visit(node.right, r, query, best);
-  } else {
-    visit(node.right, r, query, best);
-    visit(node.left, l, query, best);
+void ClusterTree::visit(std::uint32_t child, float bound, const float* query, Best& best) const {
+  if (bound > best.limit()) return;
+  if (child & kLeaf) return scan(leaves_[child & ~kLeaf], query, best);
+  const Node& node = nodes_[child];
+  float b[kFan];
+  bounds(child, query, b);
+  std::uint32_t by_bound[kFan];  // nearest first (insertion: at most eight)
+  for (std::uint32_t m = 0; m < node.children; ++m) {
+    std::uint32_t at = m;
+    for (; at > 0 && b[by_bound[at - 1]] > b[m]; --at) by_bound[at] = by_bound[at - 1];
+    by_bound[at] = m;
   }
+  for (std::uint32_t m = 0; m < node.children; ++m) visit(node.child[by_bound[m]], b[by_bound[m]], query, best);
 }
 
 std::size_t ClusterTree::search(const float* query, std::size_t k, std::size_t* index, float* distance_out) const {
@@ -392,42 +381,59 @@ std::size_t ClusterTree::search(const float* query, std::size_t k, std::size_t* 
   alignas(64) float q[kMaxCols] = {};
   std::copy_n(query, cols_, q);
   Best best(k, metric_ == Metric::l2, order_, index, distance_out);
-  // Best first: the node whose box lies nearest is searched next, down to a leaf along the
-  // nearer child, the farther one queued; the search ends when the nearest queued box lies
-  // beyond the k-th row found.
-  struct Pending {
-    float bound;
-    std::uint32_t node;
-    bool operator<(const Pending& o) const { return bound > o.bound; }  // a min-heap
+  if (nodes_.empty()) {
+    scan(leaves_[0], q, best);
+    return best.size();
+  }
+  // Best first: the node or leaf whose box lies nearest is taken next, down along the nearest
+  // child with the others queued; the search ends when the nearest queued box lies farther
+  // than the k-th row found. A queued entry is its bound's bits (bounds are >= 0, so their
+  // bits order as the bounds do) above the child's reference: one integer comparison.
+  std::uint64_t queue[kQueue];
+  std::size_t waiting = 0;
+  const auto entry = [](float bound, std::uint32_t child) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &bound, sizeof bits);
+    return std::uint64_t{bits} << 32 | child;
   };
-  Pending queue[kQueue];
-  std::size_t queued = 0;
-  queue[queued++] = {0.0f, 0};
-  while (queued > 0) {
-    std::pop_heap(queue, queue + queued);
-    auto [lower_bound, id] = queue[--queued];
-    if (beyond(lower_bound, best.bound(), lower_bound)) break;
-    while (nodes_[id].left != 0) {
-      const Node& node = nodes_[id];
-      prefetch(children_boxes(node.left), 4 * stride_ * sizeof(std::uint16_t));
-      prefetch(children_boxes(node.right), 4 * stride_ * sizeof(std::uint16_t));
-      float bounds[2];
-      children_bounds(id, q, bounds);
-      float l = bounds[0], r = bounds[1];
-      std::uint32_t near = node.left, far = node.right;
-      if (r < l) std::swap(near, far), std::swap(l, r);
-      if (!beyond(r, best.bound(), r)) {
-        if (queued < kQueue) {
-          queue[queued++] = {r, far};
-          std::push_heap(queue, queue + queued);
+  const auto later = std::greater<std::uint64_t>();  // a min-heap
+  std::uint32_t child = 0;
+  for (;;) {
+    if (child & kLeaf) {
+      scan(leaves_[child & ~kLeaf], q, best);
+    } else {
+      const Node& node = nodes_[child];
+      float b[kFan];
+      bounds(child, q, b);
+      std::uint32_t nearest = kFan;
+      for (std::uint32_t m = 0; m < node.children; ++m) {
+        if (b[m] > best.limit()) continue;
+        std::uint32_t queued = m;
+        if (nearest == kFan) {
+          nearest = m;
+          continue;
+        }
+        if (b[m] < b[nearest]) std::swap(queued, nearest);
+        if (waiting == kQueue) {
+          visit(node.child[queued], b[queued], q, best);
         } else {
-          visit(far, r, q, best);
+          queue[waiting++] = entry(b[queued], node.child[queued]);
+          std::push_heap(queue, queue + waiting, later);
         }
       }
-      if (beyond(l, best.bound(), l)) break;
-      id = near;
+      if (nearest != kFan) {
+        child = node.child[nearest];
+        continue;
+      }
     }
-    if (nodes_[id].left == 0) scan_leaf(id, q, best);
+    if (waiting == 0) break;
+    std::pop_heap(queue, queue + waiting, later);
+    const std::uint64_t next = queue[--waiting];
+    const auto bits = static_cast<std::uint32_t>(next >> 32);
+    float bound;
+    std::memcpy(&bound, &bits, sizeof bound);
+    if (bound > best.limit()) break;
+    child = static_cast<std::uint32_t>(next);
   }
   return best.size();
 }

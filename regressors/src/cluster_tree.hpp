@@ -1,8 +1,10 @@
 #pragma once
 // Exact k nearest neighbours for wide rows (knn at dart's 49 inputs). A tree of clusters: each
-// node splits its rows in two as 2-means would, starting from the median along their principal
-// direction, and keeps their bounding box; the search skips a node whose box lies farther than
-// the k-th row found, and in a leaf a row whose distance to the leaf's centre says it must.
+// split divides its rows in two as 2-means would, starting from the median along their
+// principal direction; three levels of splits make one search node of up to eight children,
+// whose bounding boxes it keeps column by column, so that one pass over the columns bounds all
+// eight in the lanes of one vector. The search takes the node with the nearest box first and
+// skips every box that lies farther than the k-th row found.
 // Why not a k-d tree: its cells, cut along one coordinate at a time, fit trajectory rows badly
 // and its search visited most leaves (docs/regressors.md, "knn at any width").
 #include <cstddef>
@@ -28,24 +30,29 @@ class ClusterTree {
 
   /// The k (<= rows) nearest stored rows to `query` (cols() floats), nearest first: their
   /// stored indices and distances (squared under l2). Of rows at equal distance, the earlier
-  /// input row is nearer, so the answer does not depend on the tree. Every distance is summed
-  /// in one fixed order (8 lanes, then the lanes pairwise), so the answer does not depend on
-  /// the CPU either: the AVX2 and the baseline code give the same bits. Never allocates;
-  /// thread-safe.
+  /// input row is nearer, so the answer does not depend on the tree. Each distance is summed
+  /// in one fixed order (row_distance), so the answer does not depend on the CPU either.
+  /// Never allocates; thread-safe.
   std::size_t search(const float* query, std::size_t k, std::size_t* index, float* distance) const;
 
-  /// The distance search() computes between two rows of cols() floats (squared under l2):
-  /// what a brute-force search must compute to find the same rows bit for bit.
+  /// The distance search() computes between two rows of cols() floats (squared under l2): the
+  /// columns summed in 8 lanes, each lane in column order, then the lanes pairwise in one fixed
+  /// order, without fused multiply-adds. The AVX2 and the baseline x86-64 code give the same bits.
   float row_distance(const float* a, const float* b) const;
 
   const std::vector<std::size_t>& order() const { return order_; }
   std::size_t cols() const { return cols_; }
 
  private:
+  static constexpr std::size_t kFan = 8;  // children per search node: the vector lanes
+  static constexpr std::uint32_t kLeaf = 0x80000000u;  // a child reference with this bit is a leaf
+  struct Split;  // a node of the binary tree the build makes
   struct Node {
+    std::uint32_t child[kFan];  // a node's index, or kLeaf | a leaf's index
+    std::uint32_t children;
+  };
+  struct Leaf {
     std::uint32_t begin, end;  // stored rows [begin, end)
-    std::uint32_t left = 0, right = 0;  // children (0: a leaf; the root is never a child)
-    float radius = 0.0f;  // the farthest of its rows from its centre (metric distance)
   };
   struct Free {
     void operator()(void* p) const { std::free(p); }
@@ -54,25 +61,22 @@ class ClusterTree {
   using Aligned = std::unique_ptr<T[], Free>;  // 64-byte aligned
   class Best;
 
-  std::uint32_t build(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<float>& centres, std::vector<float>& boxes);
-  void visit(std::uint32_t node, float lower_bound, const float* query, Best& best) const;
-  void scan_leaf(std::uint32_t node, const float* query, Best& best) const;
-  void children_bounds(std::uint32_t node, const float* query, float* bounds) const;  // to the two children's boxes
-  float distance(const float* a, const float* b) const;  // metric distance (not squared), padded rows
+  std::uint32_t split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits, std::vector<float>& boxes);
+  std::uint32_t widen(const std::vector<Split>& splits, const std::vector<float>& boxes, std::uint32_t split,
+                      std::vector<float>& wide_boxes);
+  void visit(std::uint32_t child, float bound, const float* query, Best& best) const;
+  void scan(const Leaf& leaf, const float* query, Best& best) const;
+  void bounds(std::uint32_t node, const float* query, float* out) const;  // to each child's box
   const float* row(std::size_t i) const { return rows_.get() + i * stride_; }
-  const float* centre(std::uint32_t node) const { return centres_.get() + static_cast<std::size_t>(node) * stride_; }
-  const std::uint16_t* children_boxes(std::uint32_t node) const { return boxes_.get() + 4 * static_cast<std::size_t>(node) * stride_; }
 
   std::size_t cols_, stride_;  // stride_: cols_ rounded up to 8 lanes; the padding is zeros
   Metric metric_;
   std::size_t leaf_size_;
   std::vector<std::size_t> order_;
-  std::vector<Node> nodes_;
-  Aligned<float> rows_;     // the stored rows, padded to stride_
-  Aligned<float> centres_;  // per node: the mean of its rows
-  Aligned<std::uint16_t> boxes_;  // per inner node: its children's boxes (bfloat16, rounded outwards),
-                                  // each the least then the greatest value of each column
-  std::vector<float> to_centre_;  // each stored row's distance to its leaf's centre
+  std::vector<Node> nodes_;  // the root is nodes_[0] (none when all rows make one leaf)
+  std::vector<Leaf> leaves_;
+  Aligned<float> rows_;   // the stored rows, padded to stride_
+  Aligned<float> boxes_;  // per node, per column: its children's least values, then their greatest
 };
 
 }  // namespace dicestack
