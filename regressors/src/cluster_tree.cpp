@@ -80,27 +80,24 @@ DICESTACK_CLONES void rows_l1(const float* rows, std::size_t stride, std::size_t
 DICESTACK_CLONES float pair_l2(const float* a, const float* b, std::size_t stride) { return sum_l2(a, b, stride); }
 DICESTACK_CLONES float pair_l1(const float* a, const float* b, std::size_t stride) { return sum_l1(a, b, stride); }
 
-// How far `q` lies outside each of eight boxes, stored column by column: the eight least
-// values, then the eight greatest (squared under l2). A lane without a box holds +inf and -inf.
+// How far `q` lies outside each of eight boxes (squared under l2), stored column by column:
+// the eight centres, then the eight half-widths. Outside a box by t = max(|q - c|, w) - w: never
+// negative, and no comparison with zero. A lane without a box holds a half-width of -inf.
+inline V8 outside(const float* boxes, float x) {
+  const V8 w = load(boxes + kLanes), t = vabs(x - load(boxes));
+  return (t > w ? t : w) - w;
+}
 DICESTACK_CLONES void boxes_l2(const float* boxes, const float* q, std::size_t cols, float* out) {
   V8 acc = {};
-  const V8 zero = {};
   for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) {
-    const V8 below = load(boxes) - q[j], above = q[j] - load(boxes + kLanes);
-    V8 t = below > above ? below : above;
-    t = t > zero ? t : zero;
+    const V8 t = outside(boxes, q[j]);
     acc += t * t;
   }
   std::memcpy(out, &acc, sizeof acc);
 }
 DICESTACK_CLONES void boxes_l1(const float* boxes, const float* q, std::size_t cols, float* out) {
   V8 acc = {};
-  const V8 zero = {};
-  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) {
-    const V8 below = load(boxes) - q[j], above = q[j] - load(boxes + kLanes);
-    const V8 t = below > above ? below : above;
-    acc += t > zero ? t : zero;
-  }
+  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) acc += outside(boxes, q[j]);
   std::memcpy(out, &acc, sizeof acc);
 }
 
@@ -322,15 +319,19 @@ std::uint32_t ClusterTree::widen(const std::vector<Split>& splits, const std::ve
   wide_boxes.resize(at + 2 * kLanes * d);
   for (std::size_t j = 0; j < d; ++j)
     for (std::size_t lane = 0; lane < kLanes; ++lane) {
-      wide_boxes[at + 2 * kLanes * j + lane] = std::numeric_limits<float>::infinity();
+      wide_boxes[at + 2 * kLanes * j + lane] = 0.0f;
       wide_boxes[at + 2 * kLanes * j + kLanes + lane] = -std::numeric_limits<float>::infinity();
     }
   for (std::size_t m = 0; m < members.size(); ++m) {
     const Split& s = splits[members[m]];
     const float* lo = boxes.data() + 2 * static_cast<std::size_t>(members[m]) * d;
     for (std::size_t j = 0; j < d; ++j) {
-      wide_boxes[at + 2 * kLanes * j + m] = lo[j];
-      wide_boxes[at + 2 * kLanes * j + kLanes + m] = lo[d + j];
+      // The centre, and a half-width rounded up until the box holds [lo, hi] in float arithmetic.
+      const float c = static_cast<float>((static_cast<double>(lo[j]) + static_cast<double>(lo[d + j])) / 2.0);
+      float w = static_cast<float>(std::max(static_cast<double>(lo[d + j]) - c, c - static_cast<double>(lo[j])));
+      while (c - w > lo[j] || c + w < lo[d + j]) w = std::nextafter(w, std::numeric_limits<float>::infinity());
+      wide_boxes[at + 2 * kLanes * j + m] = c;
+      wide_boxes[at + 2 * kLanes * j + kLanes + m] = w;
     }
     std::uint32_t child;
     if (s.left == 0) {

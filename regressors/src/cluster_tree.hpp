@@ -76,7 +76,7 @@ class ClusterTree {
   std::vector<Node> nodes_;  // the root is nodes_[0] (none when all rows make one leaf)
   std::vector<Leaf> leaves_;
   Aligned<float> rows_;   // the stored rows, padded to stride_
-  Aligned<float> boxes_;  // per node, per column: its children's least values, then their greatest
+  Aligned<float> boxes_;  // per node, per column: its children's box centres, then half-widths
 };
 
 }  // namespace dicestack
