@@ -77,8 +77,6 @@ DICESTACK_CLONES void rows_l2(const float* rows, std::size_t stride, std::size_t
 DICESTACK_CLONES void rows_l1(const float* rows, std::size_t stride, std::size_t n, const float* q, float* out) {
   for (std::size_t m = 0; m < n; ++m) out[m] = sum_l1(rows + m * stride, q, stride);
 }
-DICESTACK_CLONES float pair_l2(const float* a, const float* b, std::size_t stride) { return sum_l2(a, b, stride); }
-DICESTACK_CLONES float pair_l1(const float* a, const float* b, std::size_t stride) { return sum_l1(a, b, stride); }
 
 // How far `q` lies outside each of eight boxes (squared under l2), stored column by column:
 // the eight centres, then the eight half-widths. Outside a box by t = max(|q - c|, w) - w: never
@@ -179,13 +177,6 @@ ClusterTree::ClusterTree(Rows rows, Metric metric, std::size_t leaf_size)
   rows_.reset(allocate<float>(order_.size() * stride_));
   for (std::size_t i = 0; i < order_.size(); ++i)
     std::copy_n(rows.row(static_cast<Eigen::Index>(order_[i])).data(), cols_, rows_.get() + i * stride_);
-}
-
-float ClusterTree::row_distance(const float* a, const float* b) const {
-  alignas(64) float pa[kMaxCols] = {}, pb[kMaxCols] = {};
-  std::copy_n(a, cols_, pa);
-  std::copy_n(b, cols_, pb);
-  return metric_ == Metric::l2 ? pair_l2(pa, pb, stride_) : pair_l1(pa, pb, stride_);
 }
 
 std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits,

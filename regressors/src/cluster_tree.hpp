@@ -28,20 +28,17 @@ class ClusterTree {
   /// the input index of stored row i.
   ClusterTree(Rows rows, Metric metric, std::size_t leaf_size);
 
-  /// The k (<= rows) nearest stored rows to `query` (cols() floats), nearest first: their
-  /// stored indices and distances (squared under l2). Of rows at equal distance, the earlier
-  /// input row is nearer, so the answer does not depend on the tree. Each distance is summed
-  /// in one fixed order (row_distance), so the answer does not depend on the CPU either.
-  /// Never allocates; thread-safe.
+  /// The k (<= rows) nearest stored rows to `query` (as many floats as a row), nearest first:
+  /// their stored indices and distances (squared under l2). Of rows at equal distance, the
+  /// earlier input row is nearer, so the answer does not depend on the tree. A distance is
+  /// summed in one fixed order: the float differences' squares (l1: magnitudes) in 8 lanes,
+  /// lane i summing columns i, i + 8, ... in order, then the lanes as ((0 + 4) + (2 + 6)) +
+  /// ((1 + 5) + (3 + 7)), with no fused multiply-add; the AVX2 and the baseline x86-64 code do
+  /// the same arithmetic lane by lane, so the answer does not depend on the CPU either. Never
+  /// allocates; thread-safe.
   std::size_t search(const float* query, std::size_t k, std::size_t* index, float* distance) const;
 
-  /// The distance search() computes between two rows of cols() floats (squared under l2): the
-  /// columns summed in 8 lanes, each lane in column order, then the lanes pairwise in one fixed
-  /// order, without fused multiply-adds. The AVX2 and the baseline x86-64 code give the same bits.
-  float row_distance(const float* a, const float* b) const;
-
   const std::vector<std::size_t>& order() const { return order_; }
-  std::size_t cols() const { return cols_; }
 
  private:
   static constexpr std::size_t kFan = 8;  // children per search node: the vector lanes

@@ -82,7 +82,7 @@ TEST(Knn, ClusterTreeIsExactOnWideTrajectoryLikeRowsWithRepeats) {
     }
 }
 
-// The cluster tree's distance (ClusterTree::row_distance): float differences, each of 8 lanes
+// The cluster tree's distance (ClusterTree::search): float differences, each of 8 lanes
 // summing columns j = lane, lane + 8, ... in order, then the lanes as ((0+4)+(2+6))+((1+5)+(3+7)).
 float documented_distance(const float* a, const float* b, Index cols, bool l1) {
   float lane[8] = {};
