@@ -2,32 +2,130 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <limits>
+#include <new>
 #include <numeric>
+#include <stdexcept>
+#include <string>
+
+// The 8-lane helpers below pass vectors by value; they are internal and inlined, so no ABI is
+// crossed and GCC's note that AVX changes it does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace dicestack {
 namespace {
 
-using Vec = Eigen::Map<const Eigen::VectorXf>;
-
-// Rounding slack of every bound: a node or row is skipped only when it is farther than the
-// k-th found by more than float arithmetic over 64 terms can be off, so the search stays exact.
+// Rounding slack of every bound: a box is skipped only when it lies farther than the k-th row
+// found by more than float arithmetic over 64 terms can be off, so the search stays exact.
 // Relative only: knn's rows are standardised, so no square underflows.
 constexpr float kSlack = 1e-4f;
 
 // 2-means steps that move each split plane after the median one.
 constexpr int kRefinements = 10;
 
-bool beyond(float lower_bound, float bound, float scale) { return lower_bound > bound + kSlack * (scale + bound); }
+// Nodes and leaves waiting in the best-first queue; a child that finds it full is searched
+// depth first at once.
+constexpr std::size_t kQueue = 1024;
+
+// Rows of a leaf measured in one call of the distance kernel.
+constexpr std::size_t kBlock = 64;
+
+// Distances in 8 lanes (GCC vector extensions: two SSE halves or one AVX register, the same
+// arithmetic lane by lane); no fused multiply-add (the build passes -ffp-contract=off and the
+// clones target AVX2 without FMA). So every CPU gets the same bits.
+using V8 = float __attribute__((vector_size(32)));
+using I8 = std::int32_t __attribute__((vector_size(32)));
+constexpr std::size_t kLanes = 8;
+
+inline V8 load(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline V8 vabs(V8 v) {
+  I8 bits;
+  std::memcpy(&bits, &v, sizeof v);
+  bits &= 0x7fffffff;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+inline float reduce(V8 a) { return ((a[0] + a[4]) + (a[2] + a[6])) + ((a[1] + a[5]) + (a[3] + a[7])); }
+
+// One row against another: the columns in 8 lanes, each lane in column order, then the lanes.
+inline float sum_l2(const float* a, const float* b, std::size_t stride) {
+  V8 acc = {};
+  for (std::size_t j = 0; j < stride; j += kLanes) {
+    const V8 t = load(a + j) - load(b + j);
+    acc += t * t;
+  }
+  return reduce(acc);
+}
+inline float sum_l1(const float* a, const float* b, std::size_t stride) {
+  V8 acc = {};
+  for (std::size_t j = 0; j < stride; j += kLanes) acc += vabs(load(a + j) - load(b + j));
+  return reduce(acc);
+}
+
+#define DICESTACK_CLONES __attribute__((target_clones("avx2", "default")))
+
+// Distances from `q` to n consecutive rows (squared under l2).
+DICESTACK_CLONES void rows_l2(const float* rows, std::size_t stride, std::size_t n, const float* q, float* out) {
+  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l2(rows + m * stride, q, stride);
+}
+DICESTACK_CLONES void rows_l1(const float* rows, std::size_t stride, std::size_t n, const float* q, float* out) {
+  for (std::size_t m = 0; m < n; ++m) out[m] = sum_l1(rows + m * stride, q, stride);
+}
+
+// How far `q` lies outside each of eight boxes (squared under l2), stored column by column:
+// the eight centres, then the eight half-widths. Outside a box by t = max(|q - c|, w) - w: never
+// negative, and no comparison with zero. A lane without a box holds a half-width of -inf.
+inline V8 outside(const float* boxes, float x) {
+  const V8 w = load(boxes + kLanes), t = vabs(x - load(boxes));
+  return (t > w ? t : w) - w;
+}
+DICESTACK_CLONES void boxes_l2(const float* boxes, const float* q, std::size_t cols, float* out) {
+  V8 acc = {};
+  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) {
+    const V8 t = outside(boxes, q[j]);
+    acc += t * t;
+  }
+  std::memcpy(out, &acc, sizeof acc);
+}
+DICESTACK_CLONES void boxes_l1(const float* boxes, const float* q, std::size_t cols, float* out) {
+  V8 acc = {};
+  for (std::size_t j = 0; j < cols; ++j, boxes += 2 * kLanes) acc += outside(boxes, q[j]);
+  std::memcpy(out, &acc, sizeof acc);
+}
+
+template <class T>
+T* allocate(std::size_t n) {
+  const std::size_t bytes = std::max<std::size_t>(64, (n * sizeof(T) + 63) / 64 * 64);
+  auto* p = static_cast<T*>(std::aligned_alloc(64, bytes));
+  if (!p) throw std::bad_alloc();
+  std::fill_n(p, bytes / sizeof(T), T{});
+  return p;
+}
 
 }  // namespace
 
+struct ClusterTree::Split {
+  std::uint32_t begin, end;  // rows [begin, end) in order_
+  std::uint32_t left = 0, right = 0;  // children (0: a leaf; the root is never a child)
+};
+
 // The k best so far, nearest first, in reported distances (squared under l2), equal distances
-// by input row; bound() is the k-th's metric distance, what a node's box and a leaf's ball are compared with.
+// by input row. limit(): a box farther than this (in reported distances) holds no better row.
 class ClusterTree::Best {
  public:
   Best(std::size_t k, bool squared, const std::vector<std::size_t>& order, std::size_t* index, float* distance)
-      : k_(k), squared_(squared), order_(order), index_(index), distance_(distance) {}
+      : k_(k), order_(order), index_(index), distance_(distance) {
+    // Metric distances b and a bound l: skip when l > b + kSlack (l + b), that is l (1 - kSlack)
+    // > b (1 + kSlack); squared under l2.
+    const float ratio = (1.0f + kSlack) / (1.0f - kSlack);
+    stretch_ = squared ? ratio * ratio : ratio;
+  }
 
   void offer(float d, std::size_t i) {
     if (n_ == k_ && !before(d, i, k_ - 1)) return;
@@ -40,9 +138,9 @@ class ClusterTree::Best {
     distance_[at] = d;
     index_[at] = i;
     if (n_ < k_) ++n_;
-    if (n_ == k_) bound_ = squared_ ? std::sqrt(distance_[k_ - 1]) : distance_[k_ - 1];
+    if (n_ == k_) limit_ = distance_[k_ - 1] * stretch_;
   }
-  float bound() const { return bound_; }
+  float limit() const { return limit_; }
   std::size_t size() const { return n_; }
 
  private:
@@ -51,60 +149,65 @@ class ClusterTree::Best {
   }
 
   std::size_t k_, n_ = 0;
-  bool squared_;
   const std::vector<std::size_t>& order_;
   std::size_t* index_;
   float* distance_;
-  float bound_ = std::numeric_limits<float>::infinity();
+  float stretch_;
+  float limit_ = std::numeric_limits<float>::infinity();
 };
 
 ClusterTree::ClusterTree(Rows rows, Metric metric, std::size_t leaf_size)
-    : rows_(std::move(rows)), metric_(metric), leaf_size_(std::max<std::size_t>(leaf_size, 1)) {
-  order_.resize(static_cast<std::size_t>(rows_.rows()));
+    : cols_(static_cast<std::size_t>(rows.cols())),
+      stride_((cols_ + kLanes - 1) / kLanes * kLanes),
+      metric_(metric),
+      leaf_size_(std::max<std::size_t>(leaf_size, 1)) {
+  if (cols_ > kMaxCols)
+    throw std::invalid_argument("ClusterTree: " + std::to_string(cols_) + " columns; at most " + std::to_string(kMaxCols));
+  order_.resize(static_cast<std::size_t>(rows.rows()));
   std::iota(order_.begin(), order_.end(), std::size_t{0});
   if (order_.empty()) return;
-  to_centre_.resize(order_.size());
-  build(0, static_cast<std::uint32_t>(order_.size()));
-  Rows sorted(rows_.rows(), rows_.cols());  // the rows of a leaf together: one cache-friendly run per leaf
+  std::vector<Split> splits;
+  std::vector<float> boxes, wide_boxes;
+  split(rows, 0, static_cast<std::uint32_t>(order_.size()), splits, boxes);
+  if (splits[0].left == 0) leaves_.push_back({splits[0].begin, splits[0].end});
+  else widen(splits, boxes, 0, wide_boxes);
+  boxes_.reset(allocate<float>(wide_boxes.size()));
+  std::copy(wide_boxes.begin(), wide_boxes.end(), boxes_.get());
+  // The rows of a leaf together: one cache-friendly run per leaf.
+  rows_.reset(allocate<float>(order_.size() * stride_));
   for (std::size_t i = 0; i < order_.size(); ++i)
-    sorted.row(static_cast<Eigen::Index>(i)) = rows_.row(static_cast<Eigen::Index>(order_[i]));
-  rows_ = std::move(sorted);
+    std::copy_n(rows.row(static_cast<Eigen::Index>(order_[i])).data(), cols_, rows_.get() + i * stride_);
 }
 
-float ClusterTree::distance(const float* a, const float* b) const {
-  const auto d = static_cast<Eigen::Index>(cols());
-  const auto diff = Vec(a, d) - Vec(b, d);
-  return metric_ == Metric::l2 ? std::sqrt(diff.squaredNorm()) : diff.cwiseAbs().sum();
-}
-
-std::uint32_t ClusterTree::build(std::uint32_t begin, std::uint32_t end) {
-  const std::size_t d = cols();
-  const auto row = [&](std::uint32_t i) { return rows_.row(static_cast<Eigen::Index>(order_[i])).data(); };
+std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits,
+                                 std::vector<float>& boxes) {
+  const std::size_t d = cols_;
+  const auto row = [&](std::uint32_t i) { return rows.row(static_cast<Eigen::Index>(order_[i])).data(); };
   std::vector<double> mean(d, 0.0);
   for (std::uint32_t i = begin; i < end; ++i)
     for (std::size_t j = 0; j < d; ++j) mean[j] += row(i)[j];
   for (double& m : mean) m /= static_cast<double>(end - begin);
 
-  const auto id = static_cast<std::uint32_t>(nodes_.size());
-  nodes_.push_back({begin, end});
-  for (const double m : mean) centres_.push_back(static_cast<float>(m));
-  boxes_.resize(centres_.size() * 2);
-  float* lo = boxes_.data() + 2 * static_cast<std::size_t>(id) * d;
+  const auto id = static_cast<std::uint32_t>(splits.size());
+  splits.push_back({begin, end});
+  boxes.resize(boxes.size() + 2 * d);
+  float* lo = boxes.data() + 2 * static_cast<std::size_t>(id) * d;
   float* hi = lo + d;
   std::copy_n(row(begin), d, lo);
   std::copy_n(row(begin), d, hi);
   for (std::uint32_t i = begin + 1; i < end; ++i)
     for (std::size_t j = 0; j < d; ++j) lo[j] = std::min(lo[j], row(i)[j]), hi[j] = std::max(hi[j], row(i)[j]);
-  const float* c = centre(id);
-  float radius = 0.0f;
+  double radius = 0.0;  // the farthest row from the mean (metric distance)
   std::uint32_t farthest = begin;
   for (std::uint32_t i = begin; i < end; ++i) {
-    const float t = distance(row(i), c);
-    to_centre_[i] = t;  // a leaf's rows keep their positions: this is final once the node is a leaf
+    double t = 0.0;
+    for (std::size_t j = 0; j < d; ++j) {
+      const double x = row(i)[j] - mean[j];
+      t += metric_ == Metric::l2 ? x * x : std::abs(x);
+    }
     if (t > radius) radius = t, farthest = i;
   }
-  nodes_[id].radius = radius;
-  if (end - begin <= leaf_size_ || radius == 0.0f) return id;
+  if (end - begin <= leaf_size_ || radius == 0.0) return id;
 
   // The principal direction by a few power iterations, from the farthest row's direction.
   std::vector<double> v(d), w(d);
@@ -176,51 +279,154 @@ std::uint32_t ClusterTree::build(std::uint32_t begin, std::uint32_t end) {
     if (!on_right[i]) order_[begin + half++] = sides[i];
   for (std::uint32_t i = 0, r = half; i < n; ++i)
     if (on_right[i]) order_[begin + r++] = sides[i];
-  const std::uint32_t left = build(begin, begin + half);
-  const std::uint32_t right = build(begin + half, end);
-  nodes_[id].left = left;
-  nodes_[id].right = right;
+  const std::uint32_t left = split(rows, begin, begin + half, splits, boxes);
+  const std::uint32_t right = split(rows, begin + half, end, splits, boxes);
+  splits[id].left = left;
+  splits[id].right = right;
   return id;
 }
 
-float ClusterTree::box_distance(std::uint32_t node, const float* query) const {
-  const auto d = static_cast<Eigen::Index>(cols());
-  const auto q = Vec(query, d).array();
-  const auto lo = Vec(box(node), d).array(), hi = Vec(box(node) + d, d).array();
-  const auto outside = (lo - q).max(q - hi).max(0.0f);  // per column: how far outside the box
-  return metric_ == Metric::l2 ? std::sqrt(outside.square().sum()) : outside.sum();
+std::uint32_t ClusterTree::widen(const std::vector<Split>& splits, const std::vector<float>& boxes, std::uint32_t top,
+                                 std::vector<float>& wide_boxes) {
+  // The children: the top split's, then the largest inner split among them replaced by its two,
+  // until there are eight (three levels of a balanced tree). Kept in row order.
+  std::vector<std::uint32_t> members = {splits[top].left, splits[top].right};
+  while (members.size() < kFan) {
+    std::size_t largest = members.size();
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      const Split& s = splits[members[m]];
+      if (s.left != 0 && (largest == members.size() || s.end - s.begin > splits[members[largest]].end - splits[members[largest]].begin))
+        largest = m;
+    }
+    if (largest == members.size()) break;
+    const Split& s = splits[members[largest]];
+    members[largest] = s.right;
+    members.insert(members.begin() + static_cast<std::ptrdiff_t>(largest), s.left);
+  }
+  const auto id = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.push_back({});
+  nodes_[id].children = static_cast<std::uint32_t>(members.size());
+  const std::size_t at = wide_boxes.size(), d = cols_;
+  wide_boxes.resize(at + 2 * kLanes * d);
+  for (std::size_t j = 0; j < d; ++j)
+    for (std::size_t lane = 0; lane < kLanes; ++lane) {
+      wide_boxes[at + 2 * kLanes * j + lane] = 0.0f;
+      wide_boxes[at + 2 * kLanes * j + kLanes + lane] = -std::numeric_limits<float>::infinity();
+    }
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const Split& s = splits[members[m]];
+    const float* lo = boxes.data() + 2 * static_cast<std::size_t>(members[m]) * d;
+    for (std::size_t j = 0; j < d; ++j) {
+      // The centre, and a half-width rounded up until the box holds [lo, hi] in float arithmetic.
+      const float c = static_cast<float>((static_cast<double>(lo[j]) + static_cast<double>(lo[d + j])) / 2.0);
+      float w = static_cast<float>(std::max(static_cast<double>(lo[d + j]) - c, c - static_cast<double>(lo[j])));
+      while (c - w > lo[j] || c + w < lo[d + j]) w = std::nextafter(w, std::numeric_limits<float>::infinity());
+      wide_boxes[at + 2 * kLanes * j + m] = c;
+      wide_boxes[at + 2 * kLanes * j + kLanes + m] = w;
+    }
+    std::uint32_t child;
+    if (s.left == 0) {
+      child = kLeaf | static_cast<std::uint32_t>(leaves_.size());
+      leaves_.push_back({s.begin, s.end});
+    } else {
+      child = widen(splits, boxes, members[m], wide_boxes);
+    }
+    nodes_[id].child[m] = child;
+  }
+  return id;
 }
 
-void ClusterTree::visit(std::uint32_t id, float lower_bound, const float* query, Best& best) const {
-  if (beyond(lower_bound, best.bound(), lower_bound)) return;
-  const Node& node = nodes_[id];
-  if (node.left == 0) {
-    const float to_centre = distance(query, centre(id));
-    if (beyond(to_centre - node.radius, best.bound(), to_centre + node.radius)) return;
-    const auto d = static_cast<Eigen::Index>(cols());
-    for (std::uint32_t i = node.begin; i < node.end; ++i) {
-      const float t = to_centre_[i];
-      if (beyond(std::abs(to_centre - t), best.bound(), to_centre + t)) continue;
-      const auto diff = Vec(rows_.row(static_cast<Eigen::Index>(i)).data(), d) - Vec(query, d);
-      best.offer(metric_ == Metric::l2 ? diff.squaredNorm() : diff.cwiseAbs().sum(), i);
-    }
-    return;
+void ClusterTree::bounds(std::uint32_t node, const float* query, float* out) const {
+  const float* boxes = boxes_.get() + static_cast<std::size_t>(node) * 2 * kLanes * cols_;
+  if (metric_ == Metric::l2) boxes_l2(boxes, query, cols_, out);
+  else boxes_l1(boxes, query, cols_, out);
+}
+
+void ClusterTree::scan(const Leaf& leaf, const float* query, Best& best) const {
+  float found[kBlock];
+  for (std::uint32_t from = leaf.begin; from < leaf.end; from += kBlock) {
+    const std::size_t n = std::min<std::size_t>(leaf.end - from, kBlock);
+    if (metric_ == Metric::l2) rows_l2(row(from), stride_, n, query, found);
+    else rows_l1(row(from), stride_, n, query, found);
+    for (std::size_t m = 0; m < n; ++m) best.offer(found[m], from + m);
   }
-  const float l = box_distance(node.left, query), r = box_distance(node.right, query);
-  if (l <= r) {
-    visit(node.left, l, query, best);
-    visit(node.right, r, query, best);
-  } else {
-    visit(node.right, r, query, best);
-    visit(node.left, l, query, best);
+}
+
+void ClusterTree::visit(std::uint32_t child, float bound, const float* query, Best& best) const {
+  if (bound > best.limit()) return;
+  if (child & kLeaf) return scan(leaves_[child & ~kLeaf], query, best);
+  const Node& node = nodes_[child];
+  float b[kFan];
+  bounds(child, query, b);
+  std::uint32_t by_bound[kFan];  // nearest first (insertion: at most eight)
+  for (std::uint32_t m = 0; m < node.children; ++m) {
+    std::uint32_t at = m;
+    for (; at > 0 && b[by_bound[at - 1]] > b[m]; --at) by_bound[at] = by_bound[at - 1];
+    by_bound[at] = m;
   }
+  for (std::uint32_t m = 0; m < node.children; ++m) visit(node.child[by_bound[m]], b[by_bound[m]], query, best);
 }
 
 std::size_t ClusterTree::search(const float* query, std::size_t k, std::size_t* index, float* distance_out) const {
   k = std::min(k, order_.size());
   if (k == 0) return 0;
+  alignas(64) float q[kMaxCols] = {};
+  std::copy_n(query, cols_, q);
   Best best(k, metric_ == Metric::l2, order_, index, distance_out);
-  visit(0, box_distance(0, query), query, best);
+  if (nodes_.empty()) {
+    scan(leaves_[0], q, best);
+    return best.size();
+  }
+  // Best first: the node or leaf whose box lies nearest is taken next, down along the nearest
+  // child with the others queued; the search ends when the nearest queued box lies farther
+  // than the k-th row found. A queued entry is its bound's bits (bounds are >= 0, so their
+  // bits order as the bounds do) above the child's reference: one integer comparison.
+  std::uint64_t queue[kQueue];
+  std::size_t waiting = 0;
+  const auto entry = [](float bound, std::uint32_t child) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &bound, sizeof bits);
+    return std::uint64_t{bits} << 32 | child;
+  };
+  const auto later = std::greater<std::uint64_t>();  // a min-heap
+  std::uint32_t child = 0;
+  for (;;) {
+    if (child & kLeaf) {
+      scan(leaves_[child & ~kLeaf], q, best);
+    } else {
+      const Node& node = nodes_[child];
+      float b[kFan];
+      bounds(child, q, b);
+      std::uint32_t nearest = kFan;
+      for (std::uint32_t m = 0; m < node.children; ++m) {
+        if (b[m] > best.limit()) continue;
+        std::uint32_t queued = m;
+        if (nearest == kFan) {
+          nearest = m;
+          continue;
+        }
+        if (b[m] < b[nearest]) std::swap(queued, nearest);
+        if (waiting == kQueue) {
+          visit(node.child[queued], b[queued], q, best);
+        } else {
+          queue[waiting++] = entry(b[queued], node.child[queued]);
+          std::push_heap(queue, queue + waiting, later);
+        }
+      }
+      if (nearest != kFan) {
+        child = node.child[nearest];
+        continue;
+      }
+    }
+    if (waiting == 0) break;
+    std::pop_heap(queue, queue + waiting, later);
+    const std::uint64_t next = queue[--waiting];
+    const auto bits = static_cast<std::uint32_t>(next >> 32);
+    float bound;
+    std::memcpy(&bound, &bits, sizeof bound);
+    if (bound > best.limit()) break;
+    child = static_cast<std::uint32_t>(next);
+  }
   return best.size();
 }
 

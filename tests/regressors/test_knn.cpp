@@ -4,7 +4,9 @@
 #include <string>
 #include <cmath>
 #include <numeric>
+#include <vector>
 
+#include <dicestack/core/rng.hpp>
 #include <dicestack/regressors/registry.hpp>
 #include <dicestack/test/helpers.hpp>
 
@@ -76,6 +78,66 @@ TEST(Knn, ClusterTreeIsExactOnWideTrajectoryLikeRowsWithRepeats) {
         knn->predict_row({query, static_cast<std::size_t>(wide)}, out);
         const auto expected = brute_force(x, y, query, kk, std::string(metric) == "metric=l1");
         for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << metric << " " << k << " query " << i;
+      }
+    }
+}
+
+// The cluster tree's distance (ClusterTree::search): float differences, each of 8 lanes
+// summing columns j = lane, lane + 8, ... in order, then the lanes as ((0+4)+(2+6))+((1+5)+(3+7)).
+float documented_distance(const float* a, const float* b, Index cols, bool l1) {
+  float lane[8] = {};
+  for (Index j = 0; j < cols; ++j) {
+    const float t = a[j] - b[j];
+    lane[j % 8] += l1 ? std::abs(t) : t * t;
+  }
+  return ((lane[0] + lane[4]) + (lane[2] + lane[6])) + ((lane[1] + lane[5]) + (lane[3] + lane[7]));
+}
+
+TEST(Knn, ClusterTreeSumsDistancesInTheDocumentedOrderBitForBit) {
+  // Rows with the same values in other columns lie at the same real distance from the origin,
+  // but float sums in another order differ in their last bits: which of them is nearest depends
+  // on the summation order. The tree (its AVX2 code on a CPU that has it, else the baseline
+  // code) must pick what a brute-force search with the documented order picks. Each row comes
+  // with its negative, so the column means are exactly 0 and knn's centring changes nothing.
+  const Index wide = 49, bases = 30, perms = 6;
+  Matrix x(2 * bases * perms, wide);
+  Rng rng(31);
+  for (Index b = 0; b < bases; ++b) {
+    std::vector<float> base(static_cast<std::size_t>(wide));
+    for (float& v : base) v = static_cast<float>(rng.uniform(-1.0, 1.0));
+    for (Index p = 0; p < perms; ++p) {
+      std::vector<float> row = base;
+      std::rotate(row.begin(), row.begin() + 1 + 3 * p, row.end());
+      for (Index j = 0; j < wide; ++j) {
+        x(2 * (b * perms + p), j) = row[static_cast<std::size_t>(j)];
+        x(2 * (b * perms + p) + 1, j) = -row[static_cast<std::size_t>(j)];
+      }
+    }
+  }
+  Matrix y(x.rows(), 1);
+  for (Index i = 0; i < x.rows(); ++i) y(i, 0) = static_cast<double>(1 << (i % 20)) + static_cast<double>(i);  // distinct labels
+  Matrix q = Matrix::Zero(8, wide);
+  for (Index i = 1; i < q.rows(); ++i)
+    for (Index j = 0; j < wide; ++j) q(i, j) = static_cast<double>(static_cast<float>(1e-3 * rng.uniform(-1.0, 1.0)));
+  for (const bool l1 : {false, true})
+    for (const int k : {1, 3}) {
+      auto knn = RegressorRegistry::global().create("knn", {"k=" + std::to_string(k), l1 ? "metric=l1" : "metric=l2", "leaf_size=4"});
+      knn->fit(x, y, 0);
+      for (Index i = 0; i < q.rows(); ++i) {
+        std::vector<float> qf(static_cast<std::size_t>(wide)), row(static_cast<std::size_t>(wide));
+        for (Index j = 0; j < wide; ++j) qf[static_cast<std::size_t>(j)] = static_cast<float>(q(i, j));
+        std::vector<std::pair<float, Index>> d;
+        for (Index r = 0; r < x.rows(); ++r) {
+          for (Index j = 0; j < wide; ++j) row[static_cast<std::size_t>(j)] = static_cast<float>(x(r, j));
+          d.emplace_back(documented_distance(row.data(), qf.data(), wide, l1), r);
+        }
+        std::sort(d.begin(), d.end());
+        double expected = 0.0;
+        for (int n = 0; n < k; ++n) expected += y(d[static_cast<std::size_t>(n)].second, 0);
+        expected /= k;
+        double out = 0.0;
+        knn->predict_row({q.row(i).data(), static_cast<std::size_t>(wide)}, {&out, 1});
+        EXPECT_EQ(out, expected) << (l1 ? "l1" : "l2") << " k " << k << " query " << i;
       }
     }
 }
