@@ -114,24 +114,20 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "cup+clock+start_state",
         "a pattern with feedback on the cup alone: the cup's position and velocity, t and the whole start state",
         Blocks{true, false, false, true, Current::cup}));
-    // Every map again, its regressor answering the cup velocity to set.
-    const std::size_t bases = v->size();
-    for (std::size_t i = 0; i < bases; ++i) {
-      const BuiltinFeatureMap& m = *(*v)[i];
-      v->push_back(std::make_unique<BuiltinFeatureMap>(
-          m.name() + std::string(kVelocityTargetSuffix),
-          m.description() + "; answers the cup velocity to set (the action is its difference from the cup's velocity)",
-          m.blocks(), ActionTarget::velocity));
-    }
-    // Every map again, acting for the moment its action lands (delays).
-    const std::size_t targets = v->size();
-    for (std::size_t i = 0; i < targets; ++i) {
-      const BuiltinFeatureMap& m = *(*v)[i];
-      v->push_back(std::make_unique<BuiltinFeatureMap>(
-          m.name() + std::string(kAheadSuffix),
-          m.description() + "; under delays, the cup moved ahead to where it is when the action lands",
-          m.blocks(), m.target(), true));
-    }
+    // Every map again, its regressor answering the cup velocity to set; then every one of
+    // those again, acting for the moment its action lands (delays).
+    auto twins = [v](std::string_view suffix, const std::string& what, bool velocity, bool ahead) {
+      const std::size_t maps = v->size();
+      for (std::size_t i = 0; i < maps; ++i) {
+        const BuiltinFeatureMap& m = *(*v)[i];
+        v->push_back(std::make_unique<BuiltinFeatureMap>(m.name() + std::string(suffix), m.description() + "; " + what,
+                                                         m.blocks(), velocity ? ActionTarget::velocity : m.target(),
+                                                         ahead || m.ahead()));
+      }
+    };
+    twins(kVelocityTargetSuffix, "answers the cup velocity to set (the action is its difference from the cup's velocity)",
+          true, false);
+    twins(kAheadSuffix, "under delays, the cup moved ahead to where it is when the action lands", false, true);
     return v;
   }();
   return *maps;

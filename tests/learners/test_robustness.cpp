@@ -95,15 +95,20 @@ PerturbationDraw bare_draw(const WorldConfig& w) {
   return d;
 }
 
+// One rollout of `p` in the world `w` with only what `d` sets perturbed.
+Episode perturbed_rollout(const WorldConfig& w, const PerturbationDraw& d, Policy& p, std::uint64_t seed = 1) {
+  RolloutOptions o;
+  o.perturbation = &d;
+  DiceEnv env(w);
+  return rollout(env, p, random_start_state(w, seed), seed, StepSource::policy, o);
+}
+
 TEST(Perturbed, ObservationDelayShowsOlderStates) {
   const WorldConfig w = test::short_world(30);
   PerturbationDraw d = bare_draw(w);
   d.observation_delay = 3;
-  RolloutOptions o;
-  o.perturbation = &d;
-  DiceEnv env(w);
   Watcher p;
-  const Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::policy, o);
+  const Episode e = perturbed_rollout(w, d, p);
   ASSERT_EQ(p.seen.size(), e.actions.size());
   for (std::size_t t = 0; t < p.seen.size(); ++t) EXPECT_EQ(p.seen[t], e.states[t >= 3 ? t - 3 : 0]) << t;
 }
@@ -144,11 +149,8 @@ TEST(Perturbed, PendingHoldsWhatRunsBeforeTheChoiceInOrder) {
   const WorldConfig w = test::short_world(12);
   PerturbationDraw d = bare_draw(w);
   d.action_delay = 3;
-  RolloutOptions o;
-  o.perturbation = &d;
-  DiceEnv env(w);
   PendingWatcher p;
-  const Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::policy, o);
+  const Episode e = perturbed_rollout(w, d, p);
   ASSERT_EQ(p.pending.size(), e.actions.size());
   for (std::size_t t = 0; t < p.pending.size(); ++t) {
     ASSERT_EQ(p.pending[t].size(), 3u) << t;
@@ -158,6 +160,7 @@ TEST(Perturbed, PendingHoldsWhatRunsBeforeTheChoiceInOrder) {
     }
   }
   PendingWatcher q;  // no delay: nothing pending
+  DiceEnv env(w);
   rollout(env, q, random_start_state(w, 1), 1, StepSource::policy);
   for (const auto& v : q.pending) EXPECT_TRUE(v.empty());
 }
