@@ -54,12 +54,18 @@ int run_learners() {
   print_line("(playback is an evaluation: the leaderboard's last row replays the demonstrations)");
   print_line("\nfeature maps (--features NAME): what a learned policy's regressor reads");
   for (const auto& name : feature_map_names()) {
+    if (name.find('/') != std::string::npos) continue;  // the twins are listed once, below
     const FeatureMap& m = feature_map(name);
     char line[256];
-    std::snprintf(line, sizeof line, "  %-18s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
+    std::snprintf(line, sizeof line, "  %-23s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
                   m.description().c_str());
     print_line(line);
   }
+  print_line("each also as NAME" + std::string(kVelocityTargetSuffix) +
+             " (the regressor answers the cup velocity to set; the action is that less the cup's velocity), NAME" +
+             std::string(kAheadSuffix) +
+             " (under delays, the cup moved ahead to where it is when the action lands) and NAME" +
+             std::string(kVelocityTargetSuffix) + std::string(kAheadSuffix) + " (both)");
   return 0;
 }
 

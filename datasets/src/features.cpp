@@ -117,8 +117,8 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
     // Every map again, its regressor answering the cup velocity to set; then every one of
     // those again, acting for the moment its action lands (delays).
     auto twins = [v](std::string_view suffix, const std::string& what, bool velocity, bool ahead) {
-      const std::size_t maps = v->size();
-      for (std::size_t i = 0; i < maps; ++i) {
+      const std::size_t before = v->size();
+      for (std::size_t i = 0; i < before; ++i) {
         const BuiltinFeatureMap& m = *(*v)[i];
         v->push_back(std::make_unique<BuiltinFeatureMap>(m.name() + std::string(suffix), m.description() + "; " + what,
                                                          m.blocks(), velocity ? ActionTarget::velocity : m.target(),

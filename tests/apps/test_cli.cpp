@@ -22,6 +22,7 @@
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/hash.hpp>
 #include <dicestack/core/perturbation.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/version.hpp>
 
 #include <dicestack/test/helpers.hpp>
@@ -653,6 +654,19 @@ TEST(CliInterrupt, CtrlCStopsALongRunAtOnceAndLeavesTheOldOutput) {
   kill(pid, SIGINT);
   EXPECT_EQ(wait_for(pid, 10.0), 130);
   EXPECT_FALSE(std::filesystem::exists(model));
+}
+
+TEST(Cli, LearnersListEachBaseFeatureMapAndTheirTwinsOnce) {
+  const Process p = run("learners", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  for (const auto& name : feature_map_names()) {
+    if (name.find('/') == std::string::npos) {
+      EXPECT_THAT(p.output, HasSubstr("  " + name + " ")) << name;
+    }
+  }
+  EXPECT_THAT(p.output, HasSubstr("each also as NAME/velocity"));
+  EXPECT_THAT(p.output, HasSubstr("NAME/ahead"));
+  EXPECT_THAT(p.output, Not(HasSubstr("state/ahead"))) << "the twins are not listed one by one";
 }
 
 TEST(CliLearning, HugeCountsAreRefusedSayingWhatTheyWouldNeed) {
