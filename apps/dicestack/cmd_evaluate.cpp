@@ -33,6 +33,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   auto model = std::make_shared<const Model>(load_model(opt.model));
+  check_ahead_world(model->features(), world);
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
   if (!opt.report.empty()) check_report_replaceable(opt.report);
   if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))

@@ -54,6 +54,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   request.factors = opt.factors;
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
+    check_ahead_world(model->features(), world);
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
     run.policy = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
     run.record = model->record;

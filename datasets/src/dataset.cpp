@@ -1,22 +1,33 @@
 #include <dicestack/datasets/dataset.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/perturbation.hpp>
 
 namespace dicestack {
 namespace {
 
 // The action delay an episode ran under (its perturbation's "action_delay"; 0 when nominal).
+// Its pending actions are rebuilt from its labels, which are what was chosen only where the
+// recording's actor labelled its own steps: a step the learner took (DAgger's mixture) records
+// the expert's label instead, so such an episode is refused.
 std::size_t action_delay_of(const Episode& e) {
   if (e.perturbation.empty()) return 0;
   const auto j = nlohmann::json::parse(e.perturbation, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("action_delay") || !j["action_delay"].is_number_unsigned())
-    throw InputError("episode \"" + e.name + "\": its perturbation has no \"action_delay\" (a whole number of steps)");
-  return j["action_delay"].get<std::size_t>();
+  if (j.is_discarded() || !j.is_object() || !j.contains("action_delay") || !j["action_delay"].is_number_unsigned() ||
+      j["action_delay"].get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxActionDelay))
+    throw InputError("episode \"" + e.name + "\": its perturbation's \"action_delay\" must be a whole number of steps in [0, " +
+                     std::to_string(kMaxActionDelay) + "]");
+  const auto delay = j["action_delay"].get<std::size_t>();
+  if (delay > 0 && std::find(e.sources.begin(), e.sources.end(), StepSource::policy) != e.sources.end())
+    throw InputError("episode \"" + e.name + "\" ran under an action delay with steps a learner chose, whose choices are not "
+                     "recorded (only the expert's labels): an \"/ahead\" map cannot rebuild what was pending");
+  return delay;
 }
 
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features) {

@@ -156,6 +156,16 @@ State cup_ahead(const History& h) {
   return s;
 }
 
+void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
+  if (!map.ahead()) return;
+  const PhysicsConfig nominal{}, &p = world.physics;
+  if (p.gravity.x != nominal.gravity.x || p.gravity.y != nominal.gravity.y || p.control_dt != nominal.control_dt ||
+      p.substeps != nominal.substeps)
+    throw ConfigError("feature map \"" + map.name() +
+                      "\" moves the cup ahead in the default world's physics (gravity, control_dt, substeps); this "
+                      "world's differ: use the map without \"" + std::string(kAheadSuffix) + "\"");
+}
+
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {
   const bool velocity = target() == ActionTarget::velocity;
   const State s = ahead() ? cup_ahead(h) : h.current();

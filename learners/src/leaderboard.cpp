@@ -1,7 +1,6 @@
 #include <dicestack/learners/leaderboard.hpp>
 
 #include <algorithm>
-#include <limits>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -652,10 +651,10 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   }
   plan.set = read_demo_set(opt.demos);
   plan.combos = row_combos(plan, say);
+  for (const auto& [learner, features] : plan.combos) check_ahead_world(feature_map(features), opt.world);
   // The table keeps every row's rollouts of every seed (the pages' per-episode results).
-  const long double rollouts = static_cast<long double>(plan.combos.size()) * opt.seeds * plan.episodes;
-  require_memory("leaderboard",
-                 rollouts >= 1.8e19L ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(rollouts),
+  const double rollouts = static_cast<double>(plan.combos.size()) * opt.seeds * plan.episodes;
+  require_memory("leaderboard", static_cast<std::uint64_t>(std::min(rollouts, 1e18)),
                  episode_memory_bound(opt.world.episode.max_steps), "rollouts (rows x seeds x episodes)");
   // Episode split: learners get the training episodes. Row split (the paper's protocol): they
   // get the training rows as one pseudo-episode, as the paper fitted on shuffled rows.

@@ -58,6 +58,9 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
   }
   if (wanted("all"))
     for (const char* level : {"easy", "medium", "hard"}) plan.emplace_back("all", level);
+  if (plan.empty())
+    throw ConfigError("robustness: no row to measure: an expert reads the world itself, so its table leaves out the "
+                      "sensing factors (observation_noise, observation_delay)");
   // Every perturbation is checked against the world before any row runs.
   auto perturbation = [&](const std::string& f, const std::string& level) {
     Perturbation p = f == "none" ? Perturbation{} : f == "all" ? perturbation_level(level) : perturbation_factor(f, level);

@@ -22,6 +22,7 @@ TrainReport train_model(const TrainRequest& request) {
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(
       request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
+  check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
   const DemoSplit split(request.demos, request.split);

@@ -287,6 +287,13 @@ std::optional<std::uint64_t> seed_from(const py::handle& seed, const char* what)
 
 int threads_from(const py::handle& threads) {
   if (threads.is_none()) return 0;
+  if (!py::isinstance<py::int_>(threads) || py::isinstance<py::bool_>(threads))
+    throw py::value_error("threads must be a whole number in [0, " + std::to_string(kMaxThreads) + "] or None, got " +
+                          py::repr(threads).cast<std::string>());
+  const py::int_ big(kMaxThreads);
+  if (threads.attr("__gt__")(big).cast<bool>())
+    throw py::value_error("threads must be in [0, " + std::to_string(kMaxThreads) + "] (0 or None: all cores), got " +
+                          py::str(threads).cast<std::string>());
   const long long t = threads.cast<long long>();
   if (t < 0 || t > kMaxThreads)
     throw py::value_error("threads must be in [0, " + std::to_string(kMaxThreads) + "] (0 or None: all cores), got " +

@@ -173,6 +173,7 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   std::optional<std::vector<Episode>> demo_episodes;
   if (!demos.is_none()) demo_episodes = demos_from(demos, world, nullptr);
   std::shared_ptr<const Model> model = m.model;
+  check_ahead_world(model->features(), world);
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
   std::vector<Episode> rollouts;

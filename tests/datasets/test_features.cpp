@@ -235,6 +235,25 @@ TEST(Features, DatasetRowsOfAnAheadMapRunThroughTheEpisodesOwnDelay) {
       << "the base map shows the cup as recorded";
   e.perturbation = R"({"dice_mass": 0.5})";
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"action_delay\""));
+  e.perturbation = R"({"action_delay": 1000000000000})";  // a user's file: bounded, not allocated
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("in [0, 100]"));
+  // A step a learner took (DAgger) records the expert's label, not what was pending.
+  e.perturbation = R"({"action_delay": 2})";
+  e.sources[1] = StepSource::policy;
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("steps a learner chose"));
+  EXPECT_NO_THROW(make_dataset({e}, feature_map("state+clock"))) << "a map that reads no pending actions";
+}
+
+TEST(Features, AheadMapsRefuseAWorldWhosePhysicsTheyDoNotPredict) {
+  WorldConfig w;
+  EXPECT_NO_THROW(check_ahead_world(feature_map("state/ahead"), w));
+  w.physics.gravity.y = -9.81;
+  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state/ahead"), w); }), HasSubstr("default world's physics"));
+  EXPECT_NO_THROW(check_ahead_world(feature_map("state"), w));
+  w = WorldConfig{};
+  w.physics.substeps = 8;
+  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state+clock/velocity/ahead"), w); }),
+              HasSubstr("state+clock/velocity/ahead"));
 }
 
 }  // namespace

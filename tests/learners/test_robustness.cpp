@@ -254,8 +254,11 @@ TEST(Robustness, FactorsChooseTheRowsInTheTablesOrderAndAnUnknownOneIsRefusedFir
       return row.factor == some[i].factor && row.level == some[i].level;
     });
     ASSERT_NE(same, all.end());
-    EXPECT_EQ(same->stats.dice_in_cup_mean, some[i].stats.dice_in_cup_mean) << "a row does not depend on the others";
   }
+  r.reads_world = true;  // an expert: sensing rows alone leave nothing to measure
+  r.factors = {"observation_noise"};
+  EXPECT_THAT(test::error_of([&] { robustness(watcher, w, r); }), HasSubstr("no row to measure"));
+  r.reads_world = false;
   std::atomic<int> made{0};
   r.factors = {"none", "wind"};
   EXPECT_THAT(test::error_of([&] {

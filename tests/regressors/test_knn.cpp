@@ -73,8 +73,14 @@ TEST(Knn, ClusterTreeIsExactOnWideTrajectoryLikeRowsWithRepeats) {
       knn->fit(x, y, 0);
       const int kk = std::stoi(std::string(k).substr(2));
       double out[3];
-      for (Index i = 0; i < q.rows() + 12; ++i) {
-        const double* query = i < q.rows() ? q.row(i).data() : x.row((i - q.rows()) * steps + 3).data();  // a repeated row
+      for (Index i = 0; i < q.rows() + 24; ++i) {
+        Eigen::VectorXd near;
+        const double* query = i < q.rows() ? q.row(i).data() : x.row(((i - q.rows()) % 12) * steps + 3).data();  // a repeated row
+        if (i >= q.rows() + 12) {  // a hair (1e-6) off a training row in one column: bounds near distance 0
+          near = x.row(((i - q.rows()) % 12) * steps + 17).transpose();
+          near((i * 7) % wide) += 1e-6;
+          query = near.data();
+        }
         knn->predict_row({query, static_cast<std::size_t>(wide)}, out);
         const auto expected = brute_force(x, y, query, kk, std::string(metric) == "metric=l1");
         for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << metric << " " << k << " query " << i;
@@ -91,6 +97,16 @@ float documented_distance(const float* a, const float* b, Index cols, bool l1) {
     lane[j % 8] += l1 ? std::abs(t) : t * t;
   }
   return ((lane[0] + lane[4]) + (lane[2] + lane[6])) + ((lane[1] + lane[5]) + (lane[3] + lane[7]));
+}
+
+// The same terms summed in another order (column by column): the negative control.
+float sequential_distance(const float* a, const float* b, Index cols, bool l1) {
+  float sum = 0.0f;
+  for (Index j = 0; j < cols; ++j) {
+    const float t = a[j] - b[j];
+    sum += l1 ? std::abs(t) : t * t;
+  }
+  return sum;
 }
 
 TEST(Knn, ClusterTreeSumsDistancesInTheDocumentedOrderBitForBit) {
@@ -119,6 +135,7 @@ TEST(Knn, ClusterTreeSumsDistancesInTheDocumentedOrderBitForBit) {
   Matrix q = Matrix::Zero(8, wide);
   for (Index i = 1; i < q.rows(); ++i)
     for (Index j = 0; j < wide; ++j) q(i, j) = static_cast<double>(static_cast<float>(1e-3 * rng.uniform(-1.0, 1.0)));
+  int order_tells = 0;  // queries where the other order picks other rows
   for (const bool l1 : {false, true})
     for (const int k : {1, 3}) {
       auto knn = RegressorRegistry::global().create("knn", {"k=" + std::to_string(k), l1 ? "metric=l1" : "metric=l2", "leaf_size=4"});
@@ -126,20 +143,25 @@ TEST(Knn, ClusterTreeSumsDistancesInTheDocumentedOrderBitForBit) {
       for (Index i = 0; i < q.rows(); ++i) {
         std::vector<float> qf(static_cast<std::size_t>(wide)), row(static_cast<std::size_t>(wide));
         for (Index j = 0; j < wide; ++j) qf[static_cast<std::size_t>(j)] = static_cast<float>(q(i, j));
-        std::vector<std::pair<float, Index>> d;
-        for (Index r = 0; r < x.rows(); ++r) {
-          for (Index j = 0; j < wide; ++j) row[static_cast<std::size_t>(j)] = static_cast<float>(x(r, j));
-          d.emplace_back(documented_distance(row.data(), qf.data(), wide, l1), r);
-        }
-        std::sort(d.begin(), d.end());
-        double expected = 0.0;
-        for (int n = 0; n < k; ++n) expected += y(d[static_cast<std::size_t>(n)].second, 0);
-        expected /= k;
+        auto mean_of_nearest = [&](float (*distance)(const float*, const float*, Index, bool)) {
+          std::vector<std::pair<float, Index>> d;
+          for (Index r = 0; r < x.rows(); ++r) {
+            for (Index j = 0; j < wide; ++j) row[static_cast<std::size_t>(j)] = static_cast<float>(x(r, j));
+            d.emplace_back(distance(row.data(), qf.data(), wide, l1), r);
+          }
+          std::sort(d.begin(), d.end());
+          double mean = 0.0;
+          for (int n = 0; n < k; ++n) mean += y(d[static_cast<std::size_t>(n)].second, 0);
+          return mean / k;
+        };
+        const double expected = mean_of_nearest(documented_distance);
+        order_tells += mean_of_nearest(sequential_distance) != expected;
         double out = 0.0;
         knn->predict_row({q.row(i).data(), static_cast<std::size_t>(wide)}, {&out, 1});
         EXPECT_EQ(out, expected) << (l1 ? "l1" : "l2") << " k " << k << " query " << i;
       }
     }
+  EXPECT_GT(order_tells, 0) << "the rows must tell the documented summation order from another";
 }
 
 TEST(Knn, PrincipalAxesSearchMatchesBruteForceOnCorrelatedStates) {

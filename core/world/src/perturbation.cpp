@@ -133,7 +133,7 @@ void validate(const Perturbation& p, const WorldConfig& world, const std::string
   require(p.action_bias >= 0 && p.action_bias <= 10, "action_bias", "in [0, 10]", p.action_bias);
   require(p.observation_noise >= 0 && p.observation_noise <= 10, "observation_noise", "in [0, 10]", p.observation_noise);
   require(p.start_widening >= 0 && p.start_widening <= 3, "start_widening", "in [0, 3]", p.start_widening);
-  const int room = std::min(100, world.episode.max_steps - 1);
+  const int room = std::min(kMaxActionDelay, world.episode.max_steps - 1);
   const std::string delays = "in [0, " + std::to_string(room) + "] (shorter than the episode's " +
                              std::to_string(world.episode.max_steps) + " steps)";
   require(p.action_delay >= 0 && p.action_delay <= room, "action_delay", delays, p.action_delay);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <dicestack/core/types.hpp>
+#include <dicestack/core/world_config.hpp>
 
 namespace dicestack {
 
@@ -78,6 +79,10 @@ class FeatureMap {
 /// nominal world (each action a velocity change, then gravity, no contact). The dice stay as
 /// shown. The current state itself when nothing is unseen or pending.
 State cup_ahead(const History& history);
+
+/// Throws ConfigError if `map` is an "/ahead" map and `world`'s physics (gravity, control step,
+/// substeps) is not the default world's, which cup_ahead() moves the cup in.
+void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 
 /// The built-in maps, by name:
 ///  - "state": the 24 state numbers (the paper's input; what every model before format 2 used)

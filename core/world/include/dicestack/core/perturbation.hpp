@@ -67,6 +67,9 @@ std::string perturbation_to_json(const Perturbation& p);
 std::string perturbation_summary(const Perturbation& p);
 Perturbation perturbation_from_json(std::string_view text, const std::string& source, const WorldConfig& world);
 
+/// The longest delay, in control steps, of either kind (and shorter than the episode).
+inline constexpr int kMaxActionDelay = 100;
+
 /// What one episode got.
 struct PerturbationDraw {
   WorldConfig world;        ///< the world it runs in (physics and start ranges changed)
