@@ -164,6 +164,22 @@ TEST(Knn, ClusterTreeSumsDistancesInTheDocumentedOrderBitForBit) {
   EXPECT_GT(order_tells, 0) << "the rows must tell the documented summation order from another";
 }
 
+TEST(Knn, ClusterTreeStaysExactWhenItsQueueOfNodesIsFull) {
+  // Many leaves and far queries with a large k: nearly every node passes its bound, more than
+  // the best-first queue holds, and the search goes on depth first; still brute force's rows.
+  const Index rows = 40000, wide = 24;
+  const Matrix x = random_matrix(rows, wide, 41), y = random_matrix(rows, 3, 42);
+  const Matrix q = 6.0 * random_matrix(4, wide, 43);
+  auto knn = RegressorRegistry::global().create("knn", {"k=64", "leaf_size=4"});
+  knn->fit(x, y, 0);
+  double out[3];
+  for (Index i = 0; i < q.rows(); ++i) {
+    knn->predict_row({q.row(i).data(), static_cast<std::size_t>(wide)}, out);
+    const auto expected = brute_force(x, y, q.row(i).data(), 64, false);
+    for (int j = 0; j < 3; ++j) ASSERT_NEAR(out[j], expected[static_cast<std::size_t>(j)], 1e-12) << "query " << i;
+  }
+}
+
 TEST(Knn, PrincipalAxesSearchMatchesBruteForceOnCorrelatedStates) {
   // States on a few correlated directions (as the dice move with the cup): the rotated and the
   // unrotated tree find the brute-force neighbours.
