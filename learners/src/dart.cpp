@@ -15,11 +15,17 @@ class Dart final : public Learner {
  public:
   using Learner::Learner;
 
+  // DART's noise in dvy and dw when the tracker demonstrates (fractions of action.scale).
+  static constexpr double kTrackerNoiseDvy = 0.5, kTrackerNoiseDw = 0.2;
+
   LearnResult learn(const LearnContext& c) const override {
     const Perturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
     const int episodes = static_cast<int>(params().integer("episodes"));
     const double noise = params().real("noise");
     Action fraction{noise, noise, noise};
+    // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
+    // that (docs/learners.md: 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
+    if (params().choice("expert") == "tracker") fraction = {noise, kTrackerNoiseDvy, kTrackerNoiseDw};
     const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
     for (std::size_t k = 0; k < kActionDim; ++k)
       if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
@@ -73,8 +79,8 @@ class Dart final : public Learner {
             {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
-            {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise)", {}},
-            {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise)", {}},
+            {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise; with expert=tracker, 0.5)", {}},
+            {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise; with expert=tracker, 0.2)", {}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "noisy demonstrations from random training starts", {}},
             {"mpc_robust", ParamType::integer, "0", 0, 1000,
              "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},

@@ -79,6 +79,18 @@ class DiceStackVectorEnv(_VectorBase):
         self.closed = True
 
     @property
+    def pending(self):
+        """Per environment, the (d, 3) actions that run before its next one under an action delay
+        (DiceStackEnv.pending); (0, 3) arrays without a delay."""
+        return self._vec.pending
+
+    @property
+    def unseen(self):
+        """Per environment, the actions that ran since the state its observation shows
+        (DiceStackEnv.unseen)."""
+        return self._vec.unseen
+
+    @property
     def world(self):
         """The world config as a dict (`dicestack config`'s format)."""
         return world_dict(self._world)

@@ -196,6 +196,12 @@ class VectorEnv {
   }
 
   std::size_t size() const { return envs_.size(); }
+  /// Each environment's pending (or unseen) actions under its delays, as (d, 3) arrays.
+  py::list queues(bool pending) const {
+    py::list out;
+    for (const EnvCore& e : envs_) out.append(rows_to_array(pending ? e.pending() : e.unseen()));
+    return out;
+  }
 
   // The count checked before the pool's threads start: at least 1, and within memory.
   static int pool_size(long long num_envs, int threads) {
@@ -389,7 +395,9 @@ void bind_env(py::module_& m) {
             return v.reset(s);
           },
           py::arg("seeds"))
-      .def("step", &VectorEnv::step, py::arg("actions"));
+      .def("step", &VectorEnv::step, py::arg("actions"))
+      .def_property_readonly("pending", [](const VectorEnv& v) { return v.queues(true); })
+      .def_property_readonly("unseen", [](const VectorEnv& v) { return v.queues(false); });
 }
 
 }  // namespace dicestack::python

@@ -148,3 +148,17 @@ def test_a_policy_on_an_ahead_map_reads_what_is_pending(builtin_episodes):
     assert differ > 0
     with pytest.raises(ValueError, match="pending"):
         model.policy().act(obs, pending=np.zeros((2, 4)))
+
+
+def test_the_vector_env_shows_each_environments_pending_actions():
+    vec = dicestack.DiceStackVectorEnv(3, perturb={"action_delay": 2, "observation_delay": 1}, threads=1)
+    vec.reset(seed=5)
+    assert [p.shape for p in vec.pending] == [(2, 3)] * 3 and not any(p.any() for p in vec.pending)
+    actions = np.array([[0.1, 0.0, 0.0], [0.2, 0.0, 0.0], [0.3, 0.0, 0.0]])
+    vec.step(actions)
+    for i, p in enumerate(vec.pending):
+        assert np.array_equal(p[-1], actions[i]), "each environment's last choice runs last"
+    assert [u.shape for u in vec.unseen] == [(1, 3)] * 3
+    nominal = dicestack.DiceStackVectorEnv(2, threads=1)
+    nominal.reset(seed=1)
+    assert [p.shape for p in nominal.pending] == [(0, 3)] * 2
