@@ -26,6 +26,12 @@ struct Blocks {
   Current current = Current::state;
 };
 
+// The state a map's row and answer refer to: for an "/ahead" map the cup where it is when the
+// action lands (computed into `scratch`), else the current state itself (no copy: the hot path).
+const State& acting_state(const FeatureMap& m, const History& h, State& scratch) {
+  return m.ahead() ? (scratch = cup_ahead(h)) : h.current();
+}
+
 class BuiltinFeatureMap final : public FeatureMap {
  public:
   BuiltinFeatureMap(std::string name, std::string description, Blocks blocks,
@@ -60,7 +66,8 @@ class BuiltinFeatureMap final : public FeatureMap {
   }
 
   void compute(const History& h, std::span<double> out) const override {
-    const State s = ahead_ ? cup_ahead(h) : h.current();
+    State scratch;
+    const State& s = acting_state(*this, h, scratch);
     std::size_t at = 0;
     if (blocks_.current == Current::state) std::copy(s.begin(), s.end(), out.begin());
     if (blocks_.current == Current::cup)
@@ -168,13 +175,15 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
 
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {
   const bool velocity = target() == ActionTarget::velocity;
-  const State s = ahead() ? cup_ahead(h) : h.current();
+  State scratch;
+  const State& s = acting_state(*this, h, scratch);
   for (std::size_t k = 0; k < kActionDim; ++k) out[k] = action[k] + (velocity ? s[kCupVelocity[k]] : 0.0);
 }
 
 Action FeatureMap::action(const History& h, std::span<const double> output) const {
   const bool velocity = target() == ActionTarget::velocity;
-  const State s = ahead() ? cup_ahead(h) : h.current();
+  State scratch;
+  const State& s = acting_state(*this, h, scratch);
   Action a;
   for (std::size_t k = 0; k < kActionDim; ++k) a[k] = output[k] - (velocity ? s[kCupVelocity[k]] : 0.0);
   return a;

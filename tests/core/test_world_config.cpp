@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -47,6 +49,21 @@ TEST(WorldConfig, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(to_json(back), to_json(c));
   EXPECT_EQ(back.physics.substeps, 7);
   EXPECT_DOUBLE_EQ(back.cost.sigma[5], 0.25);
+}
+
+TEST(WorldConfig, EqualityIsFieldByFieldAsTheHashSeesIt) {
+  // An expert remakes its planning world when an episode's config differs (planning_sim).
+  const WorldConfig a;
+  EXPECT_EQ(a, world_config_from_json(to_json(a)));
+  for (auto change : std::vector<std::function<void(WorldConfig&)>>{
+           [](WorldConfig& c) { c.physics.gravity.y = -4.1; }, [](WorldConfig& c) { c.dice.mass = 1.5; },
+           [](WorldConfig& c) { c.cup.start_anchor.x = 3.9; }, [](WorldConfig& c) { c.cost.sigma[23] = 0.5; },
+           [](WorldConfig& c) { c.randomization.shift *= 2.0; }, [](WorldConfig& c) { c.episode.max_steps = 99; }}) {
+    WorldConfig b = a;
+    change(b);
+    EXPECT_NE(a, b);
+    EXPECT_NE(world_hash(a), world_hash(b));
+  }
 }
 
 TEST(WorldConfig, DeepNestingIsRefusedNotCrashed) {

@@ -6,6 +6,7 @@ namespace dicestack {
 struct Vec2 {
   double x = 0.0;
   double y = 0.0;
+  bool operator==(const Vec2&) const = default;
 };
 
 }  // namespace dicestack

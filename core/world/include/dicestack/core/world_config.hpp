@@ -21,6 +21,7 @@ struct WallsConfig {
   double ceiling_y = 6.95;  ///< ceiling centre line, m
   double radius = 0.40;     ///< segment radius, m, > 0
   double friction = 1.0;    ///< Coulomb coefficient, >= 0 (paper eq. 3)
+  bool operator==(const WallsConfig&) const = default;
 };
 
 /// The cup: three rounded segments on one rigid body, mouth up at angle 0 (paper III).
@@ -33,6 +34,7 @@ struct CupConfig {
   double friction = 0.4;       ///< paper eq. 4
   Vec2 start_anchor{4.00, 1.90};          ///< left end of the base before the start rotation, m
   double start_angle = std::numbers::pi;  ///< rotation about the centre of mass at the start
+  bool operator==(const CupConfig&) const = default;
 };
 
 /// The three dice: octagons, squares with cut corners (paper III).
@@ -43,6 +45,7 @@ struct DiceConfig {
   double friction = 0.6;     ///< paper eq. 2
   std::array<double, kDiceCount> start_x{4.08, 4.51, 4.93};  ///< m
   double start_y = 1.25;     ///< m; the dice start 5 cm above the table and drop
+  bool operator==(const DiceConfig&) const = default;
 };
 
 /// Integration and simulation settings.
@@ -56,6 +59,7 @@ struct PhysicsConfig {
   double units_per_metre = 10.0;  ///< internal Box2D length scale; keeps its 0.01-unit skin at 1 mm
   double action_noise = 0.0;      ///< std of Gaussian noise added to each action, as a fraction of
                                   ///< ActionConfig::scale; 0 is deterministic (paper III non-determinism)
+  bool operator==(const PhysicsConfig&) const = default;
 };
 
 /// Action scaling and limits.
@@ -65,6 +69,7 @@ struct ActionConfig {
   /// Largest |dv| the environment accepts per step; larger actions are clipped (m/s, m/s, rad/s).
   /// Human recordings reach 17 m/s with the stopping mechanic.
   std::array<double, kActionDim> limit{20.0, 20.0, 10.0};
+  bool operator==(const ActionConfig&) const = default;
 };
 
 /// Randomised initial states for reset(seed). All zero gives the paper's start.
@@ -74,6 +79,7 @@ struct RandomizationConfig {
   double cup_lift = 0.2;     ///< the cup starts U(0, lift) higher, m
   double cup_tilt = 0.05;    ///< the cup's start angle changes by U(-tilt, tilt), rad
   bool die_quarter_turns = true;  ///< each die starts rotated by a random multiple of 90 degrees
+  bool operator==(const RandomizationConfig&) const = default;
 };
 
 /// Tolerances of the outcome judge (DESIGN "Outcome judge").
@@ -85,11 +91,13 @@ struct JudgeConfig {
   double rest_angular_speed = 0.2; ///< max die angular speed at rest, rad/s
   double wall_contact_distance = 0.002;  ///< a gap at most this wide counts as touching, m
   int success_hold_steps = 5;      ///< a realistic success must hold this many control steps
+  bool operator==(const JudgeConfig&) const = default;
 };
 
 /// Episode limits.
 struct EpisodeConfig {
   int max_steps = 400;  ///< time limit in control steps (truncated after it)
+  bool operator==(const EpisodeConfig&) const = default;
 };
 
 /// The optimisers' cost (paper eq. 6) and the environment's reward.
@@ -99,6 +107,7 @@ struct CostConfig {
   /// Per-dimension scale of the L2 state distance (population std of the 68 human recordings,
   /// converted to SI; see docs/world.md).
   State sigma{};
+  bool operator==(const CostConfig&) const = default;
 };
 
 /// Everything that defines a world. Plain data; validate() checks it.
@@ -115,6 +124,7 @@ struct WorldConfig {
 
   /// The cost defaults, with the measured per-dimension sigma.
   static CostConfig default_cost();
+  bool operator==(const WorldConfig&) const = default;
 };
 
 /// Throws ConfigError naming the first field that is out of range, e.g.
