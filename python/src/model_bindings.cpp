@@ -1,6 +1,7 @@
 // Models (load, predict, save), the policy a model gives (it keeps its episode's history for the
 // feature map), the automatic experts, and train() / evaluate() (with its report page) /
 // leaderboard() as the command line runs them, with a progress bar and Ctrl-C (LongCall).
+#include <cmath>
 #include <memory>
 #include <optional>
 
@@ -40,8 +41,8 @@ class PyPolicy {
   explicit PyPolicy(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
   void reset() { states_.clear(); }
   Action act(const py::handle& observation, const py::handle& pending, const py::handle& unseen) {
-    const auto ahead = pending.is_none() ? std::vector<Action>{} : rows_from<kActionDim>(pending, "pending");
-    const auto since = unseen.is_none() ? std::vector<Action>{} : rows_from<kActionDim>(unseen, "unseen");
+    const auto ahead = actions_from(pending, "pending");
+    const auto since = actions_from(unseen, "unseen");
     states_.push_back(state_from(observation, "observation"));
     // The world's applied actions are not known here; no built-in feature map reads them.
     return model_->act(History{states_, {}, ahead, since});
@@ -49,6 +50,18 @@ class PyPolicy {
   std::size_t t() const { return states_.empty() ? 0 : states_.size() - 1; }
 
  private:
+  // None, or (N, 3) finite actions.
+  static std::vector<Action> actions_from(const py::handle& rows, const char* what) {
+    if (rows.is_none()) return {};
+    auto actions = rows_from<kActionDim>(rows, what);
+    for (std::size_t i = 0; i < actions.size(); ++i)
+      for (std::size_t k = 0; k < kActionDim; ++k)
+        if (!std::isfinite(actions[i][k]))
+          throw py::value_error(std::string(what) + "[" + std::to_string(i) + "][" + std::to_string(k) +
+                                "] must be finite, got " + std::to_string(actions[i][k]));
+    return actions;
+  }
+
   std::shared_ptr<const Model> model_;
   std::vector<State> states_;
 };

@@ -148,6 +148,8 @@ def test_a_policy_on_an_ahead_map_reads_what_is_pending(builtin_episodes):
     assert differ > 0
     with pytest.raises(ValueError, match="pending"):
         model.policy().act(obs, pending=np.zeros((2, 4)))
+    with pytest.raises(ValueError, match=r"unseen\[0\]\[1\] must be finite"):
+        model.policy().act(obs, unseen=np.array([[0.0, np.nan, 0.0]]))
 
 
 def test_the_vector_env_shows_each_environments_pending_actions():
