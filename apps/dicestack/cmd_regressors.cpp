@@ -63,9 +63,12 @@ int run_learners() {
   }
   print_line("each also as NAME" + std::string(kVelocityTargetSuffix) +
              " (the regressor answers the cup velocity to set; the action is that less the cup's velocity), NAME" +
+             std::string(kPositionTargetSuffix) +
+             " (it answers the cup pose to servo to; the action sets the velocity 10/s times the pose error), NAME" +
              std::string(kAheadSuffix) +
              " (under delays, the cup moved ahead to where it is when the action lands) and NAME" +
-             std::string(kVelocityTargetSuffix) + std::string(kAheadSuffix) + " (both)");
+             std::string(kVelocityTargetSuffix) + std::string(kAheadSuffix) + " or NAME" +
+             std::string(kPositionTargetSuffix) + std::string(kAheadSuffix) + " (both)");
   return 0;
 }
 

@@ -101,6 +101,7 @@ class BuiltinFeatureMap final : public FeatureMap {
 };
 
 constexpr std::size_t kCupVelocity[kActionDim] = {si::kCupVx, si::kCupVy, si::kCupW};
+constexpr std::size_t kCupPose[kActionDim] = {si::kCupX, si::kCupY, si::kCupAngle};
 
 const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
   static const auto* maps = [] {
@@ -123,18 +124,19 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         Blocks{true, false, false, true, Current::cup}));
     // Every map again, its regressor answering the cup velocity to set; then every one of
     // those again, acting for the moment its action lands (delays).
-    auto twins = [v](std::string_view suffix, const std::string& what, bool velocity, bool ahead) {
-      const std::size_t before = v->size();
-      for (std::size_t i = 0; i < before; ++i) {
+    const std::size_t base = v->size();
+    auto twins = [v](std::size_t count, std::string_view suffix, const std::string& what, ActionTarget target, bool ahead) {
+      for (std::size_t i = 0; i < count; ++i) {
         const BuiltinFeatureMap& m = *(*v)[i];
         v->push_back(std::make_unique<BuiltinFeatureMap>(m.name() + std::string(suffix), m.description() + "; " + what,
-                                                         m.blocks(), velocity ? ActionTarget::velocity : m.target(),
-                                                         ahead || m.ahead()));
+                                                         m.blocks(), ahead ? m.target() : target, ahead || m.ahead()));
       }
     };
-    twins(kVelocityTargetSuffix, "answers the cup velocity to set (the action is its difference from the cup's velocity)",
-          true, false);
-    twins(kAheadSuffix, "under delays, the cup moved ahead to where it is when the action lands", false, true);
+    twins(base, kVelocityTargetSuffix, "answers the cup velocity to set (the action is its difference from the cup's velocity)",
+          ActionTarget::velocity, false);
+    twins(base, kPositionTargetSuffix, "answers the cup pose to servo to (the action sets the velocity 10/s times the pose error)",
+          ActionTarget::position, false);
+    twins(v->size(), kAheadSuffix, "under delays, the cup moved ahead to where it is when the action lands", ActionTarget::impulse, true);
     return v;
   }();
   return *maps;
@@ -174,18 +176,28 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
 }
 
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {
-  const bool velocity = target() == ActionTarget::velocity;
   State scratch;
   const State& s = acting_state(*this, h, scratch);
-  for (std::size_t k = 0; k < kActionDim; ++k) out[k] = action[k] + (velocity ? s[kCupVelocity[k]] : 0.0);
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    switch (target()) {
+      case ActionTarget::impulse: out[k] = action[k]; break;
+      case ActionTarget::velocity: out[k] = action[k] + s[kCupVelocity[k]]; break;
+      case ActionTarget::position: out[k] = s[kCupPose[k]] + (action[k] + s[kCupVelocity[k]]) / kPositionGain; break;
+    }
+  }
 }
 
 Action FeatureMap::action(const History& h, std::span<const double> output) const {
-  const bool velocity = target() == ActionTarget::velocity;
   State scratch;
   const State& s = acting_state(*this, h, scratch);
   Action a;
-  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = output[k] - (velocity ? s[kCupVelocity[k]] : 0.0);
+  for (std::size_t k = 0; k < kActionDim; ++k) {
+    switch (target()) {
+      case ActionTarget::impulse: a[k] = output[k]; break;
+      case ActionTarget::velocity: a[k] = output[k] - s[kCupVelocity[k]]; break;
+      case ActionTarget::position: a[k] = kPositionGain * (output[k] - s[kCupPose[k]]) - s[kCupVelocity[k]]; break;
+    }
+  }
   return a;
 }
 

@@ -665,6 +665,7 @@ TEST(Cli, LearnersListEachBaseFeatureMapAndTheirTwinsOnce) {
     }
   }
   EXPECT_THAT(p.output, HasSubstr("each also as NAME/velocity"));
+  EXPECT_THAT(p.output, HasSubstr("NAME/position"));
   EXPECT_THAT(p.output, HasSubstr("NAME/ahead"));
   EXPECT_THAT(p.output, Not(HasSubstr("state/ahead"))) << "the twins are not listed one by one";
 }

@@ -142,7 +142,7 @@ TEST(Features, AVelocityMapSeesTheSameRowAndAnswersTheCupVelocityToSet) {
   base.label(h, a, label);
   EXPECT_EQ(label, (std::array<double, kActionDim>{0.5, -1.0, 2.0})) << "an impulse map answers the action";
   for (const auto& n : feature_map_names()) {
-    if (n.ends_with(kVelocityTargetSuffix) || n.ends_with(kAheadSuffix)) continue;
+    if (n.find('/') != std::string::npos) continue;  // the base maps
     EXPECT_EQ(feature_map(n + std::string(kVelocityTargetSuffix)).width(), feature_map(n).width()) << n;
   }
 }
@@ -158,6 +158,41 @@ TEST(Features, DatasetLabelsOfAVelocityMapAreTheCupVelocityEachStepSets) {
     for (Eigen::Index k = 0; k < 3; ++k)
       EXPECT_DOUBLE_EQ(d.y(t, k), e.states[static_cast<std::size_t>(t)][21 + static_cast<std::size_t>(k)] +
                                       e.actions[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]);
+}
+
+TEST(Features, APositionMapAnswersThePoseItsServoPullsTheCupTo) {
+  const FeatureMap& base = feature_map("state+clock+start_state");
+  const FeatureMap& m = feature_map("state+clock+start_state/position");
+  EXPECT_EQ(m.target(), ActionTarget::position);
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const History h{states, {}};
+  EXPECT_EQ(row_of(m, h), row_of(base, h));
+  // numbered(200): cup x, y, angle = 200, 201, 202; vx, vy, w = 221, 222, 223.
+  const Action a{0.5, -1.0, 2.0};
+  std::array<double, kActionDim> label{};
+  m.label(h, a, label);
+  EXPECT_DOUBLE_EQ(label[0], 200.0 + (0.5 + 221.0) / kPositionGain);
+  EXPECT_DOUBLE_EQ(label[2], 202.0 + (2.0 + 223.0) / kPositionGain);
+  const Action back = m.action(h, label);
+  for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_NEAR(back[k], a[k], 1e-9) << k;
+  // A tracker's action v_ref + gain (p_ref - p) - v, taken anywhere, has one label: the point
+  // p_ref + v_ref / gain. So DART's noise leaves a path follower's labels unchanged.
+  const double p_ref = 3.0, v_ref = 1.5;
+  for (double p : {2.5, 3.0, 3.7}) {
+    std::vector<State> at{numbered(0), numbered(0)};
+    at[1][state_index::kCupX] = p;
+    at[1][state_index::kCupVx] = -0.4 * p;
+    const History hp{at, {}};
+    const Action tracked{v_ref + kPositionGain * (p_ref - p) - at[1][state_index::kCupVx], 0.0, 0.0};
+    m.label(hp, tracked, label);
+    EXPECT_NEAR(label[0], p_ref + v_ref / kPositionGain, 1e-12) << p;
+  }
+  for (const auto& n : feature_map_names()) {
+    if (n.find('/') != std::string::npos) continue;
+    EXPECT_EQ(feature_map(n + std::string(kPositionTargetSuffix)).width(), feature_map(n).width()) << n;
+    EXPECT_EQ(feature_map(n + std::string(kPositionTargetSuffix) + std::string(kAheadSuffix)).target(),
+              ActionTarget::position) << n;
+  }
 }
 
 TEST(Features, AnAheadMapWithNothingPendingIsItsBaseMap) {
@@ -233,8 +268,15 @@ TEST(Features, DatasetRowsOfAnAheadMapRunThroughTheEpisodesOwnDelay) {
   }
   EXPECT_NE(make_dataset({e}, m).x(2, 0), make_dataset({e}, feature_map("state+clock")).x(2, 0))
       << "the base map shows the cup as recorded";
-  e.perturbation = R"({"dice_mass": 0.5})";
+  e.perturbation = R"({"dice_mass": 0.5})";  // nothing but physics: the rows as recorded
+  EXPECT_EQ(make_dataset({e}, m).x, make_dataset({e}, feature_map("state+clock")).x);
+  e.perturbation = R"({"action_delay": 2.5})";
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"action_delay\""));
+  e.perturbation = R"({"observation_noise_std": [0.1]})";
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"observation_noise_std\" must be 24"));
+  e.perturbation = R"({"action_noise_std": [0.1, 0, 0]})";
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, feature_map("state")); }), HasSubstr("no \"noise_seed\""));
+  EXPECT_THAT(test::error_of([&] { make_dataset({e}, feature_map("state")); }), HasSubstr("episode_0000"));
   e.perturbation = R"({"action_delay": 1000000000000})";  // a user's file: bounded, not allocated
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("in [0, 100]"));
   // A step a learner took (DAgger) records the expert's label, not what was pending.

@@ -40,10 +40,13 @@ struct History {
 inline constexpr std::size_t kMaxFeatureWidth = 64;
 
 /// What a policy's regressor answers: the action itself (the cup's velocity change, the paper's
-/// impulse), or the cup velocity the action is to set (the action is then that velocity minus
-/// the cup's velocity now). An expert that tracks a reference by cancelling the cup's velocity
-/// error gives labels that hold the noise of the last step; as velocities they are smooth.
-enum class ActionTarget { impulse, velocity };
+/// impulse), the cup velocity the action is to set (the action is then that velocity minus
+/// the cup's velocity now), or the cup pose r a servo pulls the cup to (the action sets the
+/// velocity kPositionGain (r - p) on x, y and angle). An expert that tracks a reference by
+/// cancelling the cup's velocity error gives labels that hold the noise of the last step; as
+/// velocities they are smooth; as poses, for a tracker of the same gain, the same wherever the
+/// cup is (so a learner's errors do not add up into a drift).
+enum class ActionTarget { impulse, velocity, position };
 
 /// A named, versioned map from a History to one input row, and from the regressor's answer to
 /// an action. Immutable; thread-safe.
@@ -93,7 +96,8 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 ///  - "state+clock+start_state": + t and the whole start state
 ///  - "clock+start_state", "cup+clock+start_state": open loop, and feedback on the cup alone
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
-/// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default).
+/// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default),
+/// and as NAME + "/position" (kPositionTargetSuffix): answering the pose to servo the cup to.
 /// Each of these also as NAME + "/ahead" (kAheadSuffix): under delays, the row shows
 /// cup_ahead() instead of the current cup (with no delay, the same rows as NAME). The clock
 /// stays t, the choices made so far: a policy's episode is then the nominal one, d steps late.
@@ -104,6 +108,11 @@ const FeatureMap& feature_map(std::string_view name);
 
 /// The suffix of a map whose regressor answers the cup velocity to set (ActionTarget::velocity).
 inline constexpr std::string_view kVelocityTargetSuffix = "/velocity";
+/// The suffix of a map whose regressor answers the cup pose to servo to (ActionTarget::position).
+inline constexpr std::string_view kPositionTargetSuffix = "/position";
+/// The servo gain of "/position" maps, 1/s: the tracker's default gain, so that its labels are
+/// one pose per step wherever the cup is.
+inline constexpr double kPositionGain = 10.0;
 
 /// The suffix of a map that acts for the moment its action lands (FeatureMap::ahead()).
 inline constexpr std::string_view kAheadSuffix = "/ahead";
