@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -12,22 +13,24 @@
 namespace dicestack {
 namespace {
 
-// The action delay an episode ran under (its perturbation's "action_delay"; 0 when nominal).
-// Its pending actions are rebuilt from its labels, which are what was chosen only where the
-// recording's actor labelled its own steps: a step the learner took (DAgger's mixture) records
-// the expert's label instead, so such an episode is refused.
-std::size_t action_delay_of(const Episode& e) {
-  if (e.perturbation.empty()) return 0;
-  const auto j = nlohmann::json::parse(e.perturbation, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("action_delay") || !j["action_delay"].is_number_unsigned() ||
-      j["action_delay"].get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxActionDelay))
-    throw InputError("episode \"" + e.name + "\": its perturbation's \"action_delay\" must be a whole number of steps in [0, " +
-                     std::to_string(kMaxActionDelay) + "]");
-  const auto delay = j["action_delay"].get<std::size_t>();
-  if (delay > 0 && std::find(e.sources.begin(), e.sources.end(), StepSource::policy) != e.sources.end())
-    throw InputError("episode \"" + e.name + "\" ran under an action delay with steps a learner chose, whose choices are not "
-                     "recorded (only the expert's labels): an \"/ahead\" map cannot rebuild what was pending");
-  return delay;
+// What a policy was shown at each step of an episode run with perturbed sensing or delays, as
+// a rollout showed it: the episode's own PerturbedChannel, replayed from the draw it saved (its
+// noises come from the saved seed, whatever was chosen). It is replayed only where the rows
+// differ: under observation noise or delay, and for an "/ahead" map under an action delay.
+// What was pending or unseen is rebuilt from the labels, which are what was chosen only where
+// the recording's actor labelled its own steps: a step the learner took (DAgger's mixture)
+// records the expert's label instead, so an "/ahead" map refuses such an episode.
+std::optional<PerturbedChannel> replayed_channel(const Episode& e, const FeatureMap& features) {
+  if (e.perturbation.empty()) return std::nullopt;
+  const PerturbationDraw d = channel_draw_from_json(e.perturbation, "episode \"" + e.name + "\"");
+  const bool sensing = d.observation_delay > 0 ||
+                       std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0; });
+  const bool delayed = d.action_delay > 0 || d.observation_delay > 0;
+  if (!sensing && !(features.ahead() && delayed)) return std::nullopt;
+  if (features.ahead() && delayed && std::find(e.sources.begin(), e.sources.end(), StepSource::policy) != e.sources.end())
+    throw InputError("episode \"" + e.name + "\" ran under a delay with steps a learner chose, whose choices are not "
+                     "recorded (only the expert's labels): an \"/ahead\" map cannot rebuild what was pending or unseen");
+  return PerturbedChannel(d);
 }
 
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features) {
@@ -42,17 +45,20 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
     check_episode(*e);
     d.episode_begin.push_back(static_cast<std::size_t>(row));
     d.episode_names.push_back(e->name);
-    // Under an action delay, the actions recorded at the `delay` steps before t run before
-    // the one recorded at t (zeros before the first): what an "/ahead" map moves the cup through.
-    const std::size_t delay = features.ahead() ? action_delay_of(*e) : 0;
-    std::vector<Action> pending(delay);
+    std::optional<PerturbedChannel> channel = replayed_channel(*e, features);
+    std::vector<State> seen;
+    std::vector<Action> pending, unseen;
     for (std::size_t t = 0; t < e->size(); ++t, ++row) {
-      for (std::size_t k = 0; k < delay; ++k)
-        pending[k] = t + k >= delay ? e->actions[t + k - delay] : Action{0.0, 0.0, 0.0};
-      const History h{std::span<const State>(e->states.data(), t + 1), std::span<const Action>(e->actions.data(), t),
-                      pending};
+      if (channel) {
+        seen.push_back(channel->observe(e->states[t]));
+        pending.assign(channel->pending().begin(), channel->pending().end());
+        unseen.assign(channel->unseen().begin(), channel->unseen().end());
+      }
+      const History h{std::span<const State>(channel ? seen.data() : e->states.data(), t + 1),
+                      std::span<const Action>(e->actions.data(), t), pending, unseen};
       features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
       features.label(h, e->actions[t], {d.y.row(row).data(), kActionDim});
+      if (channel) channel->execute(e->actions[t]);
     }
   }
   return d;

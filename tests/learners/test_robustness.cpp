@@ -13,6 +13,8 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/features.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/robustness.hpp>
 
@@ -111,6 +113,55 @@ TEST(Perturbed, ObservationDelayShowsOlderStates) {
   const Episode e = perturbed_rollout(w, d, p);
   ASSERT_EQ(p.seen.size(), e.actions.size());
   for (std::size_t t = 0; t < p.seen.size(); ++t) EXPECT_EQ(p.seen[t], e.states[t >= 3 ? t - 3 : 0]) << t;
+}
+
+// The Watcher's swing, writing down the row and label `map` makes of what it is shown.
+class RowWatcher final : public Policy {
+ public:
+  explicit RowWatcher(const FeatureMap& map) : map_(map) {}
+  Action act(const History& h) override {
+    const Action a = watch_.act(h);
+    rows.emplace_back(map_.width());
+    map_.compute(h, rows.back());
+    labels.emplace_back(kActionDim);
+    map_.label(h, a, labels.back());
+    return a;
+  }
+  std::string name() const override { return "row-watcher"; }
+  std::vector<std::vector<double>> rows, labels;
+
+ private:
+  const FeatureMap& map_;
+  Watcher watch_;
+};
+
+TEST(Perturbed, TrainingRowsShowWhatTheRolloutShowedThePolicy) {
+  const WorldConfig w = test::short_world(30);
+  PerturbationDraw d = bare_draw(w);
+  for (std::size_t k = 0; k < kStateDim; ++k) d.observation_noise[k] = 0.05 * observation_spread()[k];
+  d.observation_delay = 2;
+  d.action_delay = 1;
+  d.action_noise = {0.05, 0.05, 0.05};
+  d.noise_seed = 99;
+  for (const char* name : {"state+clock+start_state/velocity", "state+clock/velocity/ahead", "state/position/ahead", "state"}) {
+    const FeatureMap& map = feature_map(name);
+    RowWatcher p(map);
+    RolloutOptions o;
+    o.perturbation = &d;
+    DiceEnv env(w);
+    // Labelled as an expert's steps: what a learner chose under a delay is not rebuilt.
+    Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::expert, o);
+    const Dataset rows = make_dataset({e}, map);
+    ASSERT_EQ(static_cast<std::size_t>(rows.x.rows()), p.rows.size()) << name;
+    for (std::size_t t = 0; t < p.rows.size(); ++t) {
+      for (std::size_t k = 0; k < map.width(); ++k)
+        ASSERT_EQ(rows.x(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(k)), p.rows[t][k]) << name << " " << t << " " << k;
+      for (std::size_t k = 0; k < kActionDim; ++k)
+        ASSERT_EQ(rows.y(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(k)), p.labels[t][k]) << name << " " << t << " " << k;
+    }
+    e.perturbation.clear();  // negative control: the true states are other rows
+    EXPECT_NE(make_dataset({e}, map).x, rows.x) << name;
+  }
 }
 
 TEST(Perturbed, ActionDelayExecutesNothingUntilTheFirstChoiceArrives) {

@@ -1,7 +1,9 @@
 #include <dicestack/core/perturbation.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <span>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -275,6 +277,50 @@ std::string draw_to_json(const PerturbationDraw& d) {
          {"start_cup_tilt", w.randomization.cup_tilt},
          {"noise_seed", d.noise_seed}};
   return j.dump();
+}
+
+PerturbationDraw channel_draw_from_json(std::string_view text, const std::string& source) {
+  const json j = json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) throw InputError(source + ": its perturbation must be a JSON object");
+  auto bad = [&](const char* key, const std::string& what) {
+    return InputError(source + ": its perturbation's \"" + std::string(key) + "\" must be " + what);
+  };
+  // A field left out is nominal (a set written by hand may name only what it perturbed).
+  auto reals = [&](const char* key, std::span<double> out, bool std_dev) {
+    if (!j.contains(key)) return;
+    const json& v = j[key];
+    const std::string what = std::to_string(out.size()) + (std_dev ? " standard deviations >= 0" : " finite numbers");
+    if (!v.is_array() || v.size() != out.size()) throw bad(key, what);
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      if (!v[k].is_number() || !std::isfinite(v[k].get<double>()) || std::abs(v[k].get<double>()) > 1e6 ||
+          (std_dev && v[k].get<double>() < 0))
+        throw bad(key, what);
+      out[k] = v[k].get<double>();
+    }
+  };
+  auto steps = [&](const char* key) {
+    if (!j.contains(key)) return 0;
+    const json& v = j[key];
+    if (!v.is_number_unsigned() || v.get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxActionDelay))
+      throw bad(key, "a whole number of steps in [0, " + std::to_string(kMaxActionDelay) + "]");
+    return static_cast<int>(v.get<std::uint64_t>());
+  };
+  PerturbationDraw d;
+  reals("action_bias", d.action_bias, false);
+  reals("action_noise_std", d.action_noise, true);
+  reals("observation_noise_std", d.observation_noise, true);
+  d.action_delay = steps("action_delay");
+  d.observation_delay = steps("observation_delay");
+  const bool noisy = std::any_of(d.action_noise.begin(), d.action_noise.end(), [](double v) { return v > 0; }) ||
+                     std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0; });
+  if (j.contains("noise_seed")) {
+    if (!j["noise_seed"].is_number_unsigned()) throw bad("noise_seed", "a whole number");
+    d.noise_seed = j["noise_seed"].get<std::uint64_t>();
+  } else if (noisy) {
+    throw InputError(source + ": its perturbation has noise but no \"noise_seed\" to replay it from");
+  }
+  d.acts = true;
+  return d;
 }
 
 PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw)
