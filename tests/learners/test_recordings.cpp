@@ -152,12 +152,12 @@ TEST(LearnerSpec, ParsesOptionsAndRefusesUnknownOnes) {
   EXPECT_THROW(parse_learner_spec("dart:noise"), ConfigError);
 }
 
-TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringVelocities) {
+TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringPoses) {
   EXPECT_EQ(default_features("bc"), "state");
   EXPECT_EQ(default_features("dart"), "state+clock+start_state");
   EXPECT_EQ(default_features("dart", {"expert=mpc"}), "state+clock+start_state");
-  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state/velocity");
-  EXPECT_EQ(feature_map(default_features("dart", {"expert=tracker"})).target(), ActionTarget::velocity);
+  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state/position");
+  EXPECT_EQ(feature_map(default_features("dart", {"expert=tracker"})).target(), ActionTarget::position);
   EXPECT_THROW(default_features("dart", {"expert=oracle"}), ConfigError);
 }
 

@@ -29,6 +29,11 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
                                                   const TrackerConfig& config, std::uint64_t seed, int threads = 0,
                                                   Cluster& cluster = local_cluster());
 
+/// True when the context's feature map answers a cup pose to servo to ("/position"): the
+/// tracker's labels are then one pose per step, and the learners follow one recording
+/// (docs/learners.md, "Position targets").
+bool servo_targets(const LearnContext& c);
+
 /// The options of a learner whose expert may be the tracker (DART, DAgger): tracker_probes,
 /// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations) and
 /// tracker_recordings (follow only that many of the demonstrations, drawn with the run's seed).
