@@ -308,12 +308,11 @@ struct RunPlan {
 
   const std::string& base(const std::string& spec) const { return specs.at(spec).name; }
 
-  // A learner row's options: the profile's defaults, then the spec's, then --option (for every
-  // learner that has the key).
+  // A learner row's options: the profile's defaults for the learner, then for the row's spec,
+  // then the spec's own, then --option (for every learner that has the key).
   std::vector<std::string> options_for(const std::string& spec) const {
     const std::string& learner = base(spec);
-    const auto defaults = profile->learner_options.find(learner);
-    std::vector<std::string> out = defaults == profile->learner_options.end() ? std::vector<std::string>{} : defaults->second;
+    std::vector<std::string> out;
     auto put = [&](const std::string& kv) {
       const auto key = kv.substr(0, kv.find('='));
       for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -322,6 +321,9 @@ struct RunPlan {
           out.push_back(kv);
         }
     };
+    for (const std::string* key : {&learner, &spec})
+      if (const auto defaults = profile->learner_options.find(*key); defaults != profile->learner_options.end())
+        for (const auto& kv : defaults->second) put(kv);
     for (const auto& kv : specs.at(spec).options) put(kv);
     for (const auto& kv : request.options) put(kv);
     return out;

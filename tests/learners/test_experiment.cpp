@@ -65,6 +65,9 @@ TEST(Profile, QuickAndPaperAreDataAndOtherNamesAreRefused) {
               quick.left_out.end());
   EXPECT_TRUE(paper.left_out.empty());
   EXPECT_EQ(quick.learner_options.at("dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}));
+  // A row spec's own defaults: the tracker's row keeps the main job within its minutes.
+  EXPECT_EQ(quick.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
+  EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
   EXPECT_GT(paper.optimiser_evaluations, quick.optimiser_evaluations);
   try {
     leaderboard_profile("huge");

@@ -13,7 +13,8 @@ struct Profile {
   int rollouts = 20;  ///< evaluation rollouts per row and training seed (unless --episodes)
   /// The learner rows when none are named (specs, as --learners takes them).
   std::vector<std::string> learners{"bc", "dagger", "dart"};
-  /// Learner options applied before the user's --option (learners not listed: their defaults).
+  /// Learner options applied before the user's --option, by learner ("dart") and then by row spec
+  /// ("dart:expert=tracker"); learners not listed: their defaults.
   std::map<std::string, std::vector<std::string>> learner_options;
   /// Every learner also with the bare state and with dart's feature map (the paper's picture);
   /// otherwise each learner with its own default map.
