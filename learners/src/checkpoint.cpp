@@ -11,6 +11,7 @@
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/core/read_file.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
 
@@ -65,6 +66,17 @@ std::string value_before(const std::string& learner, const std::string& key) {
   for (const auto& p : LearnerRegistry::global().info(learner).params)
     if (p.name == key) return p.default_value;
   return "";
+}
+
+// What an option's text means in a run: a default that depends on the run's feature map
+// (tracker_paths -1, the default since it depends on the map; 3 before) resolved with it.
+std::string meaning(const std::string& key, const std::string& text, const json& run) {
+  if (key != "tracker_paths" || text != "-1" || !run.contains("features") || !run["features"].is_string()) return text;
+  try {
+    return std::to_string(tracker_paths_for(-1, run["features"].get<std::string>()));
+  } catch (const ConfigError&) {  // a map this version does not know: compared as written
+    return text;
+  }
 }
 
 // Every parameter of `schema` -> its value in `params`, typed: what a run's regressor settings mean.
@@ -289,7 +301,8 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
         const std::string then = it != before.end() ? it->second : value_before(learner, k);
-        if (then != now) differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
+        if (meaning(k, then, saved_run) != meaning(k, now, run))
+          differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
       }
     }
     if (!differences.empty())

@@ -95,6 +95,11 @@ std::vector<ParamSpec> tracker_param_specs() {
 
 bool servo_targets(const LearnContext& c) { return feature_map(c.features).target() == ActionTarget::position; }
 
+int tracker_paths_for(int paths, const std::string& features) {
+  if (paths >= 0) return paths;
+  return feature_map(features).target() == ActionTarget::position ? kServoPaths : kOtherPaths;
+}
+
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
   ExpertConfig config;
   if (name == "tracker") {
@@ -103,8 +108,7 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     TrackerConfig tracker;
     tracker.probes = static_cast<int>(params.integer("tracker_probes"));
     tracker.optimise = params.boolean("tracker_optimise");
-    tracker.keep = static_cast<int>(params.integer("tracker_paths"));
-    if (tracker.keep < 0) tracker.keep = servo_targets(c) ? kServoPaths : kOtherPaths;
+    tracker.keep = tracker_paths_for(static_cast<int>(params.integer("tracker_paths")), c.features);
     tracker.rescue_interval = static_cast<int>(params.integer("tracker_rescue"));
     tracker.smooth = params.real("tracker_smooth");
     tracker.robust_trials = static_cast<int>(params.integer("tracker_robust"));

@@ -306,6 +306,13 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   EXPECT_THAT(edited("/curve/0/deviation", "x"), HasSubstr("field \"curve[0].deviation\" must be a finite number"));
   EXPECT_THAT(edited("/curve", 5), HasSubstr("field \"curve\" must be an array"));
   EXPECT_THAT(edited("/format", "dicestack-model"), HasSubstr("dagger.json: not a checkpoint state"));
+  // Written when tracker_paths defaulted to 3, which -1 now means for this run's map.
+  EXPECT_EQ(saved["run"]["learner_options"]["tracker_paths"], "-1");
+  nlohmann::json three = saved;
+  three["run"]["learner_options"]["tracker_paths"] = "3";
+  EXPECT_EQ(resume_with(three), "");
+  three["run"]["learner_options"]["tracker_paths"] = "1";
+  EXPECT_THAT(resume_with(three), HasSubstr("option tracker_paths \"1\" in the checkpoint, \"-1\" in this run"));
   nlohmann::json v2 = saved;  // version 2: the learner's options joined into one string, the --set text
   v2["version"] = 2;
   v2["run"].erase("regressor_params");

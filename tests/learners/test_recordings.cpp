@@ -74,6 +74,10 @@ TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
                            ->learn(c);
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
   EXPECT_EQ(learned.model->record.at("learner"), "dart");
+  EXPECT_EQ(learned.model->record.at("tracker_paths"), "3") << "the default resolved for a map answering impulses";
+  EXPECT_EQ(tracker_paths_for(-1, "state+clock+start_state/position"), 1);
+  EXPECT_EQ(tracker_paths_for(-1, "state/velocity"), 3);
+  EXPECT_EQ(tracker_paths_for(5, "state/position"), 5);
 }
 
 TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {

@@ -34,6 +34,10 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
 /// (docs/learners.md, "Position targets").
 bool servo_targets(const LearnContext& c);
 
+/// How many recordings a learner's tracker follows for the option value `paths`: -1 is the
+/// default for the feature map `features` (1 for a "/position" map, else 3); others as given.
+int tracker_paths_for(int paths, const std::string& features);
+
 /// The options of a learner whose expert may be the tracker (DART, DAgger): tracker_probes,
 /// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations) and
 /// tracker_recordings (follow only that many of the demonstrations, drawn with the run's seed).
