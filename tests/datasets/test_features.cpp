@@ -274,7 +274,11 @@ TEST(Features, DatasetRowsOfAnAheadMapRunThroughTheEpisodesOwnDelay) {
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"action_delay\""));
   e.perturbation = R"({"observation_noise_std": [0.1]})";
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, m); }), HasSubstr("\"observation_noise_std\" must be 24"));
-  e.perturbation = R"({"action_noise_std": [0.1, 0, 0]})";
+  e.perturbation = R"({"action_noise_std": [0.1, 0, 0]})";  // shows in no row by itself
+  EXPECT_NO_THROW(make_dataset({e}, feature_map("state")));
+  std::string zeros;
+  for (std::size_t k = 0; k + 1 < kStateDim; ++k) zeros += "0, ";
+  e.perturbation = R"({"observation_noise_std": [)" + zeros + "0.1]}";
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, feature_map("state")); }), HasSubstr("no \"noise_seed\""));
   EXPECT_THAT(test::error_of([&] { make_dataset({e}, feature_map("state")); }), HasSubstr("episode_0000"));
   e.perturbation = R"({"action_delay": 1000000000000})";  // a user's file: bounded, not allocated

@@ -311,13 +311,14 @@ PerturbationDraw channel_draw_from_json(std::string_view text, const std::string
   reals("observation_noise_std", d.observation_noise, true);
   d.action_delay = steps("action_delay");
   d.observation_delay = steps("observation_delay");
-  const bool noisy = std::any_of(d.action_noise.begin(), d.action_noise.end(), [](double v) { return v > 0; }) ||
-                     std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0; });
+  // What the policy saw is replayed from the seed only under observation noise (the action
+  // noise drawn from the same stream shows in no observation by itself).
+  const bool seen_noise = std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0; });
   if (j.contains("noise_seed")) {
     if (!j["noise_seed"].is_number_unsigned()) throw bad("noise_seed", "a whole number");
     d.noise_seed = j["noise_seed"].get<std::uint64_t>();
-  } else if (noisy) {
-    throw InputError(source + ": its perturbation has noise but no \"noise_seed\" to replay it from");
+  } else if (seen_noise) {
+    throw InputError(source + ": its perturbation has observation noise but no \"noise_seed\" to replay it from");
   }
   d.acts = true;
   return d;

@@ -96,7 +96,7 @@ std::string draw_to_json(const PerturbationDraw& draw);
 /// The actuation and sensing of a draw saved by draw_to_json (what a PerturbedChannel needs to
 /// replay an episode's observations: the noises' std, the bias, the delays and the noise seed);
 /// the world is left the default, and a field left out is nominal. Throws InputError naming
-/// `source` and the field out of range, or when there is noise and no noise seed.
+/// `source` and the field out of range, or when there is observation noise and no noise seed.
 PerturbationDraw channel_draw_from_json(std::string_view text, const std::string& source);
 
 /// What a perturbed episode's policy sees and what the world executes (the draw's sensing and
