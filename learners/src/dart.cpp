@@ -25,7 +25,7 @@ class Dart final : public Learner {
     int episodes = static_cast<int>(params().integer("episodes"));
     // A servo policy's labels do not change with the noise, so it learns the reference from
     // how many starts it saw: 300 -> 600 episodes gave 60.2 -> 70.3 % (docs/learners.md).
-    if (episodes == 0) episodes = params().choice("expert") == "tracker" && servo_targets(c) ? kServoEpisodes : kEpisodes;
+    if (episodes == 0) episodes = params().choice("expert") == "tracker" && servo_targets(c.features) ? kServoEpisodes : kEpisodes;
     const double noise = params().real("noise");
     Action fraction{noise, noise, noise};
     // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
@@ -73,9 +73,10 @@ class Dart final : public Learner {
     return r;
   }
 
-  // The tracker cancels the cup's pose error each step, so under DART's noise its actions hold
-  // the last step's noise; the pose it pulls the cup to does not change with it, and the servo
-  // keeps a learner's errors from adding up into a drift (docs/learners.md, "Position targets").
+  // The tracker cancels the cup's velocity error each step, so under DART's noise its actions
+  // hold the last step's noise; the pose it pulls the cup to does not change with it, and the
+  // servo keeps a learner's errors from adding up into a drift (docs/learners.md, "Position
+  // targets").
   std::string preferred_features() const override {
     return params().choice("expert") == "tracker" ? "state+clock+start_state" + std::string(kPositionTargetSuffix)
                                                   : std::string();

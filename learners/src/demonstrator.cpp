@@ -93,11 +93,11 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}}};
 }
 
-bool servo_targets(const LearnContext& c) { return feature_map(c.features).target() == ActionTarget::position; }
+bool servo_targets(const std::string& features) { return feature_map(features).target() == ActionTarget::position; }
 
 int tracker_paths_for(int paths, const std::string& features) {
   if (paths >= 0) return paths;
-  return feature_map(features).target() == ActionTarget::position ? kServoPaths : kOtherPaths;
+  return servo_targets(features) ? kServoPaths : kOtherPaths;
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {

@@ -321,9 +321,7 @@ struct RunPlan {
           out.push_back(kv);
         }
     };
-    for (const std::string* key : {&learner, &spec})
-      if (const auto defaults = profile->learner_options.find(*key); defaults != profile->learner_options.end())
-        for (const auto& kv : defaults->second) put(kv);
+    for (const auto& kv : profile->options_for(learner, spec)) put(kv);
     for (const auto& kv : specs.at(spec).options) put(kv);
     for (const auto& kv : request.options) put(kv);
     return out;

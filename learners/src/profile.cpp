@@ -45,6 +45,14 @@ const std::vector<Profile>& profiles() {
 
 }  // namespace
 
+std::vector<std::string> Profile::options_for(const std::string& learner, const std::string& spec) const {
+  std::vector<std::string> out;
+  for (const std::string* key : {&learner, &spec})
+    if (const auto it = learner_options.find(*key); it != learner_options.end() && (key == &learner || spec != learner))
+      out.insert(out.end(), it->second.begin(), it->second.end());
+  return out;
+}
+
 const Profile& leaderboard_profile(const std::string& name) {
   for (const auto& p : profiles())
     if (p.name == name) return p;

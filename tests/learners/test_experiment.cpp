@@ -68,6 +68,10 @@ TEST(Profile, QuickAndPaperAreDataAndOtherNamesAreRefused) {
   // A row spec's own defaults: the tracker's row keeps the main job within its minutes.
   EXPECT_EQ(quick.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
   EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
+  EXPECT_EQ(quick.options_for("dart", "dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
+  EXPECT_TRUE(quick.options_for("dart", "dart").empty());
+  EXPECT_EQ(quick.options_for("dagger", "dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}))
+      << "a spec that is the learner's name is looked up once";
   EXPECT_GT(paper.optimiser_evaluations, quick.optimiser_evaluations);
   try {
     leaderboard_profile("huge");

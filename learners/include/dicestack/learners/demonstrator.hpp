@@ -29,10 +29,10 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
                                                   const TrackerConfig& config, std::uint64_t seed, int threads = 0,
                                                   Cluster& cluster = local_cluster());
 
-/// True when the context's feature map answers a cup pose to servo to ("/position"): the
+/// True when the feature map `features` answers a cup pose to servo to ("/position"): the
 /// tracker's labels are then one pose per step, and the learners follow one recording
 /// (docs/learners.md, "Position targets").
-bool servo_targets(const LearnContext& c);
+bool servo_targets(const std::string& features);
 
 /// How many recordings a learner's tracker follows for the option value `paths`: -1 is the
 /// default for the feature map `features` (1 for a "/position" map, else 3); others as given.

@@ -27,6 +27,10 @@ struct Profile {
   int bayes_evaluations = 200;       ///< Bayesian optimisation (each evaluation refits a GP)
   int reinforce_iterations = 100;
   int rrt_nodes = 100;
+
+  /// The options this profile gives a learner row, in order of application: those for the
+  /// learner ("dart"), then those for the row's spec ("dart:expert=tracker").
+  std::vector<std::string> options_for(const std::string& learner, const std::string& spec) const;
 };
 
 /// "quick" (minutes on 2 cores) or "paper" (the paper's budgets; about an hour and a half).
