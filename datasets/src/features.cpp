@@ -24,7 +24,14 @@ struct Blocks {
   bool previous = false;
   bool start_state = false;  // the whole start state instead of its two summary numbers
   Current current = Current::state;
+  bool dice_frame = false;  // x measured from the start's mean die x (which one more column holds)
 };
+
+double start_dice_mean_x(const State& s0) {
+  double dice = 0.0;
+  for (std::size_t i = 0; i < kDiceCount; ++i) dice += s0[si::die(i)];
+  return dice / static_cast<double>(kDiceCount);
+}
 
 // The state a map's row and answer refer to: for an "/ahead" map the cup where it is when the
 // action lands (computed into `scratch`), else the current state itself (no copy: the hot path).
@@ -43,11 +50,12 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
   ActionTarget target() const override { return target_; }
   bool ahead() const override { return ahead_; }
+  double origin_x(const History& h) const override { return blocks_.dice_frame ? start_dice_mean_x(h.start()) : 0.0; }
   const Blocks& blocks() const { return blocks_; }
 
   std::size_t width() const override {
     return current_width() + (blocks_.clock ? 1 : 0) + (blocks_.start ? 2 : 0) + (blocks_.previous ? kStateDim : 0) +
-           (blocks_.start_state ? kStateDim : 0);
+           (blocks_.start_state ? kStateDim : 0) + (blocks_.dice_frame ? 1 : 0);
   }
 
   std::vector<std::string> column_names() const override {
@@ -62,31 +70,40 @@ class BuiltinFeatureMap final : public FeatureMap {
       for (auto n : state_names()) out.push_back("prev_" + std::string(n));
     if (blocks_.start_state)
       for (auto n : state_names()) out.push_back("start_" + std::string(n));
+    if (blocks_.dice_frame) out.emplace_back("origin_x");
     return out;
   }
 
   void compute(const History& h, std::span<double> out) const override {
     State scratch;
     const State& s = acting_state(*this, h, scratch);
+    // Under the dice frame every x is measured from the start's mean die x (that origin last).
+    const double x0 = blocks_.dice_frame ? start_dice_mean_x(h.start()) : 0.0;
+    const auto put_state = [&](const State& from, std::size_t at) {
+      std::copy(from.begin(), from.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
+      if (!blocks_.dice_frame) return;
+      out[at + si::kCupX] -= x0;
+      for (std::size_t i = 0; i < kDiceCount; ++i) out[at + si::die(i)] -= x0;
+    };
     std::size_t at = 0;
-    if (blocks_.current == Current::state) std::copy(s.begin(), s.end(), out.begin());
+    if (blocks_.current == Current::state) put_state(s, 0);
     if (blocks_.current == Current::cup)
-      for (auto k : kCupParts) out[at++] = s[k];
+      for (auto k : kCupParts) out[at++] = s[k] - (k == si::kCupX ? x0 : 0.0);
     at = current_width();
     if (blocks_.clock) out[at++] = static_cast<double>(h.t());
     if (blocks_.start) {
-      const State& s0 = h.start();
-      double dice = 0.0;
-      for (std::size_t i = 0; i < kDiceCount; ++i) dice += s0[si::die(i)];
-      out[at++] = s0[si::kCupX];
-      out[at++] = dice / static_cast<double>(kDiceCount);
+      out[at++] = h.start()[si::kCupX] - x0;
+      out[at++] = start_dice_mean_x(h.start()) - x0;
     }
     if (blocks_.previous) {
-      const State& p = h.states.size() >= 2 ? h.states[h.states.size() - 2] : s;
-      std::copy(p.begin(), p.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
+      put_state(h.states.size() >= 2 ? h.states[h.states.size() - 2] : s, at);
       at += kStateDim;
     }
-    if (blocks_.start_state) std::copy(h.start().begin(), h.start().end(), out.begin() + static_cast<std::ptrdiff_t>(at));
+    if (blocks_.start_state) {
+      put_state(h.start(), at);
+      at += kStateDim;
+    }
+    if (blocks_.dice_frame) out[at] = x0;
   }
 
  private:
@@ -115,6 +132,13 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "state+history", "the state and the previous state (the start repeated at t = 0)", Blocks{false, false, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>("state+clock+start_state", "the state, t and the whole start state",
                                                      Blocks{true, false, false, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "state+clock+start_state@dice",
+        "the state, t and the whole start state, every x measured from the start's mean die x (that origin last)",
+        Blocks{true, false, false, true, Current::state, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "clock+start_state@dice", "open loop: t and the whole start state, every x measured from the start's mean die x (that origin last)",
+        Blocks{true, false, false, true, Current::none, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
         Blocks{true, false, false, true, Current::none}));
@@ -182,7 +206,9 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
     switch (target()) {
       case ActionTarget::impulse: out[k] = action[k]; break;
       case ActionTarget::velocity: out[k] = action[k] + s[kCupVelocity[k]]; break;
-      case ActionTarget::position: out[k] = s[kCupPose[k]] + (action[k] + s[kCupVelocity[k]]) / kPositionGain; break;
+      case ActionTarget::position:
+        out[k] = s[kCupPose[k]] + (action[k] + s[kCupVelocity[k]]) / kPositionGain - (k == 0 ? origin_x(h) : 0.0);
+        break;
     }
   }
 }
@@ -195,7 +221,9 @@ Action FeatureMap::action(const History& h, std::span<const double> output) cons
     switch (target()) {
       case ActionTarget::impulse: a[k] = output[k]; break;
       case ActionTarget::velocity: a[k] = output[k] - s[kCupVelocity[k]]; break;
-      case ActionTarget::position: a[k] = kPositionGain * (output[k] - s[kCupPose[k]]) - s[kCupVelocity[k]]; break;
+      case ActionTarget::position:
+        a[k] = kPositionGain * (output[k] + (k == 0 ? origin_x(h) : 0.0) - s[kCupPose[k]]) - s[kCupVelocity[k]];
+        break;
     }
   }
   return a;

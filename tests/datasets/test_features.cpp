@@ -195,6 +195,44 @@ TEST(Features, APositionMapAnswersThePoseItsServoPullsTheCupTo) {
   }
 }
 
+TEST(Features, ADiceFrameMapSeesTheSameSceneMovedInXAsTheSame) {
+  // The whole scene, start and now, moved 0.37 m in x: every input but the origin and every
+  // pose answer stay as they were; the origin is the start's mean die x.
+  const std::vector<State> states{numbered(100), numbered(200)};
+  std::vector<State> moved = states;
+  const double dx = 0.37;
+  for (State& s : moved) {
+    s[state_index::kCupX] += dx;
+    for (std::size_t i = 0; i < kDiceCount; ++i) s[state_index::die(i)] += dx;
+  }
+  const History h{states, {}}, hm{moved, {}};
+  for (const auto* name : {"state+clock+start_state@dice", "state+clock+start_state@dice/position",
+                           "state+clock+start_state@dice/velocity"}) {
+    const FeatureMap& m = feature_map(name);
+    const auto row = row_of(m, h), row_moved = row_of(m, hm);
+    ASSERT_EQ(row.size(), feature_map("state+clock+start_state").width() + 1) << name;
+    EXPECT_EQ(m.column_names().back(), "origin_x");
+    const double origin = (103.0 + 109.0 + 115.0) / 3.0;  // numbered(100)'s die x: 103, 109, 115
+    EXPECT_DOUBLE_EQ(row.back(), origin) << name;
+    EXPECT_DOUBLE_EQ(row_moved.back(), origin + dx) << name;
+    for (std::size_t j = 0; j + 1 < row.size(); ++j) EXPECT_NEAR(row[j], row_moved[j], 1e-12) << name << " column " << j;
+    EXPECT_DOUBLE_EQ(row[0], 200.0 - origin) << "the cup's x is measured from the origin";
+    const Action a{0.5, -1.0, 2.0};
+    std::array<double, kActionDim> label{}, label_moved{};
+    m.label(h, a, label);
+    m.label(hm, a, label_moved);
+    for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_NEAR(label[k], label_moved[k], 1e-12) << name << " " << k;
+    const Action back = m.action(hm, label_moved);
+    for (std::size_t k = 0; k < kActionDim; ++k) EXPECT_NEAR(back[k], a[k], 1e-9) << name << " " << k;
+  }
+  // The map without the frame answers a pose in the world's x: the moved scene's label moves.
+  const FeatureMap& world = feature_map("state+clock+start_state/position");
+  std::array<double, kActionDim> label{}, label_moved{};
+  world.label(h, {0.5, -1.0, 2.0}, label);
+  world.label(hm, {0.5, -1.0, 2.0}, label_moved);
+  EXPECT_NEAR(label_moved[0] - label[0], dx, 1e-12);
+}
+
 TEST(Features, AnAheadMapWithNothingPendingIsItsBaseMap) {
   const std::vector<State> states{numbered(100), numbered(200)};
   const History h{states, {}};

@@ -71,6 +71,9 @@ class FeatureMap {
   /// True for a map that acts for the moment its action lands (kAheadSuffix).
   virtual bool ahead() const { return false; }
 
+  /// Where x is measured from in this map's rows and pose answers (0: the world's origin).
+  virtual double origin_x(const History&) const { return 0.0; }
+
   /// The regressor's answer for `action` taken after `history`: a training label.
   void label(const History& history, const Action& action, std::span<double> out) const;
   /// The action for the regressor's answer `output` after `history`. Hot path.
@@ -95,6 +98,9 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 ///    velocity changes, which carry the previous action
 ///  - "state+clock+start_state": + t and the whole start state
 ///  - "clock+start_state", "cup+clock+start_state": open loop, and feedback on the cup alone
+///  - "state+clock+start_state@dice", "clock+start_state@dice": every x measured from the
+///    start's mean die x, that origin a last column (origin_x()): a recording the tracker moves
+///    to each start is then the same rows and poses for every start
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
 /// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default),
 /// and as NAME + "/position" (kPositionTargetSuffix): answering the pose to servo the cup to.
