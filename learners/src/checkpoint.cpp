@@ -60,9 +60,10 @@ std::map<std::string, std::string> saved_options(const json& saved) {
 
 // What a learner's option meant in checkpoints written before the option existed: the behaviour
 // then, which is its default unless listed here (DaD corrected towards whole states before it
-// had "target").
+// had "target"; the tracker did not narrow a path before it had "tracker_shrink").
 std::string value_before(const std::string& learner, const std::string& key) {
   if (learner == "dad" && key == "target") return "state";
+  if (key == "tracker_shrink") return "0";
   for (const auto& p : LearnerRegistry::global().info(learner).params)
     if (p.name == key) return p.default_value;
   return "";
@@ -297,10 +298,18 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
       // this run gives it the value its absence meant.
       const auto before = saved_options(saved);
       const std::string learner = fs::path(state_file).stem().string();
+      // The tracker's options mean nothing to a run whose expert is another.
+      const auto option_then = [&](const std::string& k) {
+        const auto it = before.find(k);
+        return it != before.end() ? it->second : value_before(learner, k);
+      };
+      const json expert_now = value.value("expert", json());
+      const bool tracker_run = option_then("expert") == "tracker" || expert_now == "tracker";
       for (const auto& [k, v] : value.items()) {
+        if (!tracker_run && k.starts_with("tracker_")) continue;
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
-        const std::string then = it != before.end() ? it->second : value_before(learner, k);
+        const std::string then = option_then(k);
         if (meaning(k, then, saved_run) != meaning(k, now, run))
           differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
       }

@@ -55,9 +55,11 @@ constexpr int kServoPaths = 1, kOtherPaths = 3;
 
 // The tracker as the learners' expert: the bare tracker's settings but for what was tuned for
 // DART on the tuning seeds (docs/learners.md, "Policies from the human recordings"): the
-// best-ranked recordings, smoothed, chosen robust to a learner's errors.
+// best-ranked recordings, smoothed, chosen robust to a learner's errors, narrowed before
+// warped where none succeeds as recorded (in the dice frame 80.8 -> 83.0 %, and a 3x faster search).
 TrackerConfig learner_tracker_defaults() {
   TrackerConfig d;
+  d.shrink_steps = 5;
   d.keep = -1;  // kServoPaths or kOtherPaths
   d.smooth = 4.0;
   d.robust_trials = 5;

@@ -297,6 +297,7 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
     return resume_with(j);
   };
   using ::testing::HasSubstr;
+  using ::testing::Not;
   EXPECT_THAT(edited("/version", 5), HasSubstr("dagger.json: format version 5 is newer than this dicestack reads (4)"));
   EXPECT_THAT(edited("/version", 1.5), HasSubstr("dagger.json: field \"version\" must be an integer"));
   EXPECT_THAT(edited("/iteration", "one"), HasSubstr("field \"iteration\" must be an integer in [0, 1000000], got \"one\""));
@@ -306,13 +307,26 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   EXPECT_THAT(edited("/curve/0/deviation", "x"), HasSubstr("field \"curve[0].deviation\" must be a finite number"));
   EXPECT_THAT(edited("/curve", 5), HasSubstr("field \"curve\" must be an array"));
   EXPECT_THAT(edited("/format", "dicestack-model"), HasSubstr("dagger.json: not a checkpoint state"));
+  // The tracker's options mean nothing to a run whose expert is another: not compared.
+  nlohmann::json other = saved;
+  other["run"]["learner_options"]["tracker_paths"] = "7";
+  other["run"]["learner_options"].erase("tracker_shrink");
+  EXPECT_EQ(resume_with(other), "");
+  // A checkpoint of the tracker (so this run differs in its expert, and its tracker options count).
+  nlohmann::json tracked = saved;
+  tracked["run"]["learner_options"]["expert"] = "tracker";
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option expert \"tracker\" in the checkpoint, \"scripted\" in this run"));
   // Written when tracker_paths defaulted to 3, which -1 now means for this run's map.
   EXPECT_EQ(saved["run"]["learner_options"]["tracker_paths"], "-1");
-  nlohmann::json three = saved;
-  three["run"]["learner_options"]["tracker_paths"] = "3";
-  EXPECT_EQ(resume_with(three), "");
-  three["run"]["learner_options"]["tracker_paths"] = "1";
-  EXPECT_THAT(resume_with(three), HasSubstr("option tracker_paths \"1\" in the checkpoint, \"-1\" in this run"));
+  tracked["run"]["learner_options"]["tracker_paths"] = "3";
+  EXPECT_THAT(resume_with(tracked), Not(HasSubstr("tracker_paths")));
+  tracked["run"]["learner_options"]["tracker_paths"] = "1";
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_paths \"1\" in the checkpoint, \"-1\" in this run"));
+  // Written before tracker_shrink existed, when the tracker never narrowed a path.
+  EXPECT_EQ(saved["run"]["learner_options"]["tracker_shrink"], "5");
+  tracked["run"]["learner_options"]["tracker_paths"] = "-1";
+  tracked["run"]["learner_options"].erase("tracker_shrink");
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_shrink \"(absent)\" in the checkpoint, \"5\" in this run"));
   nlohmann::json v2 = saved;  // version 2: the learner's options joined into one string, the --set text
   v2["version"] = 2;
   v2["run"].erase("regressor_params");

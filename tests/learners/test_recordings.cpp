@@ -156,11 +156,11 @@ TEST(LearnerSpec, ParsesOptionsAndRefusesUnknownOnes) {
   EXPECT_THROW(parse_learner_spec("dart:noise"), ConfigError);
 }
 
-TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringPoses) {
+TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringPosesFromTheDice) {
   EXPECT_EQ(default_features("bc"), "state");
   EXPECT_EQ(default_features("dart"), "state+clock+start_state");
   EXPECT_EQ(default_features("dart", {"expert=mpc"}), "state+clock+start_state");
-  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state/position");
+  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state@dice/position");
   EXPECT_EQ(feature_map(default_features("dart", {"expert=tracker"})).target(), ActionTarget::position);
   EXPECT_THROW(default_features("dart", {"expert=oracle"}), ConfigError);
 }
