@@ -57,7 +57,7 @@ int run_learners() {
     if (name.find('/') != std::string::npos) continue;  // the twins are listed once, below
     const FeatureMap& m = feature_map(name);
     char line[256];
-    std::snprintf(line, sizeof line, "  %-23s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
+    std::snprintf(line, sizeof line, "  %-28s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
                   m.description().c_str());
     print_line(line);
   }

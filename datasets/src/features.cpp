@@ -137,11 +137,12 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "the state, t and the whole start state, every x measured from the start's mean die x (that origin last)",
         Blocks{true, false, false, true, Current::state, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
-        "clock+start_state@dice", "open loop: t and the whole start state, every x measured from the start's mean die x (that origin last)",
-        Blocks{true, false, false, true, Current::none, true}));
-    v->push_back(std::make_unique<BuiltinFeatureMap>(
         "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
         Blocks{true, false, false, true, Current::none}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "clock+start_state@dice",
+        "open loop: t and the whole start state, every x measured from the start's mean die x (that origin last)",
+        Blocks{true, false, false, true, Current::none, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "cup+clock+start_state",
         "a pattern with feedback on the cup alone: the cup's position and velocity, t and the whole start state",

@@ -298,7 +298,6 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
       // this run gives it the value its absence meant.
       const auto before = saved_options(saved);
       const std::string learner = fs::path(state_file).stem().string();
-      // The tracker's options mean nothing to a run whose expert is another.
       const auto option_then = [&](const std::string& k) {
         const auto it = before.find(k);
         return it != before.end() ? it->second : value_before(learner, k);
@@ -306,7 +305,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
       const json expert_now = value.value("expert", json());
       const bool tracker_run = option_then("expert") == "tracker" || expert_now == "tracker";
       for (const auto& [k, v] : value.items()) {
-        if (!tracker_run && k.starts_with("tracker_")) continue;
+        if (!tracker_run && k.starts_with("tracker_")) continue;  // nothing to a run of another expert
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
         const std::string then = option_then(k);

@@ -67,8 +67,8 @@ TEST(Profile, QuickAndPaperAreDataAndOtherNamesAreRefused) {
   EXPECT_EQ(quick.learner_options.at("dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}));
   // A row spec's own defaults: the paper profile's tracker rows keep a kernel SVR's fit in bounds.
   EXPECT_EQ(quick.learner_options.count("dart:expert=tracker"), 0U);
-  EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
-  EXPECT_EQ(paper.options_for("dart", "dart:expert=tracker"), (std::vector<std::string>{"episodes=300"}));
+  EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300", "tracker_shrink=0"}));
+  EXPECT_EQ(paper.options_for("dart", "dart:expert=tracker"), (std::vector<std::string>{"episodes=300", "tracker_shrink=0"}));
   EXPECT_TRUE(quick.options_for("dart", "dart:expert=tracker").empty());
   EXPECT_TRUE(quick.options_for("dart", "dart").empty());
   EXPECT_EQ(quick.options_for("dagger", "dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}))

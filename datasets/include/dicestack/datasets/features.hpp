@@ -102,8 +102,9 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 ///    start's mean die x, that origin a last column (origin_x()): a recording the tracker moves
 ///    to each start is then the same rows and poses for every start
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
-/// answering the cup velocity to set ("state+clock+start_state/velocity" is dart's default),
-/// and as NAME + "/position" (kPositionTargetSuffix): answering the pose to servo the cup to.
+/// answering the cup velocity to set, and as NAME + "/position" (kPositionTargetSuffix):
+/// answering the pose to servo the cup to ("state+clock+start_state@dice/position" is dart's
+/// default with the tracker).
 /// Each of these also as NAME + "/ahead" (kAheadSuffix): under delays, the row shows
 /// cup_ahead() instead of the current cup (with no delay, the same rows as NAME). The clock
 /// stays t, the choices made so far: a policy's episode is then the nominal one, d steps late.
