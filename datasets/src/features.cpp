@@ -27,12 +27,6 @@ struct Blocks {
   bool dice_frame = false;  // x measured from the start's mean die x (which one more column holds)
 };
 
-double start_dice_mean_x(const State& s0) {
-  double dice = 0.0;
-  for (std::size_t i = 0; i < kDiceCount; ++i) dice += s0[si::die(i)];
-  return dice / static_cast<double>(kDiceCount);
-}
-
 // The state a map's row and answer refer to: for an "/ahead" map the cup where it is when the
 // action lands (computed into `scratch`), else the current state itself (no copy: the hot path).
 const State& acting_state(const FeatureMap& m, const History& h, State& scratch) {
@@ -50,7 +44,7 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
   ActionTarget target() const override { return target_; }
   bool ahead() const override { return ahead_; }
-  double origin_x(const History& h) const override { return blocks_.dice_frame ? start_dice_mean_x(h.start()) : 0.0; }
+  double origin_x(const History& h) const override { return blocks_.dice_frame ? mean_dice_x(h.start()) : 0.0; }
   const Blocks& blocks() const { return blocks_; }
 
   std::size_t width() const override {
@@ -78,7 +72,7 @@ class BuiltinFeatureMap final : public FeatureMap {
     State scratch;
     const State& s = acting_state(*this, h, scratch);
     // Under the dice frame every x is measured from the start's mean die x (that origin last).
-    const double x0 = blocks_.dice_frame ? start_dice_mean_x(h.start()) : 0.0;
+    const double x0 = blocks_.dice_frame ? mean_dice_x(h.start()) : 0.0;
     const auto put_state = [&](const State& from, std::size_t at) {
       std::copy(from.begin(), from.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
       if (!blocks_.dice_frame) return;
@@ -93,7 +87,7 @@ class BuiltinFeatureMap final : public FeatureMap {
     if (blocks_.clock) out[at++] = static_cast<double>(h.t());
     if (blocks_.start) {
       out[at++] = h.start()[si::kCupX] - x0;
-      out[at++] = start_dice_mean_x(h.start()) - x0;
+      out[at++] = mean_dice_x(h.start()) - x0;
     }
     if (blocks_.previous) {
       put_state(h.states.size() >= 2 ? h.states[h.states.size() - 2] : s, at);

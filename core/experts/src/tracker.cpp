@@ -22,12 +22,6 @@ namespace si = state_index;
 constexpr std::uint64_t kProbeStream = 0x70726f6265ULL;  // "probe"
 constexpr std::uint64_t kProbeNoiseStream = 0x70726f62654eULL;  // "probeN"
 
-double mean_dice_x(const State& s) {
-  double x = 0.0;
-  for (std::size_t i = 0; i < kDiceCount; ++i) x += s[si::die(i)];
-  return x / static_cast<double>(kDiceCount);
-}
-
 void check_path(const CupPath& p) {
   if (p.states.empty()) throw InputError("tracker: recording \"" + p.name + "\" has no steps");
   if (p.states.size() != p.actions.size())

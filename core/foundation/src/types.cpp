@@ -16,6 +16,12 @@ const std::array<std::string_view, kStateDim>& state_names() {
   return names;
 }
 
+double mean_dice_x(const State& s) {
+  double x = 0.0;
+  for (std::size_t i = 0; i < kDiceCount; ++i) x += s[state_index::die(i)];
+  return x / static_cast<double>(kDiceCount);
+}
+
 const std::array<std::string_view, kActionDim>& action_names() {
   static constexpr std::array<std::string_view, kActionDim> names{"dvx", "dvy", "dw"};
   return names;

@@ -29,6 +29,10 @@ inline constexpr std::size_t kCupVx = 21, kCupVy = 22, kCupW = 23;
 constexpr std::size_t die(std::size_t i) { return 3 + 6 * i; }
 }  // namespace state_index
 
+/// The dice' mean x in `s`: where the tracker anchors a recording and the "@dice" feature maps
+/// measure x from.
+double mean_dice_x(const State& s);
+
 /// Column names of a State: cup_x, cup_y, cup_angle, die0_x, ..., die2_w, cup_vx, cup_vy, cup_w.
 const std::array<std::string_view, kStateDim>& state_names();
 
