@@ -57,11 +57,13 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   save_model(*r.result.model, opt.out);
   const std::filesystem::path curve_path = opt.out.string() + ".curve.csv";
   if (!r.result.curve.empty()) write_curve_csv(r.result.curve, curve_path);
+  const auto& record = r.result.model->record;
   if (opt.json) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
                      {"features", r.features},    {"seconds", r.seconds},   {"train_error", r.score.train_error}};
     if (r.score.test_error) j["test_error"] = *r.score.test_error;
     if (!r.result.curve.empty()) j["curve"] = curve_path.string();
+    if (record.contains("tracker_followed")) j["tracker_followed"] = record.at("tracker_followed");
     print_line(j.dump());
   } else {
     char line[256];
@@ -70,6 +72,12 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
                   r.score.test_error ? (", test error " + std::to_string(*r.score.test_error).substr(0, 5)).c_str() : "",
                   opt.out.string().c_str());
     print_line(line);
+    // Which recording a policy from recordings plays, and how robust the ranking found it:
+    // what to look at first when a policy from a few recordings stacks rarely.
+    if (record.contains("tracker_followed")) print_line("  the demonstrator followed " + record.at("tracker_followed"));
+    if (record.contains("dart_expert_successes"))
+      print_line("  dart: the expert succeeded in " + record.at("dart_expert_successes") + " of " +
+                 record.at("dart_episodes") + " noisy episodes");
   }
   return 0;
 }

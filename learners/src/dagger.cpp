@@ -80,6 +80,7 @@ class Dagger final : public Learner {
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";
     model->record["expert"] = expert_name;
+    if (expert_config.recordings) model->record["tracker_followed"] = followed_recordings(*expert_config.recordings);
     if (!perturbation.nominal()) model->record["perturb"] = params().choice("perturb");
     result.model = model;
     return result;

@@ -65,9 +65,11 @@ class Dart final : public Learner {
     r.model->record["learner"] = "dart";
     r.model->record["expert"] = params().choice("expert");
     r.model->record["dart_episodes"] = std::to_string(episodes);
-    if (params().choice("expert") == "tracker")  // the option may say -1: the map's default
+    if (params().choice("expert") == "tracker") {  // the option may say -1: the map's default
       r.model->record["tracker_paths"] = std::to_string(
           tracker_paths_for(static_cast<int>(params().integer("tracker_paths")), c.features));
+      r.model->record["tracker_followed"] = followed_recordings(*expert.recordings);
+    }
     r.model->record["dart_expert_successes"] = std::to_string(successes);
     if (!perturbation.nominal()) r.model->record["perturb"] = params().choice("perturb");
     if (c.progress) c.progress({"fit", 1, 1, 0, 0, 1, 1, 1.0});

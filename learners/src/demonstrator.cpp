@@ -95,6 +95,18 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}}};
 }
 
+std::string followed_recordings(const Recordings& recordings) {
+  const TrackerConfig& c = recordings.config();
+  const int most = c.probes * (1 + c.robust_trials);  // each probe, and each of its noisy trials
+  std::string out;
+  for (const std::size_t p : recordings.order()) {
+    out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;
+    out += most > 0 ? " (" + std::to_string(recordings.probe_successes()[p]) + " of " + std::to_string(most) + " probe trials)"
+                    : " (not ranked)";
+  }
+  return out;
+}
+
 bool servo_targets(const std::string& features) { return feature_map(features).target() == ActionTarget::position; }
 
 int tracker_paths_for(int paths, const std::string& features) {

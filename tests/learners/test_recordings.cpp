@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 #include <unistd.h>
@@ -75,6 +76,11 @@ TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
   EXPECT_EQ(learned.model->record.at("learner"), "dart");
   EXPECT_EQ(learned.model->record.at("tracker_paths"), "3") << "the default resolved for a map answering impulses";
+  // The three best-ranked recordings, each with its score out of 1 probe x (1 + 5 noisy trials).
+  const std::string followed = learned.model->record.at("tracker_followed");
+  EXPECT_THAT(followed, testing::MatchesRegex("[a-z_0-9]+ \\([0-6] of 6 probe trials\\)(, [a-z_0-9]+ \\([0-6] of 6 probe trials\\)){2}"));
+  EXPECT_TRUE(std::any_of(c.demos.begin(), c.demos.end(), [&](const Episode& e) { return followed.starts_with(e.name + " "); }))
+      << followed << " does not start with a recording of the set";
   EXPECT_EQ(tracker_paths_for(-1, "state+clock+start_state/position"), 1);
   EXPECT_EQ(tracker_paths_for(-1, "state/velocity"), 3);
   EXPECT_EQ(tracker_paths_for(5, "state/position"), 5);
@@ -88,6 +94,7 @@ TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
                                               "tracker_optimise=false"})
                            ->learn(c);
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
+  EXPECT_THAT(learned.model->record.at("tracker_followed"), HasSubstr(" (not ranked)")) << "no probes, no ranking";
 }
 
 TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
