@@ -66,9 +66,10 @@ int run_learners() {
              std::string(kPositionTargetSuffix) +
              " (it answers the cup pose to servo to; the action sets the velocity 10/s times the pose error), NAME" +
              std::string(kAheadSuffix) +
-             " (under delays, the cup moved ahead to where it is when the action lands) and NAME" +
+             " (under delays, the cup moved ahead to where it is when the action lands), NAME" +
+             std::string(kLandingSuffix) + " (that, and the clock of the step it lands at) and NAME" +
              std::string(kVelocityTargetSuffix) + std::string(kAheadSuffix) + " or NAME" +
-             std::string(kPositionTargetSuffix) + std::string(kAheadSuffix) + " (both)");
+             std::string(kPositionTargetSuffix) + std::string(kLandingSuffix) + " (both)");
   return 0;
 }
 

@@ -36,8 +36,13 @@ const State& acting_state(const FeatureMap& m, const History& h, State& scratch)
 class BuiltinFeatureMap final : public FeatureMap {
  public:
   BuiltinFeatureMap(std::string name, std::string description, Blocks blocks,
-                    ActionTarget target = ActionTarget::impulse, bool ahead = false)
-      : name_(std::move(name)), description_(std::move(description)), blocks_(blocks), target_(target), ahead_(ahead) {}
+                    ActionTarget target = ActionTarget::impulse, bool ahead = false, bool landing_clock = false)
+      : name_(std::move(name)),
+        description_(std::move(description)),
+        blocks_(blocks),
+        target_(target),
+        ahead_(ahead),
+        landing_clock_(landing_clock) {}
 
   std::string name() const override { return name_; }
   int version() const override { return 1; }
@@ -84,7 +89,7 @@ class BuiltinFeatureMap final : public FeatureMap {
     if (blocks_.current == Current::cup)
       for (auto k : kCupParts) out[at++] = s[k] - (k == si::kCupX ? x0 : 0.0);
     at = current_width();
-    if (blocks_.clock) out[at++] = static_cast<double>(h.t());
+    if (blocks_.clock) out[at++] = static_cast<double>(h.t() + (landing_clock_ ? h.pending.size() : 0));
     if (blocks_.start) {
       out[at++] = h.start()[si::kCupX] - x0;
       out[at++] = mean_dice_x(h.start()) - x0;
@@ -109,6 +114,7 @@ class BuiltinFeatureMap final : public FeatureMap {
   Blocks blocks_;
   ActionTarget target_;
   bool ahead_;
+  bool landing_clock_;  // the clock of the step the action lands at (kLandingSuffix)
 };
 
 constexpr std::size_t kCupVelocity[kActionDim] = {si::kCupVx, si::kCupVy, si::kCupW};
@@ -141,21 +147,29 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "cup+clock+start_state",
         "a pattern with feedback on the cup alone: the cup's position and velocity, t and the whole start state",
         Blocks{true, false, false, true, Current::cup}));
-    // Every map again, its regressor answering the cup velocity to set; then every one of
-    // those again, acting for the moment its action lands (delays).
+    // Every map again, its regressor answering the cup velocity to set, then the pose; then
+    // every one of those again, acting for the moment its action lands (delays), shown the
+    // clock of the step it chooses at ("/ahead") or of the step it lands at ("/landing").
     const std::size_t base = v->size();
-    auto twins = [v](std::size_t count, std::string_view suffix, const std::string& what, ActionTarget target, bool ahead) {
+    enum class Twin { target, ahead, landing };
+    auto twins = [v](std::size_t count, std::string_view suffix, const std::string& what, ActionTarget target, Twin twin) {
       for (std::size_t i = 0; i < count; ++i) {
         const BuiltinFeatureMap& m = *(*v)[i];
         v->push_back(std::make_unique<BuiltinFeatureMap>(m.name() + std::string(suffix), m.description() + "; " + what,
-                                                         m.blocks(), ahead ? m.target() : target, ahead || m.ahead()));
+                                                         m.blocks(), twin == Twin::target ? target : m.target(),
+                                                         twin != Twin::target, twin == Twin::landing));
       }
     };
     twins(base, kVelocityTargetSuffix, "answers the cup velocity to set (the action is its difference from the cup's velocity)",
-          ActionTarget::velocity, false);
+          ActionTarget::velocity, Twin::target);
     twins(base, kPositionTargetSuffix, "answers the cup pose to servo to (the action sets the velocity 10/s times the pose error)",
-          ActionTarget::position, false);
-    twins(v->size(), kAheadSuffix, "under delays, the cup moved ahead to where it is when the action lands", ActionTarget::impulse, true);
+          ActionTarget::position, Twin::target);
+    const std::size_t targets = v->size();
+    twins(targets, kAheadSuffix, "under delays, the cup moved ahead to where it is when the action lands", ActionTarget::impulse,
+          Twin::ahead);
+    twins(targets, kLandingSuffix,
+          "under delays, the cup moved ahead to where it is when the action lands, and the clock of that step",
+          ActionTarget::impulse, Twin::landing);
     return v;
   }();
   return *maps;
@@ -191,7 +205,7 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
       p.substeps != nominal.substeps)
     throw ConfigError("feature map \"" + map.name() +
                       "\" moves the cup ahead in the default world's physics (gravity, control_dt, substeps); this "
-                      "world's differ: use the map without \"" + std::string(kAheadSuffix) + "\"");
+                      "world's differ: use the map without \"" + std::string(map.name().ends_with(kLandingSuffix) ? kLandingSuffix : kAheadSuffix) + "\"");
 }
 
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {

@@ -33,7 +33,7 @@ def resolve_perturbation(perturb, world):
     if isinstance(perturb, _dicestack.Perturbation):
         return perturb
     if isinstance(perturb, dict):
-        fields = {"format": "dicestack-perturbation", "version": 1, **perturb}
+        fields = {"format": "dicestack-perturbation", "version": 2, **perturb}
         try:
             text = json.dumps(fields, allow_nan=False)
         except (TypeError, ValueError) as e:

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 
@@ -132,7 +133,7 @@ TEST(Perturbation, BadFilesAreRefusedNamingTheField) {
   const WorldConfig w = test::short_world(60);
   auto error = [&](const std::string& text) { return test::error_of([&] { perturbation_from_json(text, "p.json", w); }); };
   const std::string head = R"({"format": "dicestack-perturbation", "version": 1, )";
-  EXPECT_THAT(error(R"({"format": "dicestack-perturbation", "version": 2})"), HasSubstr("format version 2 is newer than this dicestack reads (1)"));
+  EXPECT_THAT(error(R"({"format": "dicestack-perturbation", "version": 3})"), HasSubstr("format version 3 is newer than this dicestack reads (2)"));
   EXPECT_THAT(error(R"({"format": "dicestack-world", "version": 1})"), HasSubstr("not a perturbation file"));
   EXPECT_THAT(error(head + R"("wind": 0.1})"), HasSubstr("unknown field \"wind\""));
   EXPECT_THAT(error(head + R"("friction": "lots"})"), HasSubstr("\"friction\" must be a number"));
@@ -140,6 +141,51 @@ TEST(Perturbation, BadFilesAreRefusedNamingTheField) {
   EXPECT_THAT(error(head + R"("action_delay": 1.5})"), HasSubstr("\"action_delay\" must be an integer"));
   EXPECT_THAT(error(head + R"("observation_delay": 500})"), HasSubstr("\"observation_delay\""));
   EXPECT_THAT(error("{"), HasSubstr("p.json: not JSON"));
+  // Drawn delays are version 2, a boolean, and need a delay to draw up to.
+  EXPECT_THAT(error(head + R"("action_delay": 3, "delays_drawn": true})"),
+              HasSubstr("field \"delays_drawn\" is format version 2; this file says version 1"));
+  const std::string head2 = R"({"format": "dicestack-perturbation", "version": 2, )";
+  EXPECT_THAT(error(head2 + R"("action_delay": 3, "delays_drawn": 1})"), HasSubstr("\"delays_drawn\" must be true or false"));
+  EXPECT_THAT(error(head2 + R"("delays_drawn": true})"), HasSubstr("\"delays_drawn\" draws each episode's delays"));
+}
+
+TEST(Perturbation, VersionOneFilesStillLoad) {
+  // A file as dicestack wrote it before drawn delays (format version 1).
+  const std::string v1 = R"({"format": "dicestack-perturbation", "version": 1, "friction": 0.3, "action_delay": 3})";
+  const Perturbation p = perturbation_from_json(v1, "old.json", WorldConfig{});
+  EXPECT_EQ(p.friction, 0.3);
+  EXPECT_EQ(p.action_delay, 3);
+  EXPECT_FALSE(p.delays_drawn);
+}
+
+TEST(Perturbation, DrawnDelaysCoverTheirRangeAndLeaveTheOtherDrawsAlone) {
+  const WorldConfig w;
+  Perturbation fixed = perturbation_level("medium");
+  fixed.action_delay = 3;
+  fixed.observation_delay = 2;
+  Perturbation drawn = fixed;
+  drawn.delays_drawn = true;
+  EXPECT_EQ(perturbation_from_json(perturbation_to_json(drawn), "p.json", w), drawn);
+  EXPECT_THAT(perturbation_summary(drawn), HasSubstr("delays drawn from 0"));
+  std::array<int, 4> action_seen{}, observation_seen{};
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    const PerturbationDraw d = draw_perturbation(drawn, w, seed), f = draw_perturbation(fixed, w, seed);
+    ASSERT_GE(d.action_delay, 0);
+    ASSERT_LE(d.action_delay, 3);
+    ASSERT_GE(d.observation_delay, 0);
+    ASSERT_LE(d.observation_delay, 2);
+    ++action_seen[static_cast<std::size_t>(d.action_delay)];
+    ++observation_seen[static_cast<std::size_t>(d.observation_delay)];
+    EXPECT_EQ(draw_perturbation(drawn, w, seed).action_delay, d.action_delay) << "reproducible";
+    // Everything else is what the fixed delays' file draws, number for number.
+    EXPECT_EQ(to_json(d.world), to_json(f.world)) << seed;
+    EXPECT_EQ(d.action_bias, f.action_bias) << seed;
+    EXPECT_EQ(d.noise_seed, f.noise_seed) << seed;
+    EXPECT_EQ(f.action_delay, 3);
+  }
+  for (int n : action_seen) EXPECT_GT(n, 20) << "every action delay from 0 to 3 drawn";
+  EXPECT_EQ(observation_seen[3], 0);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_GT(observation_seen[k], 30) << k;
 }
 
 }  // namespace

@@ -247,16 +247,35 @@ TEST(Features, AnAheadMapWithNothingPendingIsItsBaseMap) {
   const History h{states, {}};
   int maps = 0;
   for (const auto& n : feature_map_names()) {
-    if (!n.ends_with(kAheadSuffix)) continue;
-    const FeatureMap& ahead = feature_map(n);
-    const FeatureMap& base = feature_map(n.substr(0, n.size() - kAheadSuffix.size()));
-    EXPECT_TRUE(ahead.ahead()) << n;
-    EXPECT_FALSE(base.ahead()) << n;
-    EXPECT_EQ(ahead.target(), base.target()) << n;
-    EXPECT_EQ(row_of(ahead, h), row_of(base, h)) << n;
-    ++maps;
+    for (const std::string_view suffix : {kAheadSuffix, kLandingSuffix}) {
+      if (!n.ends_with(suffix)) continue;
+      const FeatureMap& ahead = feature_map(n);
+      const FeatureMap& base = feature_map(n.substr(0, n.size() - suffix.size()));
+      EXPECT_TRUE(ahead.ahead()) << n;
+      EXPECT_FALSE(base.ahead()) << n;
+      EXPECT_EQ(ahead.target(), base.target()) << n;
+      EXPECT_EQ(row_of(ahead, h), row_of(base, h)) << n;
+      ++maps;
+    }
   }
-  EXPECT_EQ(maps * 2, static_cast<int>(feature_map_names().size())) << "every map has its /ahead twin";
+  EXPECT_EQ(maps * 3, static_cast<int>(feature_map_names().size()) * 2) << "every map has its /ahead and /landing twins";
+}
+
+TEST(Features, ALandingMapShowsTheClockOfTheStepItsActionLandsAt) {
+  // Two choices pending: the action chosen now runs at t + 2. Everything else is the /ahead row.
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const std::vector<Action> pending{{1.0, 0.0, 0.0}, {0.0, 2.0, 0.5}};
+  const History h{states, {}, pending};
+  const FeatureMap& landing = feature_map("state+clock+start_state@dice/position/landing");
+  const FeatureMap& ahead = feature_map("state+clock+start_state@dice/position/ahead");
+  const auto row = row_of(landing, h), ahead_row = row_of(ahead, h);
+  ASSERT_EQ(row.size(), ahead_row.size());
+  EXPECT_EQ(landing.column_names(), ahead.column_names());
+  for (std::size_t j = 0; j < row.size(); ++j) EXPECT_EQ(row[j], j == kStateDim ? 3.0 : ahead_row[j]) << j;
+  EXPECT_EQ(ahead_row[kStateDim], 1.0);
+  // Under an observation delay alone nothing is pending: the clock is the step now.
+  const std::vector<Action> unseen{{1.0, 0.0, 0.0}};
+  EXPECT_EQ(row_of(landing, History{states, {}, {}, unseen})[kStateDim], 1.0);
 }
 
 TEST(Features, AnAheadMapShowsTheCupWhereThePendingActionsTakeIt) {

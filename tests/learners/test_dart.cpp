@@ -6,6 +6,8 @@
 #include <set>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/learners/evaluate.hpp>
@@ -157,6 +159,31 @@ TEST(Dart, RecordedEpisodesUnderAPerturbationAreThreadIndependent) {
     EXPECT_EQ(one[i].states, two[i].states);
     EXPECT_NE(one[i].states, nominal[i].states);
   }
+}
+
+TEST(Dart, DrawnDelaysDifferByEpisodeAndEachEpisodeSavesItsOwn) {
+  // Domain randomisation over latency: one file, a delay per episode, the one each episode got
+  // saved with it (what the dataset replays the /ahead and /landing rows from).
+  const WorldConfig w = test::short_world(20);
+  RecordRequest r = test::record_request(12, 5, 1);
+  r.perturbation.action_delay = 3;
+  r.perturbation.observation_delay = 2;
+  r.perturbation.delays_drawn = true;
+  const auto one = record_expert("scripted", {}, w, r);
+  r.threads = 2;
+  const auto two = record_expert("scripted", {}, w, r);
+  std::set<long long> action, observation;
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states) << i;
+    const auto drawn = nlohmann::json::parse(one[i].perturbation);
+    action.insert(drawn.at("action_delay").get<long long>());
+    observation.insert(drawn.at("observation_delay").get<long long>());
+  }
+  EXPECT_GE(action.size(), 3u);
+  EXPECT_GE(*action.begin(), 0);
+  EXPECT_LE(*action.rbegin(), 3);
+  EXPECT_GE(observation.size(), 2u);
+  EXPECT_LE(*observation.rbegin(), 2);
 }
 
 TEST(Dart, AModelFileAloneRollsOut) {

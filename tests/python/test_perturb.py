@@ -68,11 +68,19 @@ def test_the_vector_env_gives_each_environment_its_own_draw(rng):
     assert not np.array_equal(rows[:, 0], rows[:, 1])
 
 
+def test_drawn_delays_give_each_episode_its_own_delay():
+    env = dicestack.DiceStackEnv(perturb={"action_delay": 3, "delays_drawn": True})
+    delays = [env.reset(seed=s)[1]["perturbation"]["action_delay"] for s in range(40)]
+    assert set(delays) == {0, 1, 2, 3}
+    assert env.reset(seed=5)[1]["perturbation"]["action_delay"] == delays[5]
+
+
 @pytest.mark.parametrize("perturb, message", [
     ("extreme", "none, easy, medium, hard"),
     ({"friction": 1.5}, "\"friction\""),
     ({"action_delay": 1000}, "\"action_delay\""),
     ({"wind": 0.1}, "unknown field \"wind\""),
+    ({"delays_drawn": True}, "\"delays_drawn\" draws each episode's delays"),
 ])
 def test_bad_perturbations_are_refused_naming_the_field(perturb, message):
     with pytest.raises(ValueError, match=message.replace('"', '.')):

@@ -19,8 +19,10 @@ namespace {
 using json = nlohmann::json;
 
 constexpr const char* kFormat = "dicestack-perturbation";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;  // 2: "delays_drawn"
 constexpr std::uint64_t kPerturbStream = 0x70657274ULL;  // "pert": a stream of its own per episode
+constexpr std::uint64_t kDelayStream = 0x64656c61ULL;    // "dela": drawn delays, apart so the rest stays as in version 1
+constexpr const char* kDelaysDrawn = "delays_drawn";
 
 // The level table (docs/robustness.md). Index 0 none, 1 easy, 2 medium, 3 hard. Anchors:
 // robosuite (friction +-10 %, mass +-2 %), Isaac Lab's cube (friction x[0.7, 1.3], mass
@@ -140,6 +142,9 @@ void validate(const Perturbation& p, const WorldConfig& world, const std::string
                              std::to_string(world.episode.max_steps) + " steps)";
   require(p.action_delay >= 0 && p.action_delay <= room, "action_delay", delays, p.action_delay);
   require(p.observation_delay >= 0 && p.observation_delay <= room, "observation_delay", delays, p.observation_delay);
+  if (p.delays_drawn && p.action_delay == 0 && p.observation_delay == 0)
+    throw ConfigError(source + ": field \"" + kDelaysDrawn +
+                      "\" draws each episode's delays from 0 to action_delay and observation_delay, and both are 0");
   // The widened starts must still fit inside the walls with the dice apart (the world's own
   // check); the physics factors stay in range by the bounds above.
   if (p.start_widening > 0) {
@@ -160,6 +165,7 @@ std::string perturbation_to_json(const Perturbation& p) {
   j["format"] = kFormat;
   j["version"] = kVersion;
   for (const auto& k : kKeys) j[k.name] = k.real ? json(p.*k.real) : json(p.*k.whole);
+  j[kDelaysDrawn] = p.delays_drawn;
   return j.dump(2) + "\n";
 }
 
@@ -169,6 +175,7 @@ std::string perturbation_summary(const Perturbation& p) {
     const double v = k.real ? p.*k.real : p.*k.whole;
     if (v != 0.0) out << (out.tellp() > 0 ? ", " : "") << k.name << ' ' << v;
   }
+  if (p.delays_drawn) out << ", delays drawn from 0";
   return out.tellp() > 0 ? out.str() : "none";
 }
 
@@ -190,6 +197,13 @@ Perturbation perturbation_from_json(std::string_view text, const std::string& so
   Perturbation p;
   for (const auto& [key, value] : j.items()) {
     if (key == "format" || key == "version") continue;
+    if (key == kDelaysDrawn) {
+      if (v.get<long long>() < 2)
+        throw InputError(source + ": field \"" + key + "\" is format version 2; this file says version 1");
+      if (!value.is_boolean()) throw InputError(source + ": field \"" + key + "\" must be true or false");
+      p.delays_drawn = value.get<bool>();
+      continue;
+    }
     const Key* k = nullptr;
     for (const auto& candidate : kKeys)
       if (key == candidate.name) k = &candidate;
@@ -251,6 +265,11 @@ PerturbationDraw draw_perturbation(const Perturbation& p, const WorldConfig& wor
   d.action_delay = p.action_delay;
   for (std::size_t k = 0; k < kStateDim; ++k) d.observation_noise[k] = p.observation_noise * observation_spread()[k];
   d.observation_delay = p.observation_delay;
+  if (p.delays_drawn) {
+    Rng delays(derive_seed(episode_seed, kDelayStream));
+    d.action_delay = static_cast<int>(delays.below(static_cast<std::uint64_t>(p.action_delay) + 1));
+    d.observation_delay = static_cast<int>(delays.below(static_cast<std::uint64_t>(p.observation_delay) + 1));
+  }
   auto& r = d.world.randomization;
   for (double* range : {&r.shift, &r.cup_lift, &r.cup_tilt}) *range *= 1.0 + p.start_widening;
   d.physics = p.friction > 0 || p.dice_mass > 0 || p.cup_mass > 0 || p.gravity > 0 || p.start_widening > 0;

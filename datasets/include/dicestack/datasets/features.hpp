@@ -68,7 +68,7 @@ class FeatureMap {
   /// What the regressor's kActionDim outputs are (default: the action).
   virtual ActionTarget target() const { return ActionTarget::impulse; }
 
-  /// True for a map that acts for the moment its action lands (kAheadSuffix).
+  /// True for a map that acts for the moment its action lands (kAheadSuffix, kLandingSuffix).
   virtual bool ahead() const { return false; }
 
   /// Where x is measured from in this map's rows and pose answers (0: the world's origin).
@@ -110,6 +110,9 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 /// stays t, the choices made so far: a policy's episode is then the nominal one, d steps late.
 /// (Shown the step its action lands at, a policy trained without delay meets at t = d a cup
 /// that has not moved yet, which it never saw: measured, docs/robustness.md.)
+/// And as NAME + "/landing" (kLandingSuffix): the "/ahead" row with the clock of the step the
+/// action lands at (t plus the pending actions): for a policy trained under delays drawn per
+/// episode, which then reads one clock for the cup it meets, whatever the delay.
 /// Throws ConfigError for another name, listing these.
 const FeatureMap& feature_map(std::string_view name);
 
@@ -123,6 +126,8 @@ inline constexpr double kPositionGain = 10.0;
 
 /// The suffix of a map that acts for the moment its action lands (FeatureMap::ahead()).
 inline constexpr std::string_view kAheadSuffix = "/ahead";
+/// The suffix of an "/ahead" map whose clock is the step its action lands at.
+inline constexpr std::string_view kLandingSuffix = "/landing";
 
 /// Names feature_map() accepts, in listing order.
 std::vector<std::string> feature_map_names();

@@ -34,6 +34,9 @@ struct Perturbation {
   // (observation_spread()), `delay` steps late.
   double observation_noise = 0.0;  ///< in [0, 10]
   int observation_delay = 0;       ///< steps, in [0, 100]
+  // Domain randomisation over delays: each episode's action and observation delays drawn
+  // uniformly from 0 to the values above (format version 2), so one policy meets them all.
+  bool delays_drawn = false;
   // Starts: randomization.shift, cup_lift and cup_tilt multiplied by (1 + this). The dice's
   // jitter stays: the default dice start one side plus twice the jitter apart already.
   double start_widening = 0.0;  ///< in [0, 3]
@@ -59,7 +62,8 @@ Perturbation perturbation_factor(std::string_view factor, std::string_view level
 void validate(const Perturbation& p, const WorldConfig& world, const std::string& source = "perturbation");
 
 /// "none", "easy", "medium", "hard", or a file written by perturbation_to_json (format
-/// "dicestack-perturbation", version 1). Throws ConfigError / InputError naming the file and field.
+/// "dicestack-perturbation", versions 1 and 2). Throws ConfigError / InputError naming the file
+/// and field.
 Perturbation load_perturbation(const std::string& level_or_file, const WorldConfig& world);
 std::string perturbation_to_json(const Perturbation& p);
 /// The fields that are on, as "friction 0.3, action_delay 3" ("none" when nominal): for
