@@ -205,7 +205,8 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
       p.substeps != nominal.substeps)
     throw ConfigError("feature map \"" + map.name() +
                       "\" moves the cup ahead in the default world's physics (gravity, control_dt, substeps); this "
-                      "world's differ: use the map without \"" + std::string(map.name().ends_with(kLandingSuffix) ? kLandingSuffix : kAheadSuffix) + "\"");
+                      "world's differ: use the map without \"" +
+                      std::string(map.name().ends_with(kLandingSuffix) ? kLandingSuffix : kAheadSuffix) + "\"");
 }
 
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {

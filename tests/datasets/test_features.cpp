@@ -366,6 +366,8 @@ TEST(Features, AheadMapsRefuseAWorldWhosePhysicsTheyDoNotPredict) {
   w.physics.substeps = 8;
   EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state+clock/velocity/ahead"), w); }),
               HasSubstr("state+clock/velocity/ahead"));
+  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state+clock/position/landing"), w); }),
+              HasSubstr("use the map without \"/landing\""));
 }
 
 }  // namespace
