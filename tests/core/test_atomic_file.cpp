@@ -62,6 +62,20 @@ TEST(AtomicFile, UnwritableDirectoryIsAnInputError) {
   EXPECT_THROW(AtomicFile("/nonexistent-dir/x.txt", kText), InputError);
 }
 
+TEST(AtomicFile, AMissingFolderIsRefusedBeforeAnyWork) {
+  // check_replaceable is what commands call before they train or roll out: a missing folder
+  // is named there, not when the result is written minutes later.
+  const fs::path dir = unique_dir("missing");
+  EXPECT_EQ(test::error_of([&] { check_replaceable(dir / "nowhere" / "m.dsm", kText); }),
+            (dir / "nowhere" / "m.dsm").string() + ": its folder " + (dir / "nowhere").string() +
+                " does not exist (or is not a folder); create it first");
+  { std::ofstream(dir / "file") << "old\n"; }
+  EXPECT_THAT(test::error_of([&] { check_replaceable(dir / "file" / "m.dsm", kText); }), HasSubstr("is not a folder"));
+  EXPECT_NO_THROW(check_replaceable(dir / "m.dsm", kText));
+  EXPECT_NO_THROW(check_replaceable("relative-name-in-the-working-folder.dsm", kText));
+  fs::remove_all(dir);
+}
+
 TEST(AtomicFile, AFileThatIsNotOursIsRefusedAndKept) {
   const fs::path dir = unique_dir("foreign");
   const fs::path path = dir / "model.dsm";

@@ -79,6 +79,11 @@ Ownership Ownership::unchecked(std::string what) { return {std::move(what), null
 
 void check_replaceable(const fs::path& path, const Ownership& owner) {
   std::error_code ec;
+  // A folder that is not there fails every write into it: say so before any work, not after.
+  const fs::path parent = path.parent_path();
+  if (!parent.empty() && fs::status(parent, ec).type() != fs::file_type::directory)
+    throw InputError(path.string() + ": its folder " + parent.string() +
+                     " does not exist (or is not a folder); create it first");
   const auto st = fs::symlink_status(path, ec);
   if (ec || st.type() == fs::file_type::not_found) return;
   if (!owner.recognises && st.type() == fs::file_type::regular) return;
