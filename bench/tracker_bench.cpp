@@ -4,14 +4,15 @@
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
 //       [--recordings K [--subset-seed S]] [--probes P] [--paths N] [--no-optimise]
 //       [--noise F [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path] [--json]
-//       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv]
+//       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv] [--retry]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
 // --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
 // from each start instead, with and without that noise, and lists them by successes.
 // --rescue N runs the tracker expert with rescue_interval N (closed loop on the dice) instead of
-// the chosen path's follower. --robust K makes robust choices (TrackerConfig::robust_trials);
+// the chosen path's follower; --retry runs it trying again once a failed attempt has come to rest
+// (ExpertConfig::retry). --robust K makes robust choices (TrackerConfig::robust_trials);
 // --choices writes each start's dice x, chosen recording, warp and outcome.
 #include <algorithm>
 #include <chrono>
@@ -40,7 +41,7 @@ struct Options {
   std::uint64_t seed = 1000, subset_seed = 0;
   TrackerConfig tracker;
   double noise = 0.0, noise_from = 0.0, noise_to = 1e9;
-  bool per_path = false, json = false;
+  bool per_path = false, json = false, retry = false;
   std::string choices;  // --choices FILE: one CSV line per start
 };
 
@@ -62,6 +63,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--paths") o.tracker.keep = std::stoi(next());
     else if (a == "--no-optimise") o.tracker.optimise = false;
     else if (a == "--rescue") o.tracker.rescue_interval = std::stoi(next());
+    else if (a == "--retry") o.retry = true;
     else if (a == "--smooth") o.tracker.smooth = std::stod(next());
     else if (a == "--robust") o.tracker.robust_trials = std::stoi(next());
     else if (a == "--robust-noise") o.tracker.robust_noise = std::stod(next());
@@ -149,6 +151,7 @@ int main(int argc, char** argv) try {
   EnvPool envs(world, o.threads), sims(world, o.threads);
   ExpertConfig expert_config;
   expert_config.recordings = recordings;
+  expert_config.retry = o.retry;
   std::vector<std::unique_ptr<Expert>> experts;
   for (int w = 0; w < resolve_threads(o.threads); ++w) experts.push_back(make_expert("tracker", expert_config));
   const auto t1 = clock::now();
@@ -160,7 +163,7 @@ int main(int argc, char** argv) try {
     r.choice = choose_path(*recordings, env, sims.at(w), s);
     const PathFollower follower(recordings->paths()[r.choice.path], r.choice.warp, env.get_state(), env.t(),
                                 o.tracker.gain, o.tracker.keep_extremes);
-    Expert* expert = o.tracker.rescue_interval > 0 ? experts[static_cast<std::size_t>(w)].get() : nullptr;
+    Expert* expert = o.tracker.rescue_interval > 0 || o.retry ? experts[static_cast<std::size_t>(w)].get() : nullptr;
     if (expert) expert->reset(s);
     r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);
   });

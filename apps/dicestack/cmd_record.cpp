@@ -28,7 +28,7 @@ struct RecordOptions {
   int threads = 0;
   double noise = 0.0;
   std::string perturb = "none";
-  bool successes_only = false, no_replan = false;
+  bool successes_only = false, no_replan = false, retry = false;
   bool json = false;
 };
 
@@ -42,6 +42,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
+  expert.retry = opt.retry;
   std::string recordings;  // for the provenance
   if (opt.expert == "tracker") {
     if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
@@ -66,7 +67,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   header.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string());
   header.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
                       std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
-                      (opt.no_replan ? " --no-replan" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
+                      (opt.no_replan ? " --no-replan" : "") + (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
                       (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
                       (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
                       "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
@@ -155,6 +156,9 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_flag("--no-replan", opt->no_replan,
                 "mpc: choose the plan once, from the start, and never replan (its actions are then a function of "
                 "the start, the step and the state)");
+  cmd->add_flag("--retry", opt->retry,
+                "mpc and tracker: once a failed attempt has come to rest, start afresh from there (a new plan, a "
+                "path chosen anew), as the +retry feature maps expect");
   cmd->add_flag("--successes-only", opt->successes_only, "Keep only realistic successes");
   cmd->add_flag("--json", opt->json, "Print one JSON object");
   cmd->callback([opt, &cluster] { run_record(*opt, cluster); });

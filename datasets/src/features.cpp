@@ -5,6 +5,7 @@
 #include <memory>
 
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/judge.hpp>
 #include <dicestack/core/world_config.hpp>
 
 namespace dicestack {
@@ -25,7 +26,15 @@ struct Blocks {
   bool start_state = false;  // the whole start state instead of its two summary numbers
   Current current = Current::state;
   bool dice_frame = false;  // x measured from the start's mean die x (which one more column holds)
+  bool attempts = false;    // the clock and the start restart with each attempt (attempt_start)
 };
+
+// The step the current attempt began at, judged in the default world (a map has no world of its
+// own; the tracker's retries judge in it too, so both agree).
+std::size_t attempt_begin(const History& h) {
+  static const WorldConfig nominal{};
+  return attempt_start(h.states, nominal);
+}
 
 // The state a map's row and answer refer to: for an "/ahead" map the cup where it is when the
 // action lands (computed into `scratch`), else the current state itself (no copy: the hot path).
@@ -49,7 +58,8 @@ class BuiltinFeatureMap final : public FeatureMap {
   std::string description() const override { return description_; }
   ActionTarget target() const override { return target_; }
   bool ahead() const override { return ahead_; }
-  double origin_x(const History& h) const override { return blocks_.dice_frame ? mean_dice_x(h.start()) : 0.0; }
+  bool attempts() const override { return blocks_.attempts; }
+  double origin_x(const History& h) const override { return blocks_.dice_frame ? mean_dice_x(start_of(h)) : 0.0; }
   const Blocks& blocks() const { return blocks_; }
 
   std::size_t width() const override {
@@ -76,8 +86,10 @@ class BuiltinFeatureMap final : public FeatureMap {
   void compute(const History& h, std::span<double> out) const override {
     State scratch;
     const State& s = acting_state(*this, h, scratch);
+    const std::size_t begin = blocks_.attempts ? attempt_begin(h) : 0;
+    const State& start = h.states[begin];
     // Under the dice frame every x is measured from the start's mean die x (that origin last).
-    const double x0 = blocks_.dice_frame ? mean_dice_x(h.start()) : 0.0;
+    const double x0 = blocks_.dice_frame ? mean_dice_x(start) : 0.0;
     const auto put_state = [&](const State& from, std::size_t at) {
       std::copy(from.begin(), from.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
       if (!blocks_.dice_frame) return;
@@ -89,23 +101,25 @@ class BuiltinFeatureMap final : public FeatureMap {
     if (blocks_.current == Current::cup)
       for (auto k : kCupParts) out[at++] = s[k] - (k == si::kCupX ? x0 : 0.0);
     at = current_width();
-    if (blocks_.clock) out[at++] = static_cast<double>(h.t() + (landing_clock_ ? h.pending.size() : 0));
+    if (blocks_.clock) out[at++] = static_cast<double>(h.t() - begin + (landing_clock_ ? h.pending.size() : 0));
     if (blocks_.start) {
-      out[at++] = h.start()[si::kCupX] - x0;
-      out[at++] = mean_dice_x(h.start()) - x0;
+      out[at++] = start[si::kCupX] - x0;
+      out[at++] = mean_dice_x(start) - x0;
     }
     if (blocks_.previous) {
       put_state(h.states.size() >= 2 ? h.states[h.states.size() - 2] : s, at);
       at += kStateDim;
     }
     if (blocks_.start_state) {
-      put_state(h.start(), at);
+      put_state(start, at);
       at += kStateDim;
     }
     if (blocks_.dice_frame) out[at] = x0;
   }
 
  private:
+  const State& start_of(const History& h) const { return blocks_.attempts ? h.states[attempt_begin(h)] : h.start(); }
+
   std::size_t current_width() const {
     return blocks_.current == Current::state ? kStateDim : blocks_.current == Current::cup ? std::size(kCupParts) : 0;
   }
@@ -136,6 +150,16 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
         "state+clock+start_state@dice",
         "the state, t and the whole start state, every x measured from the start's mean die x (that origin last)",
         Blocks{true, false, false, true, Current::state, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "state+clock+start_state+retry",
+        "as state+clock+start_state, the clock and the start restarting when a failed attempt has come to rest "
+        "(the dice at rest, none in the cup, not stacked: attempt_start)",
+        Blocks{true, false, false, true, Current::state, false, true}));
+    v->push_back(std::make_unique<BuiltinFeatureMap>(
+        "state+clock+start_state@dice+retry",
+        "as state+clock+start_state@dice, the clock and the start restarting when a failed attempt has come to rest "
+        "(the dice at rest, none in the cup, not stacked: attempt_start)",
+        Blocks{true, false, false, true, Current::state, true, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
         Blocks{true, false, false, true, Current::none}));

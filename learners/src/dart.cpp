@@ -42,6 +42,7 @@ class Dart final : public Learner {
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
     expert.robust_trials = static_cast<int>(params().integer("mpc_robust"));
+    expert.retry = expert_retries(params().choice("retry"), c.features);
     RecordRequest request;
     request.episodes = episodes;
     request.seed = c.seed;
@@ -80,16 +81,19 @@ class Dart final : public Learner {
   // hold the last step's noise; the pose it pulls the cup to does not change with it, and the
   // servo keeps a learner's errors from adding up into a drift. Measured from the start's dice,
   // a recording moved to a start is one pose per step for every start: the learner need not
-  // learn the move (docs/learners.md, "Position targets" and "The dice frame").
+  // learn the move (docs/learners.md, "Position targets" and "The dice frame"). Its clock and
+  // start restart where a failed attempt has come to rest, and the tracker tries again there
+  // (retry=auto): the paths' success is a chaotic draw, and a second draw is most of the rest
+  // ("Trying again").
   std::string preferred_features() const override {
-    return params().choice("expert") == "tracker" ? "state+clock+start_state@dice" + std::string(kPositionTargetSuffix)
+    return params().choice("expert") == "tracker" ? "state+clock+start_state@dice+retry" + std::string(kPositionTargetSuffix)
                                                   : std::string();
   }
 
   static std::vector<ParamSpec> schema() {
     std::vector<std::string> names;
     for (const auto& e : expert_list()) names.push_back(e.name);
-    const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos; its default --features is state+clock+start_state@dice/position)", names},
+    const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos; its default --features is state+clock+start_state@dice+retry/position)", names},
             {"noise", ParamType::real, "0.1", 0, 10,
              "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
@@ -101,6 +105,9 @@ class Dart final : public Learner {
              "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},
             {"replan", ParamType::boolean, "false", 0, 1,
              "mpc: replan when the noise pushes the world off its prediction (its labels then depend on the noise so far)", {}},
+            {"retry", ParamType::choice, "auto", 0, 0,
+             "mpc and tracker: once a failed attempt has come to rest, start afresh from there (auto: with a +retry feature map)",
+             {"auto", "true", "false"}},
             {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
     std::vector<ParamSpec> out = specs;

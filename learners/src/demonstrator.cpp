@@ -109,6 +109,10 @@ std::string followed_recordings(const Recordings& recordings) {
 
 bool servo_targets(const std::string& features) { return feature_map(features).target() == ActionTarget::position; }
 
+bool expert_retries(const std::string& retry, const std::string& features) {
+  return retry == "auto" ? feature_map(features).attempts() : retry == "true";
+}
+
 int tracker_paths_for(int paths, const std::string& features) {
   if (paths >= 0) return paths;
   return servo_targets(features) ? kServoPaths : kOtherPaths;

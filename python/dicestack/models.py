@@ -29,7 +29,7 @@ def load_model(path, allow_pickle=False):
     return _dicestack.load_model(os.fspath(path), allow_pickle)
 
 
-def expert(name, demos=None, *, world=None, seed=0):
+def expert(name, demos=None, *, world=None, seed=0, retry=False):
     """An automatic expert, "scripted", "mpc" or "tracker": `expert(env)` (or `.act(env)`) gives
     the action for a DiceStackEnv's current state. It restarts by itself at each new episode; use
     one expert per world.
@@ -37,11 +37,17 @@ def expert(name, demos=None, *, world=None, seed=0):
     "tracker" is the demonstrator made of demonstrations: it follows the recorded cup path of
     `demos` ("builtin", "human", a folder or a list of Episodes) that succeeds when simulated
     from the episode's start, chosen once per episode. Its recordings are ranked in `world` with
-    `seed` when it is made (a few seconds). The other experts read no demonstrations."""
+    `seed` when it is made (a few seconds). The other experts read no demonstrations.
+
+    retry=True ("mpc", "tracker"): once a failed attempt has come to rest (dice still, not
+    stacked, the lowest on the table), start afresh from there, as the "+retry" feature maps
+    expect. The expert must then be asked at every step of an episode."""
+    if not isinstance(retry, bool):
+        raise TypeError(f"retry must be True or False, got {type(retry).__name__}")
     if name == "tracker" and demos is None:
         raise ValueError('expert "tracker" follows recordings: give them with demos= ("builtin", "human", a folder '
                          "or a list of Episodes)")
-    return _dicestack.Expert(name, None if demos is None else _demos_argument(demos), resolve_world(world), seed)
+    return _dicestack.Expert(name, None if demos is None else _demos_argument(demos), resolve_world(world), seed, retry)
 
 
 def _assignments(values, what):

@@ -87,9 +87,10 @@ std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& worl
 class PyExpert {
  public:
   /// `demos` (None, or as demos_from takes them) are the recordings "tracker" follows, ranked in
-  /// `world` with `seed`; other experts read none.
-  PyExpert(const std::string& name, const py::handle& demos, const WorldConfig& world, std::uint64_t seed) {
+  /// `world` with `seed`; other experts read none. `retry`: ExpertConfig::retry.
+  PyExpert(const std::string& name, const py::handle& demos, const WorldConfig& world, std::uint64_t seed, bool retry) {
     ExpertConfig config;
+    config.retry = retry;
     if (!demos.is_none()) {
       if (name != "tracker")
         throw py::value_error("expert \"" + name + "\" reads no demonstrations (demos= is the recordings of \"tracker\")");
@@ -304,8 +305,8 @@ void bind_models(py::module_& m) {
         }, py::arg("path"), py::arg("allow_pickle"));
 
   py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\", \"mpc\" or \"tracker\") acting on an environment")
-      .def(py::init<const std::string&, const py::handle&, const WorldConfig&, std::uint64_t>(), py::arg("name"),
-           py::arg("demos"), py::arg("world"), py::arg("seed"))
+      .def(py::init<const std::string&, const py::handle&, const WorldConfig&, std::uint64_t, bool>(), py::arg("name"),
+           py::arg("demos"), py::arg("world"), py::arg("seed"), py::arg("retry"))
       .def("act", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def("__call__", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def_property_readonly("name", &PyExpert::name);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <span>
+#include <vector>
 
 #include <dicestack/core/judge.hpp>
 
@@ -105,6 +107,79 @@ TEST(Judge, DiceInCupCountsOnlyHeldDice) {
   start[si::kCupAngle] = kPi;
   EXPECT_EQ(count_dice_in_cup(start, c), 0);
   EXPECT_EQ(count_dice_in_cup(column(4.0), c), 0);
+}
+
+// Three dice side by side on the table at rest, the cup up and away: a failed attempt at rest.
+State side_by_side() {
+  State s = column(4.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    s[si::die(i)] = 3.0 + 0.45 * static_cast<double>(i);
+    s[si::die(i) + 1] = 1.2;
+  }
+  return s;
+}
+
+TEST(Judge, AFailedAttemptAtRestIsDiceStillUnstackedAndDown) {
+  const WorldConfig c;
+  EXPECT_TRUE(failed_at_rest(side_by_side(), c));
+  EXPECT_FALSE(failed_at_rest(column(4.0), c)) << "stacked is a success, not a failure";
+  State moving = side_by_side();
+  moving[si::die(1) + 3] = 0.3;
+  EXPECT_FALSE(failed_at_rest(moving, c));
+  State spinning = side_by_side();
+  spinning[si::die(2) + 5] = 1.0;
+  EXPECT_FALSE(failed_at_rest(spinning, c));
+  State held = side_by_side();  // the dice at rest in a cup kept still in the air
+  held[si::kCupX] = 5.0;
+  held[si::kCupY] = 3.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    held[si::die(i)] = 4.8 + 0.2 * static_cast<double>(i);
+    held[si::die(i) + 1] = 3.0 - 2.2 / 3.0 + 0.3;
+  }
+  ASSERT_EQ(count_dice_in_cup(held, c), 3);
+  EXPECT_FALSE(failed_at_rest(held, c)) << "dice not down yet";
+  State covered = column(4.0);  // a column fallen over to one side, the cup left over it
+  covered[si::die(2)] += 0.3;
+  covered[si::kCupX] = 4.0;
+  covered[si::kCupY] = 2.6;
+  covered[si::kCupAngle] = kPi;
+  ASSERT_GT(count_dice_in_cup(covered, c), 0);
+  EXPECT_TRUE(failed_at_rest(covered, c)) << "a cup left still over the dice";
+}
+
+TEST(Judge, AnAttemptBeginsWhereAFailureHasRestedLongEnoughAndNotBeforeTheEarliestStep) {
+  const WorldConfig c;
+  const AttemptRule rule;  // earliest 60, rest_steps 10
+  State moving = side_by_side();
+  moving[si::die(0) + 3] = 0.5;
+  auto episode = [&](std::initializer_list<std::pair<int, bool>> runs) {  // (steps, at rest)
+    std::vector<State> states;
+    for (const auto& [n, rest] : runs) states.insert(states.end(), static_cast<std::size_t>(n), rest ? side_by_side() : moving);
+    return states;
+  };
+  auto start = [&](const std::vector<State>& states, std::size_t upto) {
+    return attempt_start(std::span<const State>(states.data(), upto + 1), c, rule);
+  };
+  EXPECT_EQ(attempt_start({}, c, rule), 0u);
+  // The dice rest before the first scoop: that run starts nothing before step 60 ...
+  const auto waits = episode({{30, true}, {40, false}, {30, true}});
+  for (std::size_t t = 0; t < 79; ++t) EXPECT_EQ(start(waits, t), 0u) << t;
+  // ... a failure resting 10 states (70 .. 79) starts an attempt at 79, and it stays the start.
+  for (std::size_t t = 79; t < waits.size(); ++t) EXPECT_EQ(start(waits, t), 79u) << t;
+  // A cup that never moves: the start's own rest starts an attempt at the earliest step.
+  const auto idle = episode({{100, true}});
+  EXPECT_EQ(start(idle, 59), 0u);
+  EXPECT_EQ(start(idle, 99), 60u);
+  // Too short a rest starts nothing; of two failures, the later one's attempt is in progress.
+  const auto twice = episode({{20, false}, {50, false}, {5, true}, {20, false}, {12, true}, {80, false}, {15, true}});
+  EXPECT_EQ(start(twice, 103), 0u);
+  EXPECT_EQ(start(twice, 104), 104u);  // the rest from 95: 10 states by 104
+  EXPECT_EQ(start(twice, 195), 104u);
+  EXPECT_EQ(start(twice, 196), 196u);
+  EXPECT_EQ(start(twice, 201), 196u);
+  // A column at rest is a success, whatever its length: no attempt after it.
+  std::vector<State> stacked(100, column(4.0));
+  EXPECT_EQ(attempt_start(stacked, c, rule), 0u);
 }
 
 TEST(Judge, OutcomeTracksMaximaAndWallContact) {

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/judge.hpp>
 #include <dicestack/core/tracker.hpp>
 
 #include <dicestack/test/helpers.hpp>
@@ -376,6 +378,44 @@ TEST(TrackerExpert, RescuesAKnockedEpisodeWhenAskedTo) {
   const auto rescued = run(5);
   EXPECT_TRUE(rescued.first);
   EXPECT_EQ(run(5).second, rescued.second);
+}
+
+TEST(TrackerExpert, TriesAgainFromWhereAFailedAttemptCameToRestWhenAskedTo) {
+  // The knock above, with the path chosen once: the attempt fails. With retry, once the failure
+  // has come to rest (attempt_start) the tracker chooses afresh from there and stacks the dice
+  // in time, the same way twice; it starts again at no other step.
+  const WorldConfig w;
+  const std::vector<CupPath> paths = successful_scripted_paths(3);
+  auto run = [&](bool retry) {
+    TrackerConfig c;
+    c.probes = 0;
+    ExpertConfig config;
+    config.retry = retry;
+    config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
+    auto tracker = make_expert("tracker", config);
+    tracker->reset(1);
+    DiceEnv env(w);
+    env.reset_to(paths[0].states.front());
+    std::vector<State> states{env.get_state()};
+    std::vector<Action> actions;
+    while (env.t() < env.config().episode.max_steps) {
+      const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
+      actions.push_back(a);
+      const StepResult r = env.step(a);
+      states.push_back(r.observation);
+      if (r.terminated) break;
+    }
+    return std::make_tuple(env.outcome().realistic_success(), actions, attempt_start(states, w));
+  };
+  const auto [once, once_actions, once_attempt] = run(false);
+  EXPECT_FALSE(once) << "the knock breaks the path chosen once";
+  EXPECT_GT(once_attempt, 0u) << "and the failure comes to rest";
+  const auto [again, again_actions, again_attempt] = run(true);
+  EXPECT_TRUE(again);
+  EXPECT_GE(again_attempt, once_attempt);
+  ASSERT_GT(again_actions.size(), once_attempt);
+  for (std::size_t t = 0; t < once_attempt; ++t) EXPECT_EQ(again_actions[t], once_actions[t]) << t;
+  EXPECT_EQ(std::get<1>(run(true)), again_actions);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/judge.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/features.hpp>
 
@@ -240,6 +241,48 @@ TEST(Features, ADiceFrameMapSeesTheSameSceneMovedInXAsTheSame) {
   world.label(h, {0.5, -1.0, 2.0}, label);
   world.label(hm, {0.5, -1.0, 2.0}, label_moved);
   EXPECT_NEAR(label_moved[0] - label[0], dx, 1e-12);
+}
+
+TEST(Features, ARetryMapRestartsItsClockAndStartWhenAFailedAttemptHasRested) {
+  // Dice side by side on the table, the cup away: moving for 80 steps, then at rest (a failed
+  // attempt) from step 80, so an attempt begins at step 89 (attempt_start). Until then the
+  // "+retry" map is its base map; from then on it is the base map of the history cut at 89.
+  State rest{};
+  rest[state_index::kCupX] = 7.5;
+  rest[state_index::kCupY] = 3.0;
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    rest[state_index::die(i)] = 3.0 + 0.45 * static_cast<double>(i);
+    rest[state_index::die(i) + 1] = 1.2;
+  }
+  std::vector<State> states;
+  for (int t = 0; t < 120; ++t) {
+    State s = rest;
+    s[state_index::kCupX] -= 0.01 * t;  // the cup moves on: rows differ step to step
+    if (t < 80) s[state_index::die(1) + 3] = 0.5 + 0.01 * t;
+    if (t >= 89) s[state_index::die(2)] += 0.001 * (t - 89);  // a die nudged after the restart
+    s[state_index::die(2) + 3] = t >= 89 ? 0.01 : s[state_index::die(2) + 3];
+    states.push_back(s);
+  }
+  ASSERT_EQ(attempt_start(states, WorldConfig{}), 89u);
+  for (const auto* name : {"state+clock+start_state@dice+retry", "state+clock+start_state@dice+retry/position"}) {
+    const FeatureMap& m = feature_map(name);
+    const FeatureMap& base = feature_map(std::string(name).replace(std::string(name).find("+retry"), 6, ""));
+    ASSERT_EQ(m.width(), base.width()) << name;
+    for (const std::size_t t : {0u, 50u, 88u, 89u, 90u, 119u}) {
+      const History h{std::span<const State>(states.data(), t + 1), {}};
+      const std::size_t from = t >= 89 ? 89 : 0;
+      const History cut{std::span<const State>(states.data() + from, t + 1 - from), {}};
+      EXPECT_EQ(row_of(m, h), row_of(base, cut)) << name << " t " << t;
+      const Action a{0.5, -1.0, 2.0};
+      std::array<double, kActionDim> label{}, label_cut{};
+      m.label(h, a, label);
+      base.label(cut, a, label_cut);
+      EXPECT_EQ(label, label_cut) << name << " t " << t;
+    }
+    const History late{states, {}};
+    EXPECT_EQ(row_of(m, late)[kStateDim], 30.0) << "the clock counts from the attempt's start";
+    EXPECT_NE(row_of(m, late), row_of(base, late));
+  }
 }
 
 TEST(Features, AnAheadMapWithNothingPendingIsItsBaseMap) {

@@ -167,9 +167,21 @@ TEST(LearnerSpec, DartLabelledByTheTrackerReadsItsMapAnsweringPosesFromTheDice) 
   EXPECT_EQ(default_features("bc"), "state");
   EXPECT_EQ(default_features("dart"), "state+clock+start_state");
   EXPECT_EQ(default_features("dart", {"expert=mpc"}), "state+clock+start_state");
-  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state@dice/position");
+  EXPECT_EQ(default_features("dart", {"expert=tracker", "episodes=10"}), "state+clock+start_state@dice+retry/position");
   EXPECT_EQ(feature_map(default_features("dart", {"expert=tracker"})).target(), ActionTarget::position);
   EXPECT_THROW(default_features("dart", {"expert=oracle"}), ConfigError);
+}
+
+TEST(LearnerSpec, TheExpertTriesAgainWithARetryMapUnlessToldOtherwise) {
+  // retry=auto follows the map: its clock and start restart with each attempt, as the expert's
+  // choices then do.
+  EXPECT_TRUE(expert_retries("auto", "state+clock+start_state@dice+retry/position"));
+  EXPECT_TRUE(expert_retries("auto", "state+clock+start_state+retry"));
+  EXPECT_FALSE(expert_retries("auto", "state+clock+start_state@dice/position"));
+  EXPECT_FALSE(expert_retries("false", "state+clock+start_state+retry"));
+  EXPECT_TRUE(expert_retries("true", "state+clock+start_state"));
+  EXPECT_THROW(parse_learner_spec("dart:retry=maybe"), ConfigError);
+  EXPECT_NO_THROW(parse_learner_spec("dagger:expert=mpc:retry=true"));
 }
 
 }  // namespace

@@ -6,9 +6,11 @@
 #include <numbers>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
+#include <dicestack/core/judge.hpp>
 #include <dicestack/core/rng.hpp>
 
 #include "swing_plan.hpp"
@@ -97,6 +99,24 @@ class ScriptedExpert final : public Expert {
   int last_step_ = -2;
 };
 
+// Sees an episode's states, one per act(), and tells when a new attempt begins at the current
+// one (attempt_start), judged in the default world as the "+retry" feature maps judge it.
+class AttemptWatch {
+ public:
+  void clear() { seen_.clear(); }
+  bool begins(const DiceEnv& env) {
+    static const WorldConfig judged{};
+    const auto t = static_cast<std::size_t>(env.t());
+    if (t + 1 == seen_.size()) seen_.pop_back();  // asked again at the same step
+    else if (t < seen_.size()) seen_.clear();     // a new episode without a reset
+    seen_.push_back(env.get_state());
+    return t > 0 && failed_at_rest(seen_.back(), judged) && attempt_start(seen_, judged) == seen_.size() - 1;
+  }
+
+ private:
+  std::vector<State> seen_;
+};
+
 // Searches swing plans by simulating each from an exact snapshot of the environment to the end
 // of the episode, and follows the first that succeeds (else the best). While the world stays on
 // the predicted trajectory nothing is simulated again; any other state (a DAgger query, noise)
@@ -117,9 +137,11 @@ class MpcExpert final : public Expert {
     plan_ = SwingPlan();
     predicted_.clear();
     last_replan_ = 0;
+    attempts_.clear();
   }
 
   Action do_act(const DiceEnv& env) override {
+    if (config_.retry && attempts_.begins(env)) plan_ = SwingPlan();  // searched afresh below
     const int t = env.t();
     const State s = env.get_state();
     const int index = t - predicted_from_;
@@ -241,6 +263,7 @@ class MpcExpert final : public Expert {
   std::vector<State> predicted_;
   int predicted_from_ = 0;
   int last_replan_ = 0;
+  AttemptWatch attempts_;
   std::optional<DiceEnv> sim_;
 };
 
@@ -252,18 +275,20 @@ class MpcExpert final : public Expert {
 // its actions then depend on when it switched, too.
 class TrackerExpert final : public Expert {
  public:
-  explicit TrackerExpert(const ExpertConfig& config) : recordings_(config.recordings) {}
+  explicit TrackerExpert(const ExpertConfig& config) : recordings_(config.recordings), retry_(config.retry) {}
   std::string name() const override { return "tracker"; }
 
  private:
   void do_reset(std::uint64_t seed) override {
     seed_ = seed;
     follower_ = PathFollower();
+    attempts_.clear();
   }
 
   Action do_act(const DiceEnv& env) override {
     const int t = env.t();
     const TrackerConfig& c = recordings_->config();
+    if (retry_ && attempts_.begins(env)) follower_ = PathFollower();
     if (!follower_.valid() || t < first_step_) {
       frame_ = env.get_state();
       choice_ = choose_path(*recordings_, env, planning_sim(sim_, env), seed_);
@@ -286,11 +311,13 @@ class TrackerExpert final : public Expert {
   }
 
   std::shared_ptr<const Recordings> recordings_;
+  bool retry_;
   std::uint64_t seed_ = 0;
   PathFollower follower_;
   TrackerChoice choice_;
   State frame_{};
   int first_step_ = 0, start_step_ = 0, last_check_ = 0;
+  AttemptWatch attempts_;
   std::optional<DiceEnv> sim_;
 };
 

@@ -89,6 +89,39 @@ double stack_shortfall(const State& s, const WorldConfig& config) {
   return sum;
 }
 
+bool failed_at_rest(const State& s, const WorldConfig& config) {
+  const auto& j = config.judge;
+  for (std::size_t i = 0; i < kDiceCount; ++i) {
+    const std::size_t d = si::die(i);
+    if (std::hypot(s[d + 3], s[d + 4]) > j.rest_speed || std::abs(s[d + 5]) > j.rest_angular_speed) return false;
+  }
+  // Dice at rest in a cup held still in the air are not down yet; a cup left over a fallen
+  // column, or lifted off it, has let them down: the lowest lies on the table.
+  const double lowest = s[si::die(dice_bottom_up(s)[0]) + 1];
+  return lowest <= table_height(config.walls) + config.dice.half_size + config.judge.gap_tolerance && !is_stacked(s, config);
+}
+
+std::size_t attempt_start(std::span<const State> states, const WorldConfig& config, const AttemptRule& rule) {
+  if (states.empty() || rule.rest_steps < 1) return 0;
+  const auto earliest = static_cast<std::size_t>(std::max(rule.earliest, 0));
+  const auto need = static_cast<std::size_t>(rule.rest_steps);
+  // Back from the last state: the latest run of failed states long enough to start an attempt.
+  std::size_t end = states.size();  // one past the run's last state
+  while (end > 0) {
+    while (end > 0 && !failed_at_rest(states[end - 1], config)) --end;
+    std::size_t begin = end;
+    while (begin > 0 && failed_at_rest(states[begin - 1], config)) --begin;
+    if (end == 0) break;
+    // The run [begin, end) starts an attempt at the first step >= earliest that closes `need`
+    // failed states in a row.
+    const std::size_t at = std::max(begin + need - 1, earliest);
+    if (at < end) return at;
+    if (end <= earliest) break;  // every earlier run ends before an attempt may begin
+    end = begin;
+  }
+  return 0;
+}
+
 Settled settle(const State& state, const WorldConfig& config, int max_steps) {
   World world(config, state);
   Settled r;

@@ -71,6 +71,9 @@ class FeatureMap {
   /// True for a map that acts for the moment its action lands (kAheadSuffix, kLandingSuffix).
   virtual bool ahead() const { return false; }
 
+  /// True for a map whose clock and start restart with each attempt (attempt_start: "+retry").
+  virtual bool attempts() const { return false; }
+
   /// Where x is measured from in this map's rows and pose answers (0: the world's origin).
   virtual double origin_x(const History&) const { return 0.0; }
 
@@ -101,6 +104,10 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 ///  - "state+clock+start_state@dice", "clock+start_state@dice": every x measured from the
 ///    start's mean die x, that origin a last column (origin_x()): a recording the tracker moves
 ///    to each start is then the same rows and poses for every start
+///  - "state+clock+start_state+retry", "state+clock+start_state@dice+retry": the clock and the
+///    start (and the frame's origin) restart where a failed attempt has come to rest
+///    (attempt_start, judged in the default world), for an expert that then tries again
+///    (ExpertConfig::retry): its second attempt is then the rows of a first one
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
 /// answering the cup velocity to set, and as NAME + "/position" (kPositionTargetSuffix):
 /// answering the pose to servo the cup to ("state+clock+start_state@dice/position" is dart's

@@ -39,6 +39,11 @@ std::string followed_recordings(const Recordings& recordings);
 /// (docs/learners.md, "Position targets").
 bool servo_targets(const std::string& features);
 
+/// Whether a learner's expert tries again after a failed attempt (ExpertConfig::retry), for the
+/// option value `retry`: "auto" when `features` is a "+retry" map (whose clock and start restart
+/// with each attempt, as the expert's choices do), else "true" or "false" as given.
+bool expert_retries(const std::string& retry, const std::string& features);
+
 /// How many recordings a learner's tracker follows for the option value `paths`: -1 is the
 /// default for the feature map `features` (1 for a "/position" map, else 3); others as given.
 int tracker_paths_for(int paths, const std::string& features);

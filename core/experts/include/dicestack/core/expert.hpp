@@ -66,6 +66,10 @@ struct ExpertConfig {
   /// success with most): plans robust to a learner's errors. 0: the first success.
   int robust_trials = 0;
   double robust_noise = 0.1;
+  /// "mpc" and "tracker": try again. When a failed attempt has come to rest (attempt_start,
+  /// judged in the default world as the "+retry" feature maps judge it), start afresh from that
+  /// state as from a start: a new plan, or a path chosen anew. Needs act() at every step.
+  bool retry = false;
   /// "tracker": the recordings it follows (required; built once and shared by every copy). Its
   /// TrackerConfig is the one the Recordings were built with.
   std::shared_ptr<const Recordings> recordings;

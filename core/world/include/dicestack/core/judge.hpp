@@ -1,6 +1,9 @@
 #pragma once
 // The outcome judge (DESIGN "Outcome judge", paper III-B/C): how many dice the cup holds,
 // whether the dice stand stacked, and whether anything touched a wall.
+#include <cstddef>
+#include <span>
+
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/world_config.hpp>
 
@@ -21,6 +24,25 @@ bool is_stacked(const State& state, const WorldConfig& config);
 /// units of its tolerance (a state is stacked when every term is at most 1). For searches that
 /// must rank near misses (the tracker's choice) without a cost of their own.
 double stack_shortfall(const State& state, const WorldConfig& config);
+
+/// A failed attempt, come to rest: every die at rest (judge.rest_speed and rest_angular_speed),
+/// the lowest on the table (not held in the air by a cup kept still), and the dice not
+/// stacked. Nothing more happens to them unless the cup scoops them again.
+bool failed_at_rest(const State& state, const WorldConfig& config);
+
+/// When an episode's attempts begin: at step 0, and again at the first step, from `earliest`
+/// on, that ends `rest_steps` states in a row failed_at_rest (the dice are left as a failed
+/// attempt left them, and a new attempt may scoop them again). A function of the states alone,
+/// so that a demonstrator that tries again and a feature map that restarts its clock there
+/// (issue 24) agree on every step.
+struct AttemptRule {
+  int earliest = 60;    ///< no attempt begins before this step (the dice rest before the first scoop)
+  int rest_steps = 10;  ///< failed_at_rest for this many states in a row
+};
+
+/// The step the attempt in progress at the last of `states` (states[0] the start, one per step)
+/// began at, under `rule`, judged with `config`. 0 for an empty span.
+std::size_t attempt_start(std::span<const State> states, const WorldConfig& config, const AttemptRule& rule = {});
 
 /// What happened in an episode so far.
 struct Outcome {
