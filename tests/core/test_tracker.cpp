@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <tuple>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
@@ -351,72 +350,65 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps));
 }
 
+// The tracker's episode from paths[0]'s start, knocked at step 20 (dvx 0.6): whether it ended
+// in a realistic success, every action and every state.
+struct KnockedEpisode {
+  bool success = false;
+  std::vector<Action> actions;
+  std::vector<State> states;
+};
+KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue_interval, bool retry) {
+  const WorldConfig w;
+  TrackerConfig c;
+  c.probes = 0;
+  c.rescue_interval = rescue_interval;
+  ExpertConfig config;
+  config.retry = retry;
+  config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
+  auto tracker = make_expert("tracker", config);
+  tracker->reset(1);
+  DiceEnv env(w);
+  env.reset_to(paths[0].states.front());
+  KnockedEpisode e;
+  e.states.push_back(env.get_state());
+  while (env.t() < env.config().episode.max_steps) {
+    const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
+    e.actions.push_back(a);
+    const StepResult r = env.step(a);
+    e.states.push_back(r.observation);
+    if (r.terminated) break;
+  }
+  e.success = env.outcome().realistic_success();
+  return e;
+}
+
 TEST(TrackerExpert, RescuesAKnockedEpisodeWhenAskedTo) {
   // The same knock as above, met by the expert itself: choosing once, it follows its path to a
   // failure; with a check every 5 steps it joins another recording and stacks, the same way twice.
-  const WorldConfig w;
   const std::vector<CupPath> paths = successful_scripted_paths(3);
-  auto run = [&](int rescue_interval) {
-    TrackerConfig c;
-    c.probes = 0;
-    c.rescue_interval = rescue_interval;
-    ExpertConfig config;
-    config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
-    auto tracker = make_expert("tracker", config);
-    tracker->reset(1);
-    DiceEnv env(w);
-    env.reset_to(paths[0].states.front());
-    std::vector<Action> actions;
-    while (env.t() < env.config().episode.max_steps) {
-      const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
-      actions.push_back(a);
-      if (env.step(a).terminated) break;
-    }
-    return std::make_pair(env.outcome().realistic_success(), actions);
-  };
-  EXPECT_FALSE(run(0).first) << "the knock breaks the path chosen once";
-  const auto rescued = run(5);
-  EXPECT_TRUE(rescued.first);
-  EXPECT_EQ(run(5).second, rescued.second);
+  EXPECT_FALSE(knocked_episode(paths, 0, false).success) << "the knock breaks the path chosen once";
+  const KnockedEpisode rescued = knocked_episode(paths, 5, false);
+  EXPECT_TRUE(rescued.success);
+  EXPECT_EQ(knocked_episode(paths, 5, false).actions, rescued.actions);
 }
 
 TEST(TrackerExpert, TriesAgainFromWhereAFailedAttemptCameToRestWhenAskedTo) {
-  // The knock above, with the path chosen once: the attempt fails. With retry, once the failure
-  // has come to rest (attempt_start) the tracker chooses afresh from there and stacks the dice
-  // in time, the same way twice; it starts again at no other step.
+  // The knock above, with the path chosen once: the attempt fails and its dice come to rest.
+  // With retry the tracker chooses afresh there (attempt_start) and stacks the dice in time, the
+  // same way twice, acting as before until then.
   const WorldConfig w;
   const std::vector<CupPath> paths = successful_scripted_paths(3);
-  auto run = [&](bool retry) {
-    TrackerConfig c;
-    c.probes = 0;
-    ExpertConfig config;
-    config.retry = retry;
-    config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
-    auto tracker = make_expert("tracker", config);
-    tracker->reset(1);
-    DiceEnv env(w);
-    env.reset_to(paths[0].states.front());
-    std::vector<State> states{env.get_state()};
-    std::vector<Action> actions;
-    while (env.t() < env.config().episode.max_steps) {
-      const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
-      actions.push_back(a);
-      const StepResult r = env.step(a);
-      states.push_back(r.observation);
-      if (r.terminated) break;
-    }
-    return std::make_tuple(env.outcome().realistic_success(), actions, attempt_start(states, w));
-  };
-  const auto [once, once_actions, once_attempt] = run(false);
-  EXPECT_FALSE(once) << "the knock breaks the path chosen once";
-  EXPECT_GT(once_attempt, 0u) << "and the failure comes to rest";
-  const auto [again, again_actions, again_attempt] = run(true);
-  EXPECT_TRUE(again);
-  EXPECT_GE(again_attempt, once_attempt);
-  ASSERT_GT(again_actions.size(), once_attempt);
-  for (std::size_t t = 0; t < once_attempt; ++t) EXPECT_EQ(again_actions[t], once_actions[t]) << t;
-  EXPECT_EQ(std::get<1>(run(true)), again_actions);
+  const KnockedEpisode once = knocked_episode(paths, 0, false);
+  const std::size_t restart = attempt_start(once.states, w);
+  EXPECT_FALSE(once.success) << "the knock breaks the path chosen once";
+  EXPECT_GT(restart, 0u) << "and the failure comes to rest";
+  const KnockedEpisode again = knocked_episode(paths, 0, true);
+  EXPECT_TRUE(again.success);
+  EXPECT_EQ(attempt_start(again.states, w), restart);
+  ASSERT_GT(again.actions.size(), restart);
+  for (std::size_t t = 0; t < restart; ++t) EXPECT_EQ(again.actions[t], once.actions[t]) << t;
+  EXPECT_NE(again.actions[restart], once.actions[restart]) << "a new choice at the restart";
+  EXPECT_EQ(knocked_episode(paths, 0, true).actions, again.actions);
 }
-
 }  // namespace
 }  // namespace dicestack

@@ -114,6 +114,30 @@ def test_tracker_follows_the_builtin_recordings_to_a_stack():
     assert terminated and info["realistic_success"] and not info["wall_contact"]
 
 
+def test_tracker_tries_again_after_a_failed_attempt_when_asked_to():
+    # A knock at step 20 makes the path chosen at the start fail; with retry=True the tracker
+    # chooses again once the failure has come to rest, and stacks before the time limit.
+    few = dicestack.load_demos("human")[:8]
+
+    def episode(retry):
+        expert = dicestack.expert("tracker", demos=few, retry=retry)
+        env = dicestack.DiceStackEnv()
+        env.reset(seed=10)
+        for t in range(env.world["episode"]["max_steps"]):
+            action = np.array([0.3, 0.0, 0.0]) if t == 20 else expert(env)
+            _, _, terminated, truncated, info = env.step(action)
+            if terminated or truncated:
+                break
+        return info["realistic_success"], t
+
+    once, once_steps = episode(False)
+    again, again_steps = episode(True)
+    assert not once and once_steps == 399
+    assert again and 200 < again_steps < 399, "a second attempt, in time"
+    with pytest.raises(TypeError, match="retry must be True or False"):
+        dicestack.expert("mpc", retry="yes")
+
+
 def test_tracker_needs_recordings_and_the_others_read_none():
     with pytest.raises(ValueError, match="give them with demos="):
         dicestack.expert("tracker")
