@@ -106,20 +106,19 @@ std::size_t attempt_start(std::span<const State> states, const WorldConfig& conf
   const auto earliest = static_cast<std::size_t>(std::max(rule.earliest, 0));
   const auto need = static_cast<std::size_t>(rule.rest_steps);
   // Back from the last state: the latest run of failed states long enough to start an attempt.
+  // A run that ends by `earliest` cannot, so the scan stops there.
   std::size_t end = states.size();  // one past the run's last state
-  while (end > 0) {
-    while (end > 0 && !failed_at_rest(states[end - 1], config)) --end;
+  while (true) {
+    while (end > earliest && !failed_at_rest(states[end - 1], config)) --end;
+    if (end <= earliest) return 0;
     std::size_t begin = end;
     while (begin > 0 && failed_at_rest(states[begin - 1], config)) --begin;
-    if (end == 0) break;
     // The run [begin, end) starts an attempt at the first step >= earliest that closes `need`
     // failed states in a row.
     const std::size_t at = std::max(begin + need - 1, earliest);
     if (at < end) return at;
-    if (end <= earliest) break;  // every earlier run ends before an attempt may begin
     end = begin;
   }
-  return 0;
 }
 
 Settled settle(const State& state, const WorldConfig& config, int max_steps) {
