@@ -70,11 +70,15 @@ std::string value_before(const std::string& learner, const std::string& key) {
 }
 
 // What an option's text means in a run: a default that depends on the run's feature map
-// (tracker_paths -1, the default since it depends on the map; 3 before) resolved with it.
+// (tracker_paths -1, the default since it depends on the map, 3 before; retry auto) resolved
+// with it.
 std::string meaning(const std::string& key, const std::string& text, const json& run) {
-  if (key != "tracker_paths" || text != "-1" || !run.contains("features") || !run["features"].is_string()) return text;
+  const bool by_map = (key == "tracker_paths" && text == "-1") || (key == "retry" && text == "auto");
+  if (!by_map || !run.contains("features") || !run["features"].is_string()) return text;
+  const std::string features = run["features"].get<std::string>();
   try {
-    return std::to_string(tracker_paths_for(-1, run["features"].get<std::string>()));
+    if (key == "retry") return expert_retries(text, features) ? "true" : "false";
+    return std::to_string(tracker_paths_for(-1, features));
   } catch (const ConfigError&) {  // a map this version does not know: compared as written
     return text;
   }

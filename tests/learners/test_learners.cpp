@@ -327,6 +327,16 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   tracked["run"]["learner_options"]["tracker_paths"] = "-1";
   tracked["run"]["learner_options"].erase("tracker_shrink");
   EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_shrink \"(absent)\" in the checkpoint, \"5\" in this run"));
+  // Written before retry existed: its absence meant no retries, which auto means for this map
+  // (state); "false" means the same, "true" does not.
+  EXPECT_EQ(saved["run"]["learner_options"]["retry"], "auto");
+  nlohmann::json retried = saved;
+  retried["run"]["learner_options"].erase("retry");
+  EXPECT_EQ(resume_with(retried), "");
+  retried["run"]["learner_options"]["retry"] = "false";
+  EXPECT_EQ(resume_with(retried), "");
+  retried["run"]["learner_options"]["retry"] = "true";
+  EXPECT_THAT(resume_with(retried), HasSubstr("option retry \"true\" in the checkpoint, \"auto\" in this run"));
   nlohmann::json v2 = saved;  // version 2: the learner's options joined into one string, the --set text
   v2["version"] = 2;
   v2["run"].erase("regressor_params");
