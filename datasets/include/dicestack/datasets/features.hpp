@@ -110,7 +110,7 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 ///    (ExpertConfig::retry): its second attempt is then the rows of a first one
 /// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
 /// answering the cup velocity to set, and as NAME + "/position" (kPositionTargetSuffix):
-/// answering the pose to servo the cup to ("state+clock+start_state@dice/position" is dart's
+/// answering the pose to servo the cup to ("state+clock+start_state@dice+retry/position" is dart's
 /// default with the tracker).
 /// Each of these also as NAME + "/ahead" (kAheadSuffix): under delays, the row shows
 /// cup_ahead() instead of the current cup (with no delay, the same rows as NAME). The clock
