@@ -83,8 +83,8 @@ class Dart final : public Learner {
   // a recording moved to a start is one pose per step for every start: the learner need not
   // learn the move (docs/learners.md, "Position targets" and "The dice frame"). Its clock and
   // start restart where a failed attempt has come to rest, and the tracker tries again there
-  // (retry=auto): the paths' success is a chaotic draw, and a second draw is most of the rest
-  // ("Trying again").
+  // (retry=auto): a path's success is a chaotic draw, and a second attempt is a second draw
+  // (docs/learners.md, "Trying again").
   std::string preferred_features() const override {
     return params().choice("expert") == "tracker" ? "state+clock+start_state@dice+retry" + std::string(kPositionTargetSuffix)
                                                   : std::string();
