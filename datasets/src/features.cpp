@@ -153,12 +153,12 @@ const std::vector<std::unique_ptr<BuiltinFeatureMap>>& builtin_maps() {
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "state+clock+start_state+retry",
         "as state+clock+start_state, the clock and the start restarting when a failed attempt has come to rest "
-        "(the dice at rest, none in the cup, not stacked: attempt_start)",
+        "(every die at rest, the lowest on the table, not stacked: attempt_start)",
         Blocks{true, false, false, true, Current::state, false, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "state+clock+start_state@dice+retry",
         "as state+clock+start_state@dice, the clock and the start restarting when a failed attempt has come to rest "
-        "(the dice at rest, none in the cup, not stacked: attempt_start)",
+        "(every die at rest, the lowest on the table, not stacked: attempt_start)",
         Blocks{true, false, false, true, Current::state, true, true}));
     v->push_back(std::make_unique<BuiltinFeatureMap>(
         "clock+start_state", "open loop: t and the whole start state, not the current state (a pattern chosen at the start)",
