@@ -425,6 +425,12 @@ TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
   EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("--demos " + kTinyDemos));
   EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("recordings followed: the "));
   EXPECT_EQ(j["episodes"][0]["origin"], "expert tracker");
+  EXPECT_THAT(j["provenance"].get<std::string>(), Not(HasSubstr("--retry")));
+  std::filesystem::remove_all(dir);
+  // Trying again after a failed attempt is part of how a set was recorded: it says so.
+  ASSERT_EQ(run("record --expert tracker --demos " + kTinyDemos + " --episodes 1 --retry --out " + dir.string(), false).status, 0);
+  std::ifstream retried(dir / "meta.json");
+  EXPECT_THAT(nlohmann::json::parse(retried)["provenance"].get<std::string>(), HasSubstr(" --retry"));
   std::filesystem::remove_all(dir);
   // The tracker without recordings, and recordings for an expert that reads none, are refused
   // before anything is written.

@@ -6,6 +6,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/judge.hpp>
 #include <dicestack/core/rng.hpp>
 
 #include <dicestack/test/helpers.hpp>
@@ -61,6 +62,37 @@ TEST(Expert, MpcWithoutReplanningKeepsTheFirstPlan) {
   const auto a = mpc_labels_under_noise(once);
   EXPECT_EQ(a, mpc_labels_under_noise(never_due));
   EXPECT_NE(a, mpc_labels_under_noise(ExpertConfig{}));  // replanning under noise answers otherwise
+}
+
+// Plan-once mpc from random start 3, knocked at step 60 (dvx -0.6).
+test::KnockedEpisode knocked_mpc(bool retry) {
+  const WorldConfig w;
+  ExpertConfig c;
+  c.replan = false;
+  c.retry = retry;
+  auto expert = make_expert("mpc", c);
+  DiceEnv env(w);
+  env.reset_to(random_start_state(w, 3), 3);
+  expert->reset(3);
+  return test::knocked_episode(*expert, env, 60, {-0.6, 0.0, 0.0});
+}
+
+TEST(Expert, MpcTriesAgainWithANewPlanWhereAFailedAttemptCameToRestWhenAskedTo) {
+  // Choosing its plan once, mpc follows it through the knock to a failure whose dice come to
+  // rest; with retry it searches a new plan there (attempt_start) and stacks, acting as before
+  // until then, the same way twice.
+  const WorldConfig w;
+  const test::KnockedEpisode once = knocked_mpc(false);
+  const std::size_t restart = attempt_start(once.states, w);
+  EXPECT_FALSE(once.success);
+  ASSERT_GT(restart, 60u) << "the failure comes to rest";
+  const test::KnockedEpisode again = knocked_mpc(true);
+  EXPECT_TRUE(again.success);
+  EXPECT_EQ(attempt_start(again.states, w), restart);
+  ASSERT_GT(again.actions.size(), restart);
+  for (std::size_t t = 0; t < restart; ++t) EXPECT_EQ(again.actions[t], once.actions[t]) << t;
+  EXPECT_NE(again.actions[restart], once.actions[restart]) << "a new plan at the restart";
+  EXPECT_EQ(knocked_mpc(true).actions, again.actions);
 }
 
 TEST(Expert, MpcRobustTrialsWithoutNoiseKeepThePlanAndWithNoiseAreSeeded) {

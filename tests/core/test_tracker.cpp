@@ -350,14 +350,8 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps));
 }
 
-// The tracker's episode from paths[0]'s start, knocked at step 20 (dvx 0.6): whether it ended
-// in a realistic success, every action and every state.
-struct KnockedEpisode {
-  bool success = false;
-  std::vector<Action> actions;
-  std::vector<State> states;
-};
-KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue_interval, bool retry) {
+// The tracker's episode from paths[0]'s start, knocked at step 20 (dvx 0.6).
+test::KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue_interval, bool retry) {
   const WorldConfig w;
   TrackerConfig c;
   c.probes = 0;
@@ -369,17 +363,7 @@ KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue_int
   tracker->reset(1);
   DiceEnv env(w);
   env.reset_to(paths[0].states.front());
-  KnockedEpisode e;
-  e.states.push_back(env.get_state());
-  while (env.t() < env.config().episode.max_steps) {
-    const Action a = env.t() == 20 ? Action{0.6, 0.0, 0.0} : tracker->act(env);
-    e.actions.push_back(a);
-    const StepResult r = env.step(a);
-    e.states.push_back(r.observation);
-    if (r.terminated) break;
-  }
-  e.success = env.outcome().realistic_success();
-  return e;
+  return test::knocked_episode(*tracker, env, 20, {0.6, 0.0, 0.0});
 }
 
 TEST(TrackerExpert, RescuesAKnockedEpisodeWhenAskedTo) {
@@ -387,7 +371,7 @@ TEST(TrackerExpert, RescuesAKnockedEpisodeWhenAskedTo) {
   // failure; with a check every 5 steps it joins another recording and stacks, the same way twice.
   const std::vector<CupPath> paths = successful_scripted_paths(3);
   EXPECT_FALSE(knocked_episode(paths, 0, false).success) << "the knock breaks the path chosen once";
-  const KnockedEpisode rescued = knocked_episode(paths, 5, false);
+  const test::KnockedEpisode rescued = knocked_episode(paths, 5, false);
   EXPECT_TRUE(rescued.success);
   EXPECT_EQ(knocked_episode(paths, 5, false).actions, rescued.actions);
 }
@@ -398,11 +382,11 @@ TEST(TrackerExpert, TriesAgainFromWhereAFailedAttemptCameToRestWhenAskedTo) {
   // same way twice, acting as before until then.
   const WorldConfig w;
   const std::vector<CupPath> paths = successful_scripted_paths(3);
-  const KnockedEpisode once = knocked_episode(paths, 0, false);
+  const test::KnockedEpisode once = knocked_episode(paths, 0, false);
   const std::size_t restart = attempt_start(once.states, w);
   EXPECT_FALSE(once.success) << "the knock breaks the path chosen once";
   EXPECT_GT(restart, 0u) << "and the failure comes to rest";
-  const KnockedEpisode again = knocked_episode(paths, 0, true);
+  const test::KnockedEpisode again = knocked_episode(paths, 0, true);
   EXPECT_TRUE(again.success);
   EXPECT_EQ(attempt_start(again.states, w), restart);
   ASSERT_GT(again.actions.size(), restart);

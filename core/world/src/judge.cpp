@@ -98,7 +98,7 @@ bool failed_at_rest(const State& s, const WorldConfig& config) {
   // Dice at rest in a cup held still in the air are not down yet; a cup left over a fallen
   // column, or lifted off it, has let them down: the lowest lies on the table.
   const double lowest = s[si::die(dice_bottom_up(s)[0]) + 1];
-  return lowest <= table_height(config.walls) + config.dice.half_size + config.judge.gap_tolerance && !is_stacked(s, config);
+  return lowest <= table_height(config.walls) + config.dice.half_size + j.gap_tolerance && !is_stacked(s, config);
 }
 
 std::size_t attempt_start(std::span<const State> states, const WorldConfig& config, const AttemptRule& rule) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <dicestack/core/matrix.hpp>
+#include <dicestack/core/env.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/world_config.hpp>
@@ -21,6 +22,29 @@ namespace dicestack::test {
 inline bool bit_equal(const State& a, const State& b) { return std::memcmp(a.data(), b.data(), sizeof(State)) == 0; }
 
 /// The default world with a short time limit, for tests that roll out or learn.
+/// An episode an expert plays from env's current state, knocked once: at step `at` the world
+/// runs `knock` instead of the expert's action. Whether it ended in a realistic success, every
+/// action and every state.
+struct KnockedEpisode {
+  bool success = false;
+  std::vector<Action> actions;
+  std::vector<State> states;
+};
+template <class Expert>
+KnockedEpisode knocked_episode(Expert& expert, DiceEnv& env, int at, const Action& knock) {
+  KnockedEpisode e;
+  e.states.push_back(env.get_state());
+  while (env.t() < env.config().episode.max_steps) {
+    const Action a = env.t() == at ? knock : expert.act(env);
+    e.actions.push_back(a);
+    const StepResult r = env.step(a);
+    e.states.push_back(r.observation);
+    if (r.terminated) break;
+  }
+  e.success = env.outcome().realistic_success();
+  return e;
+}
+
 inline WorldConfig short_world(int max_steps = 60) {
   WorldConfig w;
   w.episode.max_steps = max_steps;
