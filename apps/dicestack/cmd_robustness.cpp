@@ -22,7 +22,7 @@ namespace {
 struct RobustnessOptions {
   WorldOption world;
   std::filesystem::path model, demos, out;
-  std::string expert, format = "md";
+  std::string expert, format = "md", expert_feedback = "world";
   int episodes = 100;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -34,6 +34,8 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   if (opt.model.empty() == opt.expert.empty()) throw ConfigError("robustness: give one of --model M or --expert NAME");
   if (!opt.demos.empty() && opt.expert != "tracker")
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
+  const bool sensed = opt.expert_feedback == "observations";
+  if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
   {
     EvalRequest rows;  // the rollouts' count, checked before any recordings are read
@@ -66,9 +68,11 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
           make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, {}, opt.seed, opt.threads, cluster);
     }
     make_expert(opt.expert, config);  // an unknown name fails here, before any row
-    factory = [name = opt.expert, config] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config)); };
-    run.policy = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")");
-    request.reads_world = true;
+    const ExpertFeedback feedback = sensed ? ExpertFeedback::observations : ExpertFeedback::world;
+    factory = [name = opt.expert, config, feedback] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config), feedback); };
+    run.policy = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")") +
+                 (sensed ? ", feedback on the observations" : "");
+    request.reads_world = !sensed;
   }
   run.reads_world = request.reads_world;
   if (cluster.is_root())
@@ -105,6 +109,11 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->check(CLI::ExistingFile);
   cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
+  cmd->add_option("--expert-feedback", opt->expert_feedback,
+                  "What the expert's feedback acts on: world (its own privilege; the sensing factors are left out) or "
+                  "observations (what a policy is shown; its choices still read the world)")
+      ->check(CLI::IsMember({"world", "observations"}))
+      ->capture_default_str();
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts and the draws")->check(seed_check())->capture_default_str();
   cmd->add_option("--factors", opt->factors,

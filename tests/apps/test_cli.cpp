@@ -807,6 +807,19 @@ TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable)
   p = run(cmd + "--factors none,wind");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown factor \"wind\""));
+  // An expert's sensing rows: left out while it reads the world, measured when its feedback
+  // acts on the observations; a model always acts on them.
+  const std::string expert = "robustness --expert scripted --world " + world.string() + " --episodes 2 --format csv ";
+  p = run(expert + "--factors observation_noise");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("no row to measure"));
+  p = run(expert + "--factors none,observation_noise --expert-feedback observations", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(std::count(p.output.begin(), p.output.end(), '\n'), 1 + 1 + 3) << p.output;
+  EXPECT_NE(run(expert + "--expert-feedback sometimes").status, 0);
+  p = run(cmd + "--expert-feedback observations");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("--expert-feedback is for --expert"));
   std::filesystem::remove(out);
   std::filesystem::remove(world);
   std::filesystem::remove(model);

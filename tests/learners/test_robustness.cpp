@@ -256,6 +256,34 @@ TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
   }
 }
 
+TEST(Perturbed, AnExpertsFeedbackOnTheObservationsIsItsOwnWhereTheyAreTrueAndMovesWithTheirNoise) {
+  // Told to act on what a policy is shown, an expert's feedback reads the observations while
+  // its choices read the world: where the observations are the true states, the episode is the
+  // world-fed expert's, bit for bit; under observation noise that expert ignores the noise and
+  // the observation-fed one does not.
+  const WorldConfig w = test::short_world(40);
+  ExpertConfig c;
+  c.search_budget = 8;
+  c.replan_budget = 4;
+  PerturbationDraw noisy = bare_draw(w);
+  for (std::size_t k = 0; k < kStateDim; ++k) noisy.observation_noise[k] = 0.05 * observation_spread()[k];
+  for (const char* name : {"scripted", "mpc"}) {
+    OwnedExpertPolicy own(make_expert(name, c)), sensing(make_expert(name, c), ExpertFeedback::observations);
+    const Episode nominal = perturbed_rollout(w, bare_draw(w), own);
+    const Episode same = perturbed_rollout(w, bare_draw(w), sensing);
+    ASSERT_EQ(nominal.states.size(), same.states.size()) << name;
+    for (std::size_t t = 0; t < nominal.states.size(); ++t)
+      ASSERT_TRUE(test::bit_equal(nominal.states[t], same.states[t])) << name << " " << t;
+    const Episode unmoved = perturbed_rollout(w, noisy, own);
+    ASSERT_EQ(unmoved.states.size(), nominal.states.size()) << name;
+    for (std::size_t t = 0; t < nominal.states.size(); ++t)
+      ASSERT_TRUE(test::bit_equal(nominal.states[t], unmoved.states[t])) << name << " " << t;
+    const Episode moved = perturbed_rollout(w, noisy, sensing);
+    ASSERT_GT(moved.states.size(), 1u);
+    EXPECT_FALSE(test::bit_equal(moved.states[1], nominal.states[1])) << name << ": the first noisy feedback moves the cup";
+  }
+}
+
 TEST(Perturbed, AnInvalidPerturbationIsRefusedBeforeAnyRollout) {
   std::atomic<int> made{0};
   EvalRequest r = test::eval_request(3, 0, 1);

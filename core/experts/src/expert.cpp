@@ -87,11 +87,11 @@ class ScriptedExpert final : public Expert {
 
  private:
   void do_reset(std::uint64_t) override { last_step_ = -2; }
-  Action do_act(const DiceEnv& env) override {
+  Action do_act(const DiceEnv& env, const State& sensed) override {
     const int t = env.t();
     if (!plan_.valid() || t != last_step_ + 1) plan_ = SwingPlan(config_.swing, config_, env.config(), env.get_state(), t);
     last_step_ = t;
-    return plan_.act(env.get_state(), t);
+    return plan_.act(sensed, t);
   }
 
   ExpertConfig config_;
@@ -140,7 +140,7 @@ class MpcExpert final : public Expert {
     attempts_.clear();
   }
 
-  Action do_act(const DiceEnv& env) override {
+  Action do_act(const DiceEnv& env, const State& sensed) override {
     if (config_.retry && attempts_.begins(env)) plan_ = SwingPlan();  // searched afresh below
     const int t = env.t();
     const State s = env.get_state();
@@ -150,7 +150,7 @@ class MpcExpert final : public Expert {
     const bool fresh =
         !plan_.valid() || (config_.replan && (t < last_replan_ || t - last_replan_ >= config_.replan_interval));
     if (!on_track && fresh) replan(env);
-    return plan_.act(s, t);
+    return plan_.act(sensed, t);
   }
 
   // `noise` > 0: executed-action noise of that std (x action.scale), drawn from `noise_seed`.
@@ -285,7 +285,7 @@ class TrackerExpert final : public Expert {
     attempts_.clear();
   }
 
-  Action do_act(const DiceEnv& env) override {
+  Action do_act(const DiceEnv& env, const State& sensed) override {
     const int t = env.t();
     const TrackerConfig& c = recordings_->config();
     if (retry_ && attempts_.begins(env)) follower_ = PathFollower();
@@ -301,7 +301,7 @@ class TrackerExpert final : public Expert {
         follow(t);
       }
     }
-    return follower_.act(env.get_state(), t);
+    return follower_.act(sensed, t);
   }
 
   void follow(int t) {
@@ -325,8 +325,9 @@ class TrackerExpert final : public Expert {
 
 void Expert::reset(std::uint64_t seed) { do_reset(seed); }
 
-Action Expert::act(const DiceEnv& env, std::span<const Action> pending) {
+Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const State* sensed) {
   require_finite(env.get_state(), "expert: state");
+  if (sensed) require_finite(*sensed, "expert: sensed state");
   const DiceEnv* at = &env;
   if (!pending.empty()) {
     DiceEnv& ahead = planning_sim(ahead_, env);
@@ -336,7 +337,10 @@ Action Expert::act(const DiceEnv& env, std::span<const Action> pending) {
     if (ahead.t() >= ahead.config().episode.max_steps) return Action{0.0, 0.0, 0.0};
     at = &ahead;
   }
-  Action a = do_act(*at);
+  State feedback = at->get_state();
+  if (sensed)  // what it senses, moved as the simulator moves the world through what is pending
+    for (std::size_t k = 0; k < kStateDim; ++k) feedback[k] = (*sensed)[k] + feedback[k] - env.get_state()[k];
+  Action a = do_act(*at, feedback);
   require_finite(a, name() + " expert: action");
   const auto& limit = env.config().action.limit;
   for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);

@@ -80,21 +80,28 @@ class ExpertPolicy final : public Policy {
   const DiceEnv* env_;
 };
 
+/// What an expert's feedback acts on: the world's own state (its privilege), or what the
+/// rollout shows a policy (noisy or late under a perturbation's sensing).
+enum class ExpertFeedback { world, observations };
+
 /// An expert of its own, acting in whichever environment rollout attaches (evaluation of an
-/// expert, the robustness table). It reads the world itself, not the observations.
+/// expert, the robustness table). Its choices read the world itself; its feedback too, unless
+/// told to act on the observations (Expert::act's `sensed`).
 class OwnedExpertPolicy final : public Policy {
  public:
-  explicit OwnedExpertPolicy(std::unique_ptr<Expert> expert) : expert_(std::move(expert)) {}
+  explicit OwnedExpertPolicy(std::unique_ptr<Expert> expert, ExpertFeedback feedback = ExpertFeedback::world)
+      : expert_(std::move(expert)), feedback_(feedback) {}
   void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_->reset(seed); }
   Action act(const History& h) override {
     if (!env_) throw std::logic_error("expert " + expert_->name() + ": no environment attached (roll it out with rollout())");
-    return expert_->act(*env_, h.pending);
+    return expert_->act(*env_, h.pending, feedback_ == ExpertFeedback::observations ? &h.current() : nullptr);
   }
   std::string name() const override { return "expert " + expert_->name(); }
 
  private:
   std::unique_ptr<Expert> expert_;
+  ExpertFeedback feedback_;
   const DiceEnv* env_ = nullptr;
 };
 

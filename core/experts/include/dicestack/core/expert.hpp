@@ -87,16 +87,19 @@ class Expert {
   /// The action (dvx, dvy, dw) for env's current state, within config.action.limit.
   /// Under an action delay, `pending` holds what runs before this action lands (History's
   /// pending): the expert then acts for the state the simulator says they lead to, as a Smith
-  /// predictor does (zeros if the episode ends first). Throws InputError if the environment's
-  /// state is not finite.
-  Action act(const DiceEnv& env, std::span<const Action> pending = {});
+  /// predictor does (zeros if the episode ends first). With `sensed`, its feedback acts on that
+  /// state (what a policy is shown: noisy, late; moved by the prediction through `pending`)
+  /// while its choices and simulations still read the world: the teacher behind the policy's
+  /// sensors (docs/robustness.md). Throws InputError if a state is not finite.
+  Action act(const DiceEnv& env, std::span<const Action> pending = {}, const State* sensed = nullptr);
 
   /// The name make_expert() knows it by.
   virtual std::string name() const = 0;
 
  private:
   virtual void do_reset(std::uint64_t seed) = 0;
-  virtual Action do_act(const DiceEnv& env) = 0;
+  /// `sensed`: the state its feedback acts on (the world's own unless act() was given another).
+  virtual Action do_act(const DiceEnv& env, const State& sensed) = 0;
 
   std::optional<DiceEnv> ahead_;  // where `pending` leads (act with a delay)
 };
