@@ -230,14 +230,26 @@ class IdleThenExpert final : public Policy {
   std::size_t idle_;
 };
 
+// An mpc search small enough for a unit test.
+ExpertConfig quick_search() {
+  ExpertConfig c;
+  c.search_budget = 8;
+  c.replan_budget = 4;
+  return c;
+}
+
+// Two episodes through the same states, bit for bit.
+void expect_same_states(const Episode& a, const Episode& b, const std::string& what) {
+  ASSERT_EQ(a.states.size(), b.states.size()) << what;
+  for (std::size_t t = 0; t < a.states.size(); ++t) ASSERT_TRUE(test::bit_equal(a.states[t], b.states[t])) << what << " " << t;
+}
+
 TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
   // With the simulator as its model (a Smith predictor), an expert whose actions run 4 steps
   // late moves the world exactly as the same expert with no delay does once 4 idle steps have
   // passed: the same states, bit for bit, and the same outcome.
   const WorldConfig w = test::short_world(40);
-  ExpertConfig c;
-  c.search_budget = 8;
-  c.replan_budget = 4;
+  const ExpertConfig c = quick_search();
   PerturbationDraw d = bare_draw(w);
   d.action_delay = 4;
   RolloutOptions o;
@@ -249,8 +261,7 @@ TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
     IdleThenExpert idle(make_expert("mpc", c), 4);
     const Episode a = rollout(env, late, start, seed, StepSource::expert, o);
     const Episode b = rollout(plain, idle, start, seed, StepSource::expert);
-    ASSERT_EQ(a.states.size(), b.states.size()) << seed;
-    for (std::size_t t = 0; t < a.states.size(); ++t) ASSERT_TRUE(test::bit_equal(a.states[t], b.states[t])) << seed << " " << t;
+    expect_same_states(a, b, "seed " + std::to_string(seed));
     EXPECT_EQ(a.outcome.realistic_success(), b.outcome.realistic_success());
     EXPECT_EQ(a.outcome.wall_contact, b.outcome.wall_contact);
   }
@@ -262,22 +273,14 @@ TEST(Perturbed, AnExpertsFeedbackOnTheObservationsIsItsOwnWhereTheyAreTrueAndMov
   // world-fed expert's, bit for bit; under observation noise that expert ignores the noise and
   // the observation-fed one does not.
   const WorldConfig w = test::short_world(40);
-  ExpertConfig c;
-  c.search_budget = 8;
-  c.replan_budget = 4;
+  const ExpertConfig c = quick_search();
   PerturbationDraw noisy = bare_draw(w);
   for (std::size_t k = 0; k < kStateDim; ++k) noisy.observation_noise[k] = 0.05 * observation_spread()[k];
-  for (const char* name : {"scripted", "mpc"}) {
+  for (const std::string name : {"scripted", "mpc"}) {
     OwnedExpertPolicy own(make_expert(name, c)), sensing(make_expert(name, c), ExpertFeedback::observations);
     const Episode nominal = perturbed_rollout(w, bare_draw(w), own);
-    const Episode same = perturbed_rollout(w, bare_draw(w), sensing);
-    ASSERT_EQ(nominal.states.size(), same.states.size()) << name;
-    for (std::size_t t = 0; t < nominal.states.size(); ++t)
-      ASSERT_TRUE(test::bit_equal(nominal.states[t], same.states[t])) << name << " " << t;
-    const Episode unmoved = perturbed_rollout(w, noisy, own);
-    ASSERT_EQ(unmoved.states.size(), nominal.states.size()) << name;
-    for (std::size_t t = 0; t < nominal.states.size(); ++t)
-      ASSERT_TRUE(test::bit_equal(nominal.states[t], unmoved.states[t])) << name << " " << t;
+    expect_same_states(perturbed_rollout(w, bare_draw(w), sensing), nominal, name + ", observations true");
+    expect_same_states(perturbed_rollout(w, noisy, own), nominal, name + " reading the world, observations noisy");
     const Episode moved = perturbed_rollout(w, noisy, sensing);
     ASSERT_GT(moved.states.size(), 1u);
     EXPECT_FALSE(test::bit_equal(moved.states[1], nominal.states[1])) << name << ": the first noisy feedback moves the cup";
