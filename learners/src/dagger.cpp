@@ -96,9 +96,7 @@ class Dagger final : public Learner {
             {"schedule", ParamType::choice, "exponential", 0, 0, "exponential (p^(i-1)) or linear (1 down to 0)", {"exponential", "linear"}},
             {"expert", ParamType::choice, "mpc", 0, 0, "the expert that acts and labels (tracker: follows the recordings of --demos)", names},
             {"replan", ParamType::boolean, "true", 0, 1, "mpc: replan when the world leaves its prediction", {}},
-            {"retry", ParamType::choice, "auto", 0, 0,
-             "mpc and tracker: once a failed attempt has come to rest, start afresh from there (auto: with a +retry feature map)",
-             {"auto", "true", "false"}},
+            retry_param_spec(),
             {"include_demos", ParamType::boolean, "true", 0, 1, "start the aggregate from the demonstrations", {}}};
     for (auto& p : tracker_param_specs()) specs.push_back(std::move(p));
     specs.push_back(perturb_param_spec());

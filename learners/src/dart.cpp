@@ -105,9 +105,7 @@ class Dart final : public Learner {
              "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},
             {"replan", ParamType::boolean, "false", 0, 1,
              "mpc: replan when the noise pushes the world off its prediction (its labels then depend on the noise so far)", {}},
-            {"retry", ParamType::choice, "auto", 0, 0,
-             "mpc and tracker: once a failed attempt has come to rest, start afresh from there (auto: with a +retry feature map)",
-             {"auto", "true", "false"}},
+            retry_param_spec(),
             {"successes_only", ParamType::boolean, "true", 0, 1, "fit only on the noisy episodes that succeeded", {}},
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
     std::vector<ParamSpec> out = specs;

@@ -113,6 +113,12 @@ bool expert_retries(const std::string& retry, const std::string& features) {
   return retry == "auto" ? feature_map(features).attempts() : retry == "true";
 }
 
+ParamSpec retry_param_spec() {
+  return {"retry", ParamType::choice, "auto", 0, 0,
+          "mpc and tracker: once a failed attempt has come to rest, start afresh from there (auto: with a +retry feature map)",
+          {"auto", "true", "false"}};
+}
+
 int tracker_paths_for(int paths, const std::string& features) {
   if (paths >= 0) return paths;
   return servo_targets(features) ? kServoPaths : kOtherPaths;

@@ -326,7 +326,8 @@ class TrackerExpert final : public Expert {
 void Expert::reset(std::uint64_t seed) { do_reset(seed); }
 
 Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const State* sensed) {
-  require_finite(env.get_state(), "expert: state");
+  const State now = env.get_state();
+  require_finite(now, "expert: state");
   if (sensed) require_finite(*sensed, "expert: sensed state");
   const DiceEnv* at = &env;
   if (!pending.empty()) {
@@ -337,9 +338,9 @@ Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const St
     if (ahead.t() >= ahead.config().episode.max_steps) return Action{0.0, 0.0, 0.0};
     at = &ahead;
   }
-  State feedback = at->get_state();
+  State feedback = at == &env ? now : at->get_state();
   if (sensed)  // what it senses, moved as the simulator moves the world through what is pending
-    for (std::size_t k = 0; k < kStateDim; ++k) feedback[k] = (*sensed)[k] + feedback[k] - env.get_state()[k];
+    for (std::size_t k = 0; k < kStateDim; ++k) feedback[k] = (*sensed)[k] + feedback[k] - now[k];
   Action a = do_act(*at, feedback);
   require_finite(a, name() + " expert: action");
   const auto& limit = env.config().action.limit;

@@ -44,6 +44,10 @@ bool servo_targets(const std::string& features);
 /// with each attempt, as the expert's choices do), else "true" or "false" as given.
 bool expert_retries(const std::string& retry, const std::string& features);
 
+/// The `retry` option of the learners whose expert may try again (DART, DAgger): auto, true or
+/// false, read by expert_retries.
+ParamSpec retry_param_spec();
+
 /// How many recordings a learner's tracker follows for the option value `paths`: -1 is the
 /// default for the feature map `features` (1 for a "/position" map, else 3); others as given.
 int tracker_paths_for(int paths, const std::string& features);
