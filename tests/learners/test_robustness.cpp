@@ -262,6 +262,12 @@ TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
     const Episode a = rollout(env, late, start, seed, StepSource::expert, o);
     const Episode b = rollout(plain, idle, start, seed, StepSource::expert);
     expect_same_states(a, b, "seed " + std::to_string(seed));
+    // Fed the observations (here the true states), its feedback is moved through what is
+    // pending as the world is: the same episode.
+    DiceEnv sensing_env(w);
+    OwnedExpertPolicy sensing(make_expert("mpc", c), ExpertFeedback::observations);
+    expect_same_states(rollout(sensing_env, sensing, start, seed, StepSource::expert, o), a,
+                       "observations, seed " + std::to_string(seed));
     EXPECT_EQ(a.outcome.realistic_success(), b.outcome.realistic_success());
     EXPECT_EQ(a.outcome.wall_contact, b.outcome.wall_contact);
   }
