@@ -32,5 +32,18 @@ TEST(Standardizer, MeanAndPopulationSigmaByHand) {
   EXPECT_THROW(Standardizer::fit(Matrix(0, 2)), InputError);
 }
 
+TEST(Standardizer, AColumnOfEqualValuesIsConstantWhateverTheRoundingOfItsMean) {
+  // 78 copies of 2.6333333969116213 (the paper start's cup y in single precision) sum to a mean
+  // one ulp off, and a sigma of 1e-16: a value 2 cm away would then stand 1e14 apart.
+  Matrix m(78, 1);
+  m.setConstant(2.6333333969116213);
+  const Standardizer s = Standardizer::fit(m);
+  EXPECT_EQ(s.sigma[0], 1.0);
+  EXPECT_EQ(s.mean[0], 2.6333333969116213);
+  double in[1] = {2.6533333969116213}, out[1];
+  s.apply_row(in, out);
+  EXPECT_NEAR(out[0], 0.02, 1e-12);
+}
+
 }  // namespace
 }  // namespace dicestack

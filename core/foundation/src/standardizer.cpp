@@ -13,10 +13,13 @@ Standardizer Standardizer::fit(const Matrix& rows, std::vector<std::string>* war
   Standardizer s;
   const auto n = static_cast<double>(rows.rows());
   for (Eigen::Index j = 0; j < rows.cols(); ++j) {
-    const double mean = rows.col(j).sum() / n;
+    const bool constant = rows.col(j).minCoeff() == rows.col(j).maxCoeff();
+    const double mean = constant ? rows(0, j) : rows.col(j).sum() / n;
     const double var = (rows.col(j).array() - mean).square().sum() / n;
     double sigma = std::sqrt(var);
-    if (!(sigma > 0.0)) {
+    // n equal values rarely sum to exactly n times their value: the rounding of the mean leaves
+    // a sigma of about 1e-16 |mean|, which would blow any other value up by 1e16.
+    if (!(sigma > 0.0) || constant) {
       sigma = 1.0;
       if (warnings) {
         const std::string name = column_names && static_cast<std::size_t>(j) < column_names->size()
