@@ -54,7 +54,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   request.results = &results;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
-  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb};
+  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb, opt.world.start};
   if (!opt.report.empty())
     write_report_folder(evaluation_board(run, *model, s, results, rollouts, world, errors ? &*errors : nullptr), opt.report);
   if (!opt.video_dir.empty()) {
@@ -77,7 +77,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.description = "rollouts of " + opt.model.string();
     set.provenance = "dicestack evaluate --model " + opt.model.string() + " --episodes " + std::to_string(opt.episodes) +
                      (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
-                     " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
+                     (opt.world.start == "random" ? "" : " --start " + opt.world.start) + " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
   }
@@ -87,10 +87,11 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   }
   char line[512];
   std::snprintf(line, sizeof line,
-                "%s (%s): %d episodes from seed %llu%s\n"
+                "%s (%s): %d episodes%s from seed %llu%s\n"
                 "  realistic success %.1f%% [%.1f, %.1f], stacked %.1f%% [%.1f, %.1f], wall contact %.1f%% [%.1f, %.1f]\n"
                 "  dice in cup (most, mean) %.2f, all three %.1f%%, mean length %.0f steps, %.2f us per step",
                 opt.model.string().c_str(), model->regressor().name().c_str(), s.episodes,
+                opt.world.start == "random" ? "" : (" from " + opt.world.start + " starts").c_str(),
                 static_cast<unsigned long long>(opt.seed), opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb).c_str(),
                 100 * s.realistic_success.value, 100 * s.realistic_success.low,
                 100 * s.realistic_success.high, 100 * s.stacked.value, 100 * s.stacked.low, 100 * s.stacked.high,
@@ -109,7 +110,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
 void add_evaluate_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<EvaluateOptions>();
   CLI::App* cmd = app.add_subcommand("evaluate", "Roll a trained policy out and report its outcomes");
-  opt->world.add_to(*cmd);
+  opt->world.add_to(*cmd, true);
   cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->required()->check(CLI::ExistingFile);
   cmd->add_option("--demos", opt->demos,
                   "Also report train and test error (eq. 9) on this set: a folder, `builtin` or `human`");

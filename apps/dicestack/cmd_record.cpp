@@ -69,6 +69,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
                       std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
                       (opt.no_replan ? " --no-replan" : "") + (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
                       (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
+                      (opt.world.start == "random" ? "" : " --start " + opt.world.start) +
                       (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
                       "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
                       (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
@@ -136,7 +137,7 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   std::string experts;
   for (const auto& e : expert_list()) experts += "\n  " + e.name + ": " + e.description;
   CLI::App* cmd = app.add_subcommand("record", "Record demonstrations from an automatic expert:" + experts);
-  opt->world.add_to(*cmd);
+  opt->world.add_to(*cmd, true);
   cmd->add_option("--expert", opt->expert, "Expert name")->capture_default_str();
   cmd->add_option("--episodes", opt->episodes, "Episodes from random starts")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts")->check(seed_check())->capture_default_str();

@@ -105,7 +105,7 @@ std::vector<std::string> robustness_format_names(std::string* help) {
 void add_robustness_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<RobustnessOptions>();
   CLI::App* cmd = app.add_subcommand("robustness", "A model's or an expert's success in perturbed worlds, factor x level");
-  opt->world.add_to(*cmd);
+  opt->world.add_to(*cmd, true);
   cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->check(CLI::ExistingFile);
   cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");

@@ -87,7 +87,7 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
 void add_train_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<TrainOptions>();
   CLI::App* cmd = app.add_subcommand("train", "Train a policy: a learner fits a regressor to demonstrations");
-  opt->world.add_to(*cmd);
+  opt->world.add_to(*cmd, true);
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressor", opt->regressor, "Regressor name (see `dicestack regressors`)")->required();
   cmd->add_option("--set", opt->sets, "key=value parameter of the regressor; repeatable");

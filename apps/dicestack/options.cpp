@@ -6,17 +6,26 @@
 
 #include <unistd.h>
 
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/learners/train.hpp>
 
 namespace dicestack::cli {
 
-void WorldOption::add_to(CLI::App& app) {
+void WorldOption::add_to(CLI::App& app, bool starts) {
   app.add_option("--world", path, "World config JSON (defaults: the paper's world; see `dicestack config`)")
       ->check(CLI::ExistingFile);
+  if (starts)
+    app.add_option("--start", start,
+                   "Where episodes start: random (the world's randomization) or paper (the paper's start at rest, the "
+                   "whole scene shifted in x by U(-2 cm, 2 cm) per episode)")
+        ->check(CLI::IsMember(start_names()))
+        ->capture_default_str();
 }
 
-WorldConfig WorldOption::load() const { return path.empty() ? WorldConfig{} : load_world_config(path); }
+WorldConfig WorldOption::load() const {
+  return with_starts(path.empty() ? WorldConfig{} : load_world_config(path), start);
+}
 
 void print_line(const std::string& text) { std::cout << text << '\n' << std::flush; }
 

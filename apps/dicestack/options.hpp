@@ -12,11 +12,15 @@
 
 namespace dicestack::cli {
 
-/// `--world FILE`: a WorldConfig JSON (`dicestack config` writes the defaults).
+/// `--world FILE`: a WorldConfig JSON (`dicestack config` writes the defaults); for commands
+/// that draw many starts, also `--start random|paper` (initial_state.hpp's start distributions).
 struct WorldOption {
   std::filesystem::path path;
-  void add_to(CLI::App& app);
-  /// The config from the file, or the defaults when no file was given.
+  std::string start = "random";
+  /// `starts`: also bind `--start`.
+  void add_to(CLI::App& app, bool starts = false);
+  /// The config from the file, or the defaults when no file was given, with `--start`'s
+  /// distribution.
   WorldConfig load() const;
 };
 

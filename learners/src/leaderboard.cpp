@@ -14,6 +14,7 @@
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/json_depth.hpp>
 #include <dicestack/datasets/dataset.hpp>
@@ -416,7 +417,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   std::ostringstream header;
   header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << opt.demos.string() << " ("
          << plan.set.episodes.size() << " episodes, " << frames << " frames); split " << split.matrices().description
-         << "; profile " << opt.profile << "; " << plan.episodes << " rollouts per training seed from random starts (seed "
+         << "; profile " << opt.profile << "; " << plan.episodes << " rollouts per training seed from " << start_distribution_name(opt.world) << " starts (seed "
          << opt.seed << "), " << opt.seeds << " training seed(s); rates with 95% Wilson intervals";
   json learner_options = json::object(), row_features = json::array();
   for (const auto& l : plan.learners) learner_options[l] = plan.options_for(l);
@@ -439,6 +440,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
                {"training_seeds", opt.seeds}, {"seed", opt.seed}};
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
   if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
+  if (start_distribution_name(opt.world) != "random") plan.meta["start"] = start_distribution_name(opt.world);
 }
 
 // Resume: the rows of <out>.partial.json measured with the same settings, read by the root

@@ -32,6 +32,7 @@ std::string evaluation_json(const EvaluationRun& run, const Model& model, const 
                    {"us_per_step", s.policy_us_per_step},
                    {"seconds", s.seconds}};
   if (run.perturb != "none") j["perturb"] = run.perturb;
+  if (run.start != "random") j["start"] = run.start;
   if (errors) {
     j["train_error"] = errors->train_error;
     if (errors->test_error) j["test_error"] = *errors->test_error;
@@ -56,12 +57,13 @@ Leaderboard evaluation_board(const EvaluationRun& run, const Model& model, const
   board.rows.push_back(std::move(row));
   board.world = world;
   board.header = "dicestack " DICESTACK_VERSION " evaluation of " + run.model + ": " + std::to_string(stats.episodes) +
-                 " rollouts from random starts (seed " + std::to_string(run.seed) + "); rates with 95% Wilson intervals";
+                 " rollouts from " + run.start + " starts (seed " + std::to_string(run.seed) + "); rates with 95% Wilson intervals";
   nlohmann::json meta{{"model", run.model},        {"dicestack_version", DICESTACK_VERSION},
                       {"regressor", model.regressor().name()}, {"features", model.features().name()},
                       {"episodes", stats.episodes}, {"seed", run.seed},
                       {"initial_push", run.initial_push}};
   if (run.perturb != "none") meta["perturb"] = run.perturb;
+  if (run.start != "random") meta["start"] = run.start;
   for (const auto& [key, value] : model.record) meta["training " + key] = value;
   board.meta_json = meta.dump();
   return board;

@@ -6,9 +6,17 @@ import os
 from . import _dicestack
 
 
-def resolve_world(world=None):
-    """The _dicestack.WorldConfig for `world`; ValueError names a bad field, FileNotFoundError a
+def resolve_world(world=None, start="random"):
+    """The _dicestack.WorldConfig for `world`, its episodes starting from `start`: "random" (the
+    world's randomization) or "paper" (the paper's start at rest, the whole scene shifted in x by
+    U(-2 cm, 2 cm) per episode). ValueError names a bad field or start, FileNotFoundError a
     missing file."""
+    if not isinstance(start, str):
+        raise TypeError(f"start must be 'random' or 'paper', got {type(start).__name__}")
+    return _resolve_config(world).with_starts(start)
+
+
+def _resolve_config(world):
     if world is None:
         return _dicestack.WorldConfig()
     if isinstance(world, _dicestack.WorldConfig):

@@ -70,7 +70,9 @@ class DiceStackEnv(_EnvBase):
 
     Seeding follows Gymnasium: reset(seed=s) starts from dicestack's random start s (the same as
     DiceEnv::reset(s) in C++); reset() without a seed continues a stream derived from the last
-    seed. options={"state": 24 numbers} starts from a given state instead.
+    seed. options={"state": 24 numbers} starts from a given state instead. start="paper" draws
+    every start from the paper's instead (its pose at rest, the whole scene shifted in x by
+    U(-2 cm, 2 cm)), as `dicestack evaluate --start paper`.
 
     perturb (issue 25; docs/robustness.md): None, a level ("easy", "medium", "hard"), a
     perturbation file or a dict of its fields. Each episode then runs in the world drawn from its
@@ -82,10 +84,10 @@ class DiceStackEnv(_EnvBase):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
-    def __init__(self, world=None, render_mode=None, perturb=None):
+    def __init__(self, world=None, render_mode=None, perturb=None, start="random"):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
-        self._world = resolve_world(world)
+        self._world = resolve_world(world, start)
         self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world))
         self.render_mode = render_mode
         self.metadata = dict(type(self).metadata, render_fps=int(round(1.0 / self._world.control_dt)))

@@ -71,7 +71,7 @@ def _demos_argument(demos):
 
 
 def train(regressor, learner="bc", demos="builtin", features=None, options=None, params=None, seed=0, out=None,
-          *, world=None, split="episodes", threads=None, progress=None):
+          *, world=None, start="random", split="episodes", threads=None, progress=None):
     """Trains a model as `dicestack train` does and returns it (also written to `out` if given).
 
     regressor: a registry name (knn, linear_svr, rbf_svr, mlp, random_forest, gbt, or one added
@@ -79,11 +79,12 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
     options its settings. features: the feature map (default: the learner's). demos: "builtin",
     "human", a folder or a list of Episodes. split "episodes" holds every fifth episode out (test
     error), "none" trains on all. The model's `training` dict holds train_error, test_error (if
-    any) and seconds. progress: draw a progress bar on stderr (None: when stderr is a terminal).
+    any) and seconds. start: where training episodes start, "random" or "paper" (as `train --start`).
+    progress: draw a progress bar on stderr (None: when stderr is a terminal).
     Ctrl-C stops the training with KeyboardInterrupt; `out` is then left as it was.
     """
     return _dicestack.train(
-        resolve_world(world),
+        resolve_world(world, start),
         _demos_argument(demos),
         regressor,
         _assignments(params or {}, "params"),
@@ -98,9 +99,10 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
     )
 
 
-def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None, initial_push="none",
-             perturb=None, report=None, progress=None):
-    """Rolls `model` out from `episodes` random starts, as `dicestack evaluate --json` does, and
+def evaluate(model, episodes=20, seed=0, *, world=None, start="random", demos=None, threads=None,
+             initial_push="none", perturb=None, report=None, progress=None):
+    """Rolls `model` out from `episodes` starts (start: "random", or "paper" for the paper's start
+    shifted by up to 2 cm, as `evaluate --start`), as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
     given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
@@ -116,7 +118,7 @@ def evaluate(model, episodes=20, seed=0, *, world=None, demos=None, threads=None
         raise TypeError(f"model must be a dicestack.Model, got {type(model).__name__}")
     if report is not None and not isinstance(report, (str, os.PathLike)):
         raise TypeError(f"report must be a folder path, got {type(report).__name__}")
-    w = resolve_world(world)
+    w = resolve_world(world, start)
     perturbation = resolve_perturbation(perturb, w)
     return json.loads(
         _dicestack.evaluate(
@@ -150,8 +152,8 @@ def _names(values, what):
 
 
 def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
-                profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, threads=None,
-                out=None, format=None, perturb=None, progress=None):
+                profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, start="random",
+                threads=None, out=None, format=None, perturb=None, progress=None):
     """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
     learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
     with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
@@ -164,7 +166,8 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     dict of learner options applied to every learner that has the key; baselines: names
     (cmaes, de, basinhop, bayes, reinforce, rrt) or "all"; profile "quick" or "paper"; split
     "episodes" or "rows"; episodes: rollouts per row and seed (None: 20 quick, 100 paper);
-    seeds: training seeds per row. demos: "builtin", "human" or a folder. perturb: roll out in
+    seeds: training seeds per row. demos: "builtin", "human" or a folder. start: "random" or
+    "paper", where training and rollouts start (as `leaderboard --start`). perturb: roll out in
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
     nominal; docs/robustness.md).
 
@@ -185,7 +188,7 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
         if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
             raise ValueError(f"{name} must be a positive int, got {value!r}")
     table = _dicestack.leaderboard(
-        resolve_world(world),
+        resolve_world(world, start),
         os.fspath(demos),
         _names(regressors, "regressors"),
         _names(learners, "learners"),

@@ -9,6 +9,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
@@ -180,7 +181,7 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
                            const Perturbation& perturbation, const std::string& perturb, const std::filesystem::path& report) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
   const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push,
-                          perturbation.nominal() ? "none" : perturb};
+                          perturbation.nominal() ? "none" : perturb, start_distribution_name(world)};
   const InitialPush initial_push = initial_push_from(push);
   const int t = threads_from(threads);
   if (!report.empty()) check_report_replaceable(report);  // before any work, as `evaluate --report`

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/world_config.hpp>
 
 #include "bindings.hpp"
@@ -23,6 +24,11 @@ void bind_world(py::module_& m) {
       .def("to_json", [](const WorldConfig& c) { return to_json(c); }, "Pretty-printed JSON of every field")
       .def_property_readonly("hash", [](const WorldConfig& c) { return world_hash(c); },
                              "FNV-1a of to_json(): equal exactly for equal configs")
+      .def(
+          "with_starts", [](const WorldConfig& c, const std::string& starts) { return with_starts(c, starts); },
+          py::arg("starts"), "A copy whose starts are `starts`: random (as it is) or paper (ValueError otherwise)")
+      .def_property_readonly("start", [](const WorldConfig& c) { return start_distribution_name(c); },
+                             "random, or paper when its starts are the paper's")
       .def_property_readonly("control_dt", [](const WorldConfig& c) { return c.physics.control_dt; })
       .def_property_readonly("max_steps", [](const WorldConfig& c) { return c.episode.max_steps; });
 }

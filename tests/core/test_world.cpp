@@ -200,5 +200,27 @@ TEST(World, RandomStartsDifferAndDoNotOverlap) {
   EXPECT_TRUE(test::bit_equal(random_start_state(none, 9), paper_start_state(none)));
 }
 
+TEST(World, PaperStartsAreThePapersStartAtRestShiftedWholeByAtMostTwoCentimetres) {
+  const WorldConfig paper = with_starts(WorldConfig{}, "paper");
+  EXPECT_EQ(start_distribution_name(paper), "paper");
+  EXPECT_EQ(start_distribution_name(WorldConfig{}), "random");
+  EXPECT_EQ(with_starts(WorldConfig{}, "random"), WorldConfig{});
+  const State home = paper_start_state(paper);
+  double widest = 0.0;
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    const State s = random_start_state(paper, seed);
+    const double shift = s[state_index::kCupX] - home[state_index::kCupX];
+    widest = std::max(widest, std::abs(shift));
+    for (std::size_t k = 0; k < kStateDim; ++k) {
+      const bool x = k == state_index::kCupX || k == state_index::die(0) || k == state_index::die(1) || k == state_index::die(2);
+      EXPECT_DOUBLE_EQ(s[k], home[k] + (x ? shift : 0.0)) << "seed " << seed << ", " << state_names()[k];
+    }
+  }
+  EXPECT_LE(widest, kPaperStartShift);
+  EXPECT_GT(widest, 0.9 * kPaperStartShift);
+  EXPECT_THAT(test::error_of([] { with_starts(WorldConfig{}, "papr"); }),
+              HasSubstr("unknown start distribution \"papr\"; expected random or paper"));
+}
+
 }  // namespace
 }  // namespace dicestack

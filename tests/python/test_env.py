@@ -149,6 +149,21 @@ def test_world_from_dict_file_and_default(tmp_path):
     assert dicestack.DiceStackEnv().world == dicestack.default_world()
 
 
+def test_paper_starts_are_the_papers_start_shifted_by_at_most_two_centimetres():
+    env = dicestack.DiceStackEnv(start="paper")
+    assert env.world["randomization"]["shift"] == 0.02 and env.world["randomization"]["cup_lift"] == 0.0
+    firsts = [env.reset(seed=s)[0] for s in range(20)]
+    shifts = [o[0] - firsts[0][0] for o in firsts]
+    assert max(abs(s) for s in shifts) <= 0.04 + 1e-9 and len(set(shifts)) > 1
+    for o in firsts:
+        assert o[1] == pytest.approx(firsts[0][1]) and o[2] == pytest.approx(firsts[0][2])  # height and angle as the paper's
+        assert np.allclose(o[[3, 9, 15]] - o[0], firsts[0][[3, 9, 15]] - firsts[0][0], atol=1e-6)  # the whole scene moves
+    with pytest.raises(ValueError, match='unknown start distribution "papers"'):
+        dicestack.DiceStackEnv(start="papers")
+    with pytest.raises(TypeError, match="start must be"):
+        dicestack.DiceStackEnv(start=1)
+
+
 def test_context_manager_and_unwrapped(env):
     with dicestack.DiceStackEnv() as e:
         e.reset(seed=0)

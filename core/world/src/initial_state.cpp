@@ -25,6 +25,21 @@ State paper_start_state(const WorldConfig& config) {
   return s;
 }
 
+std::vector<std::string> start_names() { return {"random", "paper"}; }
+
+WorldConfig with_starts(WorldConfig config, std::string_view starts) {
+  if (starts == "paper") {
+    config.randomization = RandomizationConfig{kPaperStartShift, 0.0, 0.0, 0.0, false};
+  } else if (starts != "random") {
+    throw ConfigError("unknown start distribution \"" + std::string(starts) + "\"; expected random or paper");
+  }
+  return config;
+}
+
+std::string start_distribution_name(const WorldConfig& config) {
+  return config.randomization == with_starts(config, "paper").randomization ? "paper" : "random";
+}
+
 std::uint64_t evaluation_start_seed(std::uint64_t seed, std::uint64_t index) { return derive_seed(seed, index); }
 
 std::uint64_t training_start_seed(std::uint64_t seed, std::uint64_t index) {
