@@ -53,6 +53,9 @@ std::string number_text(double v) {
 // path alone: 38-43 % as velocities). Measured in docs/learners.md.
 constexpr int kServoPaths = 1, kOtherPaths = 3;
 
+// The smoothing widths the learners' tracker ranks each recording at, besides tracker_smooth.
+const std::vector<double> kVariantWidths{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0};
+
 // The tracker as the learners' expert: the bare tracker's settings but for what was tuned for
 // DART on the tuning seeds (docs/learners.md, "Policies from the human recordings"): the
 // best-ranked recordings, smoothed, chosen robust to a learner's errors, narrowed before
@@ -92,7 +95,10 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_keep_extremes", ParamType::boolean, d.keep_extremes ? "true" : "false", 0, 1,
            "tracker: narrow a moved path's swing to reach no further than the recording's", {}},
           {"tracker_shrink", ParamType::integer, std::to_string(d.shrink_steps), 0, 100,
-           "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}}};
+           "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}},
+          {"tracker_variants", ParamType::boolean, d.smooth_variants.empty() ? "false" : "true", 0, 1,
+           "tracker: also rank the 8 best-ranked recordings smoothed by each of 0, 1, 2, 3, 4, 6 and 8 steps, score "
+           "the 4 best paths again from 64 more probe starts, and follow the best", {}}};
 }
 
 std::string followed_recordings(const Recordings& recordings) {
@@ -101,7 +107,8 @@ std::string followed_recordings(const Recordings& recordings) {
   std::string out;
   for (const std::size_t p : recordings.order()) {
     out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;
-    out += most > 0 ? " (" + std::to_string(recordings.probe_successes()[p]) + " of " + std::to_string(most) + " probe trials)"
+    out += most > 0 ? " (" + std::to_string(recordings.probe_successes()[p]) + " of " +
+                          std::to_string(recordings.probe_trials()[p]) + " probe trials)"
                     : " (not ranked)";
   }
   return out;
@@ -140,6 +147,7 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     tracker.robust_warp = params.real("tracker_robust_warp");
     tracker.keep_extremes = params.boolean("tracker_keep_extremes");
     tracker.shrink_steps = static_cast<int>(params.integer("tracker_shrink"));
+    if (params.boolean("tracker_variants")) tracker.smooth_variants = kVariantWidths;
     const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
     config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);

@@ -215,6 +215,49 @@ TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
   EXPECT_EQ(Recordings(paths, w, c, 7, 1).probe_successes(), Recordings(paths, w, c, 7, 2).probe_successes());
 }
 
+TEST(Recordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainFromFreshStarts) {
+  const WorldConfig w = test::short_world(200);
+  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  TrackerConfig c;
+  c.probes = 4;
+  c.smooth = 2.0;
+  const Recordings plain(paths, w, c, 7, 1);
+  c.smooth_variants = {0.0, 2.0, 5.0};  // 2 is `smooth`'s: the recordings themselves
+  c.variant_recordings = 2;
+  c.finalists = 2;
+  c.finalist_probes = 3;
+  const Recordings r(paths, w, c, 7, 1);
+  // The recordings as before, then the two best-ranked smoothed by 0 and by 5 steps.
+  ASSERT_EQ(r.paths().size(), 3u + 2u * 2u);
+  for (std::size_t p = 0; p < 3; ++p) {
+    EXPECT_EQ(r.paths()[p].name, paths[p].name);
+    // Their first scores are the plain ranking's; a finalist's grows by its second.
+    if (r.probe_trials()[p] == 4) {
+      EXPECT_EQ(r.probe_successes()[p], plain.probe_successes()[p]);
+    } else {
+      EXPECT_GE(r.probe_successes()[p], plain.probe_successes()[p]);
+    }
+  }
+  const std::size_t best = plain.order()[0];
+  EXPECT_EQ(r.paths()[3].name, paths[best].name + " (smoothed 0)");
+  EXPECT_EQ(r.paths()[4].name, paths[best].name + " (smoothed 5)");
+  EXPECT_EQ(r.paths()[3].states, paths[best].states);  // width 0: as recorded
+  // Two finalists with 4 + 3 probe trials each lead the order, by their success rate.
+  int finalists = 0;
+  for (std::size_t p = 0; p < r.paths().size(); ++p) finalists += r.probe_trials()[p] == 7;
+  EXPECT_EQ(finalists, 2);
+  EXPECT_EQ(r.probe_trials()[r.order()[0]], 7);
+  EXPECT_EQ(r.probe_trials()[r.order()[1]], 7);
+  EXPECT_GE(r.probe_successes()[r.order()[0]], r.probe_successes()[r.order()[1]]);
+  for (std::size_t k = 2; k < r.order().size(); ++k) EXPECT_EQ(r.probe_trials()[r.order()[k]], 4);
+  // The same on any number of threads.
+  const Recordings two(paths, w, c, 7, 2);
+  EXPECT_EQ(two.order(), r.order());
+  EXPECT_EQ(two.probe_successes(), r.probe_successes());
+  c.smooth_variants = {-1.0};
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"smooth_variants\""), std::string::npos);
+}
+
 TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
   EXPECT_NE(test::error_of([] { make_expert("tracker"); }).find("needs recordings"), std::string::npos);
   EXPECT_NE(test::error_of([] { make_expert("trackr"); }).find("scripted, mpc, tracker"), std::string::npos);

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <dicestack/core/cmaes.hpp>
@@ -21,6 +22,7 @@ namespace si = state_index;
 
 constexpr std::uint64_t kProbeStream = 0x70726f6265ULL;  // "probe"
 constexpr std::uint64_t kProbeNoiseStream = 0x70726f62654eULL;  // "probeN"
+constexpr std::uint64_t kVariantNoiseStream = 0x76617269616eULL;  // "varian"
 
 void check_path(const CupPath& p) {
   if (p.states.empty()) throw InputError("tracker: recording \"" + p.name + "\" has no steps");
@@ -263,6 +265,12 @@ void validate(const TrackerConfig& c) {
   require(c.shrink_steps >= 0 && c.shrink_steps <= 100, "shrink_steps", "in [0, 100]", c.shrink_steps);
   require(c.rescue_evaluations >= 1 && c.rescue_evaluations <= 100000, "rescue_evaluations", "in [1, 100000]",
           c.rescue_evaluations);
+  require(c.smooth_variants.size() <= 100, "smooth_variants", "at most 100 widths long", static_cast<double>(c.smooth_variants.size()));
+  for (const double w : c.smooth_variants) require(w >= 0.0 && w <= 1000.0, "smooth_variants", "widths in [0, 1000]", w);
+  require(c.variant_recordings >= 1 && c.variant_recordings <= 1000000, "variant_recordings", "in [1, 1000000]",
+          c.variant_recordings);
+  require(c.finalists >= 1 && c.finalists <= 100000, "finalists", "in [1, 100000]", c.finalists);
+  require(c.finalist_probes >= 0 && c.finalist_probes <= 100000, "finalist_probes", "in [0, 100000]", c.finalist_probes);
 }
 
 PathFollower::PathFollower(const CupPath& path, const PathWarp& warp, const State& start, int start_step, double gain,
@@ -323,40 +331,89 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
   validate(config_);
   if (paths_.empty()) throw InputError("tracker: no recordings to follow");
   for (const auto& p : paths_) check_path(p);
+  const std::vector<CupPath> recorded = config_.smooth_variants.empty() ? std::vector<CupPath>{} : paths_;
   if (config_.smooth > 0.0)
     for (auto& p : paths_) p = smoothed(p, config_.smooth);
-  probe_successes_.assign(paths_.size(), 0);
-  const auto probes = static_cast<std::size_t>(config_.probes);
-  if (probes > 0) {
-    // Every (path, probe start) pair is an item of its own, so the ranking is the same on any
-    // number of threads or ranks.
-    EnvPool envs(world, threads), sims(world, threads);
-    const auto wins = distributed_map<int>(
-        cluster, paths_.size() * probes, threads,
-        [&](std::size_t item, int w) {
-          const std::size_t path = item / probes, probe = item % probes;
-          DiceEnv& env = envs.at(w);
-          const State start = random_start_state(world, training_start_seed(derive_seed(seed_, kProbeStream), probe));
-          env.reset_to(start, 0);
-          const PathFollower follower(paths_[path], {}, start, 0, config_.gain, config_.keep_extremes);
-          const EnvSnapshot snap = env.snapshot();
-          // A probe scores 1 for a success as simulated, plus 1 per noisy trial that succeeds too.
-          if (!simulate(follower, sims.at(w), snap, config_.hold_steps).success) return 0;
-          int score = 1;
-          for (int k = 0; k < config_.robust_trials; ++k)
-            score += robust_trial(paths_[path], {}, start, 0, config_, sims.at(w), snap,
-                                  derive_seed(derive_seed(seed_, kProbeNoiseStream), item * 1000 + static_cast<std::size_t>(k)));
-          return score;
-        },
-        [](const int& v) { return std::to_string(v); }, [](std::string_view b) { return std::stoi(std::string(b)); });
-    for (std::size_t item = 0; item < wins.size(); ++item) probe_successes_[item / probes] += wins[item];
+  const int per_probe = 1 + config_.robust_trials;
+  probe_successes_ = probe_scores(world, threads, cluster, 0, paths_.size(), 0, config_.probes, false);
+  probe_trials_.assign(paths_.size(), config_.probes * per_probe);
+  std::vector<std::size_t> finalists;
+  if (!recorded.empty() && config_.probes > 0) {
+    // The best-ranked recordings, each also smoothed by every other width, scored alike.
+    const std::size_t n = recorded.size();
+    for (const std::size_t r : ranked(std::min(n, static_cast<std::size_t>(config_.variant_recordings))))
+      for (const double width : config_.smooth_variants) {
+        if (width == config_.smooth) continue;
+        CupPath v = width > 0.0 ? smoothed(recorded[r], width) : recorded[r];
+        std::ostringstream name;
+        name << recorded[r].name << " (smoothed " << width << ")";
+        v.name = name.str();
+        paths_.push_back(std::move(v));
+      }
+    const auto more = probe_scores(world, threads, cluster, n, paths_.size(), 0, config_.probes, true);
+    probe_successes_.insert(probe_successes_.end(), more.begin(), more.end());
+    probe_trials_.resize(paths_.size(), config_.probes * per_probe);
+    // The best of many scores is lucky: the finalists are scored again from fresh starts.
+    finalists = ranked(std::min(paths_.size(), static_cast<std::size_t>(config_.finalists)));
+    for (const std::size_t f : finalists) {
+      probe_successes_[f] += probe_scores(world, threads, cluster, f, f + 1, config_.probes, config_.finalist_probes, true)[0];
+      probe_trials_[f] += config_.finalist_probes * per_probe;
+    }
   }
-  order_.resize(paths_.size());
-  std::iota(order_.begin(), order_.end(), std::size_t{0});
-  std::stable_sort(order_.begin(), order_.end(),
-                   [&](std::size_t a, std::size_t b) { return probe_successes_[a] > probe_successes_[b]; });
+  // Finalists first, by their score over all their trials; then the rest, most successes first.
+  order_ = ranked(paths_.size());
+  if (!finalists.empty()) {
+    std::stable_sort(finalists.begin(), finalists.end(), [&](std::size_t a, std::size_t b) {
+      return static_cast<double>(probe_successes_[a]) / probe_trials_[a] > static_cast<double>(probe_successes_[b]) / probe_trials_[b];
+    });
+    std::erase_if(order_, [&](std::size_t p) { return std::find(finalists.begin(), finalists.end(), p) != finalists.end(); });
+    order_.insert(order_.begin(), finalists.begin(), finalists.end());
+  }
   if (config_.keep > 0 && static_cast<std::size_t>(config_.keep) < order_.size())
     order_.resize(static_cast<std::size_t>(config_.keep));
+}
+
+std::vector<std::size_t> Recordings::ranked(std::size_t count) const {
+  std::vector<std::size_t> order(probe_successes_.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return probe_successes_[a] > probe_successes_[b]; });
+  order.resize(std::min(count, order.size()));
+  return order;
+}
+
+std::vector<int> Recordings::probe_scores(const WorldConfig& world, int threads, Cluster& cluster, std::size_t from,
+                                          std::size_t to, int first_probe, int probes, bool variants) const {
+  std::vector<int> score(to - from, 0);
+  if (probes <= 0 || to <= from) return score;
+  // Every (path, probe start) pair is an item of its own, so the ranking is the same on any
+  // number of threads or ranks.
+  const auto per = static_cast<std::size_t>(probes);
+  EnvPool envs(world, threads), sims(world, threads);
+  const auto wins = distributed_map<int>(
+      cluster, (to - from) * per, threads,
+      [&](std::size_t item, int w) {
+        const std::size_t path = from + item / per, probe = static_cast<std::size_t>(first_probe) + item % per;
+        DiceEnv& env = envs.at(w);
+        const State start = random_start_state(world, training_start_seed(derive_seed(seed_, kProbeStream), probe));
+        env.reset_to(start, 0);
+        const PathFollower follower(paths_[path], {}, start, 0, config_.gain, config_.keep_extremes);
+        const EnvSnapshot snap = env.snapshot();
+        // A probe scores 1 for a success as simulated, plus 1 per noisy trial that succeeds too.
+        if (!simulate(follower, sims.at(w), snap, config_.hold_steps).success) return 0;
+        // The recordings' own noise seeds are those of the first ranking, which variants left as it was.
+        const std::uint64_t noise = variants ? derive_seed(derive_seed(seed_, kVariantNoiseStream), path * 1000003 + probe)
+                                             : derive_seed(seed_, kProbeNoiseStream);
+        const std::size_t key = variants ? 0 : item;
+        int won = 1;
+        for (int k = 0; k < config_.robust_trials; ++k)
+          won += robust_trial(paths_[path], {}, start, 0, config_, sims.at(w), snap,
+                              derive_seed(noise, key * 1000 + static_cast<std::size_t>(k)));
+        return won;
+      },
+      [](const int& v) { return std::to_string(v); }, [](std::string_view b) { return std::stoi(std::string(b)); });
+  for (std::size_t item = 0; item < wins.size(); ++item) score[item / per] += wins[item];
+  return score;
 }
 
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed) {

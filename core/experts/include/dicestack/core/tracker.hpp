@@ -71,6 +71,16 @@ struct TrackerConfig {
   /// closest recordings at each step: the least change that succeeds, alike for neighbouring
   /// starts. 0: straight to CMA-ES. In [0, 100].
   int shrink_steps = 0;
+  /// Variants of the recordings: besides `smooth`, each of the `variant_recordings` best-ranked
+  /// recordings is also ranked smoothed by each of these widths (steps, each in [0, 1000]); the
+  /// `finalists` best-scoring paths are then scored again from `finalist_probes` further probe
+  /// starts, and lead the order by their score over all their trials. Whether a path plays is a
+  /// chaotic function of such details (one recording, smoothed by 1 step, plays from 59 of 100
+  /// starts; by 4, from 27): the ranking picks the width. Empty: off.
+  std::vector<double> smooth_variants;
+  int variant_recordings = 8;  ///< >= 1
+  int finalists = 4;           ///< >= 1
+  int finalist_probes = 64;    ///< >= 0
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
@@ -104,9 +114,10 @@ class PathFollower {
   double centre_ = 0.0, shift_ = 0.0, gain_ = 10.0;
 };
 
-/// Recordings prepared for the tracker: each path, and their order of trial. Built once (the
-/// ranking simulates every path from `config.probes` training starts) and shared, read-only, by
-/// every tracker expert on every thread. The order is a deterministic function of the paths,
+/// Recordings prepared for the tracker: each path (with TrackerConfig::smooth_variants, the
+/// recordings' variants after them, named "NAME (smoothed W)"), and their order of trial. Built
+/// once (the ranking simulates every path from `config.probes` training starts) and shared,
+/// read-only, by every tracker expert on every thread. The order is a deterministic function of the paths,
 /// the world, the config and the seed: the same on any number of threads or ranks.
 class Recordings {
  public:
@@ -123,15 +134,23 @@ class Recordings {
   /// Probe score per path (index as in paths()): its successes from the probe starts, and with
   /// robust_trials, 1 more for each noisy trial of such a success that also succeeds.
   const std::vector<int>& probe_successes() const { return probe_successes_; }
+  /// The trials each probe score counts: probes x (1 + robust_trials), more for a finalist.
+  const std::vector<int>& probe_trials() const { return probe_trials_; }
   const TrackerConfig& config() const { return config_; }
   std::uint64_t seed() const { return seed_; }
 
  private:
+  /// The first `count` paths by probe score, most successes first, then by index.
+  std::vector<std::size_t> ranked(std::size_t count) const;
+  /// Probe scores of paths [from, to) from probe starts [first_probe, first_probe + probes).
+  std::vector<int> probe_scores(const WorldConfig& world, int threads, Cluster& cluster, std::size_t from, std::size_t to,
+                                int first_probe, int probes, bool variants) const;
+
   std::vector<CupPath> paths_;
   TrackerConfig config_;
   std::uint64_t seed_ = 0;
   std::vector<std::size_t> order_;
-  std::vector<int> probe_successes_;
+  std::vector<int> probe_successes_, probe_trials_;
 };
 
 /// What the tracker's search chose for one start.
