@@ -33,9 +33,10 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
   return PerturbedChannel(d);
 }
 
-Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features) {
+Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features, const RowFilter& rows = {}) {
   std::size_t n = 0;
-  for (const Episode* e : episodes) n += e->size();
+  for (const Episode* e : episodes)
+    for (std::size_t t = 0; t < e->size(); ++t) n += !rows || rows(*e, t);
   const auto width = static_cast<Eigen::Index>(features.width());
   Dataset d;
   d.x.resize(static_cast<Eigen::Index>(n), width);
@@ -48,16 +49,19 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
     std::optional<PerturbedChannel> channel = replayed_channel(*e, features);
     std::vector<State> seen;
     std::vector<Action> pending, unseen;
-    for (std::size_t t = 0; t < e->size(); ++t, ++row) {
+    for (std::size_t t = 0; t < e->size(); ++t) {
       if (channel) {
         seen.push_back(channel->observe(e->states[t]));
         pending.assign(channel->pending().begin(), channel->pending().end());
         unseen.assign(channel->unseen().begin(), channel->unseen().end());
       }
-      const History h{std::span<const State>(channel ? seen.data() : e->states.data(), t + 1),
-                      std::span<const Action>(e->actions.data(), t), pending, unseen};
-      features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
-      features.label(h, e->actions[t], {d.y.row(row).data(), kActionDim});
+      if (!rows || rows(*e, t)) {
+        const History h{std::span<const State>(channel ? seen.data() : e->states.data(), t + 1),
+                        std::span<const Action>(e->actions.data(), t), pending, unseen};
+        features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
+        features.label(h, e->actions[t], {d.y.row(row).data(), kActionDim});
+        ++row;
+      }
       if (channel) channel->execute(e->actions[t]);
     }
   }
@@ -77,10 +81,10 @@ Dataset take_rows(const Dataset& all, const std::vector<std::size_t>& rows) {
 
 }  // namespace
 
-Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features) {
+Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features, const RowFilter& rows) {
   std::vector<const Episode*> all;
   for (const auto& e : episodes) all.push_back(&e);
-  return stack(all, features);
+  return stack(all, features, rows);
 }
 
 bool is_test_episode(std::size_t index) { return index % 5 == 4; }

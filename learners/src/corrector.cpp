@@ -19,13 +19,23 @@ double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::ve
   for (std::size_t j = 0; j < problem.target.size(); ++j) {
     if (states) states->push_back(env.get_state());
     env.step(actions[j]);
-    cost += problem.aim == CorrectionTarget::cup ? cup_distance_sq(env.get_state(), problem.target[j], c)
-                                                 : tracking_distance_sq(env.get_state(), problem.target[j], c);
+    const State now = env.get_state();
+    switch (problem.aim) {
+      case CorrectionTarget::cup: cost += cup_distance_sq(now, problem.target[j], c); break;
+      case CorrectionTarget::state: cost += tracking_distance_sq(now, problem.target[j], c); break;
+      case CorrectionTarget::dice: {
+        const double d = state_distance(now, problem.target[j], c);
+        cost += d * d;
+        break;
+      }
+    }
   }
   return cost;
 }
 
 namespace {
+
+constexpr std::uint64_t kRandomStartStream = 0x78307374617274ULL;  // "x0start"
 
 // Any method of action_sequence.hpp over the window's actions, in the scaled box of every action
 // the world accepts, started from the policy's own actions; the warm start stays the answer
@@ -44,13 +54,19 @@ class SequenceCorrector final : public Corrector {
     MinimiseOptions o;
     o.method = method_;
     o.iterations = options_.iterations;
+    o.evaluations = options_.evaluations;
     o.population = options_.population;
     o.sigma0 = options_.sigma0;
     o.x0 = warm;
+    if (options_.random_start) {
+      Rng rng(derive_seed(seed, kRandomStartStream));
+      o.x0 = Eigen::VectorXd(window.dim());
+      for (Eigen::Index i = 0; i < o.x0->size(); ++i) (*o.x0)[i] = rng.uniform(-1.0, 1.0);
+    }
     o.seed = seed;
     SequenceEvaluator evaluator(env);
     const MinimiseResult found = minimise(window, evaluator, o);
-    if (found.best_cost < c.warm_cost) c.actions = window.actions(found.best.data());
+    if (options_.random_start || found.best_cost < c.warm_cost) c.actions = window.actions(found.best.data());
     c.cost = window_cost(env, p, c.actions, &c.states);  // deterministic: the cost found
     c.evaluations = found.evaluations + 2;               // with the warm start's and this one
     return c;

@@ -1,15 +1,19 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iterator>
 #include <optional>
 
 #include <dicestack/core/cost.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/tracker.hpp>
 #include <dicestack/learners/corrector.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/record.hpp>
 
 #include "checkpoint.hpp"
 
@@ -18,6 +22,52 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Where the paper's code (leonidk/cupdice, its DaD routine) differs from DaD as the paper
+// describes it. `faithful` switches them on, all ("true") or some ("start+label").
+struct CodeParts {
+  bool start = false;       // every rollout from the one fixed start
+  bool label = false;       // a one-step correction at every step, aimed at the recording's next state
+  bool cost = false;        // that state's dice (poses, velocities) and the cup's velocity
+  bool schedule = false;    // growing prefixes of each recording, several refits each; the last refit kept
+  bool search = false;      // CMA-ES from a random point, wide, to a budget of evaluations; its best always kept
+  bool duplicates = false;  // every refit appends every correction so far again
+  bool any() const { return start || label || cost || schedule || search || duplicates; }
+};
+
+constexpr const char* kCodePartNames[] = {"start", "label", "cost", "schedule", "search", "duplicates"};
+
+// The code's constants: 10 prefixes x 5 sub-iterations; CMA-ES sigma0 0.8, maxfevals 5000.
+constexpr int kCodeWindows = 10, kCodeRefits = 5, kCodeEvaluations = 5000;
+constexpr double kCodeSigma0 = 0.8;
+
+CodeParts code_parts(const std::string& text) {
+  CodeParts p;
+  if (text == "false") return p;
+  if (text == "true") return {true, true, true, true, true, true};
+  bool* fields[] = {&p.start, &p.label, &p.cost, &p.schedule, &p.search, &p.duplicates};
+  for (std::size_t from = 0; from <= text.size();) {
+    const std::size_t plus = std::min(text.find('+', from), text.size());
+    const std::string part = text.substr(from, plus - from);
+    const auto* it = std::find(std::begin(kCodePartNames), std::end(kCodePartNames), part);
+    if (it == std::end(kCodePartNames))
+      throw ConfigError("dad: parameter \"faithful\": unknown part \"" + part.substr(0, 40) + (part.size() > 40 ? "...\"" : "\"") +
+                        "; expected true, false, or parts joined by '+': start, label, cost, schedule, search, duplicates");
+    *fields[it - std::begin(kCodePartNames)] = true;
+    from = plus + 1;
+  }
+  return p;
+}
+
+// Everything a run does, resolved from its options once, before any work.
+struct DadPlan {
+  CodeParts code;
+  int windows = 10, per_window = 3;
+  CorrectionTarget aim = CorrectionTarget::cup;
+  std::string corrector;
+  CorrectorOptions search;
+  bool filter = true, keep_best = true;
+};
+
 // One window to correct: where in which demonstration, and the problem the corrector solves.
 struct Task {
   std::size_t demo = 0;
@@ -25,35 +75,69 @@ struct Task {
   CorrectionProblem problem;
 };
 
+// A correction carries the rollout before its window as history (the policy's steps): those are
+// not rows. A demonstration's steps all are, whoever chose them.
+bool is_row(const Episode& e, std::size_t t) {
+  return e.sources[t] != StepSource::policy || e.sources.back() != StepSource::correction;
+}
+
+// The iteration a correction was made at, from its origin ("dad iteration <k>: ...", which a
+// checkpoint keeps where it renames the episodes); 0 for a demonstration.
+constexpr std::string_view kMadeAt = "dad iteration ";
+int made_at(const Episode& e) {
+  if (e.origin.rfind(kMadeAt, 0) != 0) return 0;
+  try {
+    return std::stoi(e.origin.substr(kMadeAt.size()));
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
 // DaD with windowed annealing (paper VI-E, DESIGN "Learners"): roll the policy out from each
 // demonstration's first state; at every w-th step, from the policy's own drifted world, find
 // the next w actions that bring the simulated cup back onto the demonstration's cup path (or,
 // with target=state, all simulated states onto the demonstration's: eq. 11 as written);
 // add those (state, action) pairs to the data once (eq. 10); refit. Windows grow from 1/10 of
-// the demonstration to all of it, with a few iterations each.
+// the demonstration to all of it, with a few iterations each. `faithful` runs the paper's code
+// instead, difference by difference (docs/learners.md, "DaD as the paper's code runs it").
 class Dad final : public Learner {
  public:
-  using Learner::Learner;
+  // A bad `faithful` is refused where the options are parsed, before any work.
+  Dad(std::string name, Params params) : Learner(std::move(name), std::move(params)) {
+    code_parts(this->params().choice("faithful"));
+  }
 
   LearnResult learn(const LearnContext& c) const override {
-    // Corrections are windows cut from the middle of a drifted episode: a map that reads the
-    // step index, the start or the previous state would see them out of their episode.
-    if (c.features != "state")
-      throw ConfigError("dad: feature map \"" + c.features + "\" reads more than the current state, and DaD's "
-                        "corrections are windows without their episode; use --features state");
-    const int windows = static_cast<int>(params().integer("windows"));
-    const int per_window = static_cast<int>(params().integer("iterations"));
-    const int total = windows * per_window;
-    const std::vector<Episode> targets = pick_targets(c.demos, static_cast<std::size_t>(params().integer("demos")), c.world.cost);
+    const DadPlan plan = make_plan();
+    const bool from_training = params().choice("starts") == "training";
+    // A window cut from the middle of a rollout carries the rollout before it, as history, for a
+    // map that reads more than the current state (the step index, the start, the frame).
+    const bool with_history = c.features != "state";
+    std::string followed;  // from training starts: the recordings the tracker followed
+    const int total = plan.windows * plan.per_window;
+    const std::vector<Episode> targets =
+        from_training ? tracker_targets(c, followed) : pick_targets(c.demos, static_cast<std::size_t>(params().integer("demos")), c.world.cost);
+    // From training starts the policy is measured where it is trained to go: the targets' starts.
+    LearnContext measured = c;
+    if (from_training) measured.held_out.clear();
+    const std::optional<State> fixed_start = plan.code.start ? std::optional<State>(paper_start_state(c.world)) : std::nullopt;
     // Long recordings must not be cut by the time limit.
     WorldConfig world = c.world;
     for (const auto& d : targets) world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 1);
 
-    std::vector<Episode> data = targets;
+    std::vector<Episode> data = targets;  // the demonstrations, then each correction once
     LearnResult result;
     std::shared_ptr<Model> best;
     double best_deviation = 0.0;
     int best_iteration = 0, first = 1;
+    // The iteration's policy is better: from training starts, it stacks from more of them (then
+    // follows its targets closer); else it follows the held-out demonstrations closer.
+    auto better = [&](const CurvePoint& p) {
+      if (!from_training) return p.deviation < best_deviation;
+      const CurvePoint& b = result.curve[static_cast<std::size_t>(best_iteration)];
+      return p.realistic_success_rate > b.realistic_success_rate ||
+             (p.realistic_success_rate == b.realistic_success_rate && p.deviation < b.deviation);
+    };
     std::size_t corrections = 0, filtered = 0;
     if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params()))) {
       first = state->iteration() + 1;
@@ -65,25 +149,25 @@ class Dad final : public Learner {
       corrections = static_cast<std::size_t>(state->integer("corrections_kept", 0, INT64_MAX));
       filtered = static_cast<std::size_t>(state->integer("corrections_filtered", 0, INT64_MAX));
     }
-    std::shared_ptr<Model> model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)));
+    std::shared_ptr<Model> model =
+        fit_model(c, fit_data(data, plan, first - 1), derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)), is_row);
     if (first == 1) {
-      result.curve.push_back(measure_policy(model, c, targets, 0, rows_of(data)));
+      result.curve.push_back(measure_policy(model, measured, targets, 0, rows_of(data)));
       best = model;
       best_deviation = result.curve.back().deviation;
     }
 
     EnvPool envs(world, c.threads);
-    const auto corrector = make_corrector(params().choice("corrector"),
-                                          {static_cast<int>(params().integer("corrector_iterations")), params().real("sigma0"),
-                                           static_cast<int>(params().integer("population")), TrackerConfig{}.gain});
+    const auto corrector = make_corrector(plan.corrector, plan.search);
     for (int k = first; k <= total; ++k) {
-      const int window = (k - 1) / per_window + 1;
+      const int window = (k - 1) / plan.per_window + 1;
       auto report = [&](const char* phase, int done, int of) {
         if (c.progress)
-          c.progress({phase, k, total, window, windows, done, of, (k - 1 + (of ? static_cast<double>(done) / of : 0.0)) / total});
+          c.progress({phase, k, total, window, plan.windows, done, of, (k - 1 + (of ? static_cast<double>(done) / of : 0.0)) / total});
       };
       report("rollouts", 0, 0);
-      const std::vector<Task> tasks = policy_windows(*model, targets, window, windows, aim(), envs, c.threads);
+      std::vector<Episode> rollouts;
+      const std::vector<Task> tasks = policy_tasks(*model, targets, plan, window, fixed_start, envs, c.threads, rollouts);
 
       // Every rank cut the same windows (the rollouts are deterministic); the corrections, the
       // heavy part, are dealt among the ranks by window length and gathered in index order.
@@ -102,20 +186,28 @@ class Dad final : public Learner {
           },
           pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
 
-      for (std::size_t i = 0; i < tasks.size(); ++i) {
-        if (params().boolean("filter") && !(fixes[i].cost < fixes[i].warm_cost)) {
-          ++filtered;
-          continue;
+      if (plan.code.label) {
+        for (auto& e : step_corrections(tasks, fixes, targets, k)) data.push_back(std::move(e));
+        corrections += tasks.size();
+      } else {
+        for (std::size_t i = 0; i < tasks.size(); ++i) {
+          if (plan.filter && !(fixes[i].cost < fixes[i].warm_cost)) {
+            ++filtered;
+            continue;
+          }
+          data.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
+                                    with_history ? &rollouts[tasks[i].demo] : nullptr));
+          ++corrections;
         }
-        data.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k));
-        ++corrections;
       }
       report("fit", 0, 1);
-      model = fit_model(c, data, derive_seed(c.seed, static_cast<std::uint64_t>(k)));
-      CurvePoint point = measure_policy(model, c, targets, k, rows_of(data));
+      const std::vector<Episode> fitted = fit_data(data, plan, k);
+      model = fit_model(c, fitted, derive_seed(c.seed, static_cast<std::uint64_t>(k)), is_row);
+      CurvePoint point = measure_policy(model, measured, targets, k, rows_of(fitted));
       point.window = window;
+      const bool improved = better(point);
       result.curve.push_back(point);
-      if (point.deviation < best_deviation) {
+      if (improved) {
         best = model;
         best_deviation = point.deviation;
         best_iteration = k;
@@ -133,19 +225,26 @@ class Dad final : public Learner {
         remove_old_best_models(c.checkpoint_dir, best_file);
       }
     }
-    const std::shared_ptr<Model> chosen = params().boolean("keep_best") ? best : model;
+    const std::shared_ptr<Model> chosen = plan.keep_best ? best : model;
     chosen->record["learner"] = "dad";
-    chosen->record["dad_iteration"] = std::to_string(params().boolean("keep_best") ? best_iteration : total);
+    chosen->record["dad_iteration"] = std::to_string(plan.keep_best ? best_iteration : total);
     chosen->record["dad_targets"] = std::to_string(targets.size());
-    chosen->record["dad_scored_on"] = c.held_out.empty() ? "targets" : std::to_string(c.held_out.size()) + " held-out demonstrations";
+    chosen->record["dad_scored_on"] = from_training ? std::to_string(targets.size()) + " training starts (realistic success)"
+                                      : c.held_out.empty() ? "targets"
+                                                           : std::to_string(c.held_out.size()) + " held-out demonstrations";
+    if (from_training) {
+      chosen->record["dad_starts"] = "training";
+      chosen->record["tracker_followed"] = followed;
+    }
     chosen->record["dad_corrections_kept"] = std::to_string(corrections);
     chosen->record["dad_corrections_filtered"] = std::to_string(filtered);
+    if (plan.code.any()) chosen->record["dad_faithful"] = params().choice("faithful");
     result.model = chosen;
     return result;
   }
 
   static std::vector<ParamSpec> schema() {
-    return {{"windows", ParamType::integer, "10", 1, 1000, "window sizes: k/windows of each demonstration, k = 1..windows", {}},
+    std::vector<ParamSpec> out{{"windows", ParamType::integer, "10", 1, 1000, "window sizes: k/windows of each demonstration, k = 1..windows", {}},
             {"iterations", ParamType::integer, "3", 1, 1000, "iterations per window", {}},
             {"corrector", ParamType::choice, "cmaes", 0, 0,
              "how each window's actions are found: an optimiser, or track (the tracker's feedback law, no search)",
@@ -159,14 +258,89 @@ class Dad final : public Learner {
             {"demos", ParamType::integer, "3", 0, 1000000,
              "demonstrations to start from and correct towards, picked far apart by first state (the paper used 3); 0: all", {}},
             {"filter", ParamType::boolean, "true", 0, 1, "drop corrections that do not beat the policy's own actions", {}},
-            {"keep_best", ParamType::boolean, "true", 0, 1, "return the iteration's policy that follows the held-out demonstrations best", {}}};
+            {"keep_best", ParamType::boolean, "true", 0, 1, "return the iteration's policy that follows the held-out demonstrations best", {}},
+            {"starts", ParamType::choice, "demos", 0, 0,
+             "where rollouts start and what their corrections aim at: demos (each target demonstration's first state, "
+             "its recorded states) or training (random training starts, each aiming at the recording's cup path the "
+             "tracker chooses there: DaD from any start; default --features state+clock+start_state@dice+retry/position)",
+             {"demos", "training"}},
+            {"episodes", ParamType::integer, "300", 1, 1000000, "starts=training: how many training starts", {}},
+            retry_param_spec(),
+            {"faithful", ParamType::text, "false", 0, 0,
+             "true: run DaD as the paper's code does; or some of its parts joined by '+': start (one fixed start), label "
+             "(one step at every step, to the recording's next state), cost (the dice and the cup's velocity), schedule "
+             "(10 growing prefixes x 5 refits, the last kept), search (CMA-ES from a random point, sigma0 0.8, 5000 "
+             "evaluations), duplicates (every refit appends every correction again)", {}}};
+    for (auto& p : tracker_param_specs()) out.push_back(std::move(p));
+    return out;
+  }
+
+  // From training starts the policy plays a recording's cup path, as DART's with the tracker does.
+  std::string preferred_features() const override {
+    return params().choice("starts") == "training" ? "state+clock+start_state@dice+retry" + std::string(kPositionTargetSuffix)
+                                                   : std::string();
   }
 
  private:
+  DadPlan make_plan() const {
+    DadPlan p;
+    p.code = code_parts(params().choice("faithful"));
+    p.windows = p.code.schedule ? kCodeWindows : static_cast<int>(params().integer("windows"));
+    p.per_window = p.code.schedule ? kCodeRefits : static_cast<int>(params().integer("iterations"));
+    p.aim = p.code.cost ? CorrectionTarget::dice
+                        : params().choice("target") == "cup" ? CorrectionTarget::cup : CorrectionTarget::state;
+    p.corrector = p.code.search ? "cmaes" : params().choice("corrector");
+    p.search = {static_cast<int>(params().integer("corrector_iterations")), params().real("sigma0"),
+                static_cast<int>(params().integer("population")), TrackerConfig{}.gain, 0, false};
+    if (p.code.search) {
+      p.search.evaluations = kCodeEvaluations;
+      p.search.sigma0 = kCodeSigma0;
+      p.search.random_start = true;
+    }
+    p.filter = !p.code.search && params().boolean("filter");
+    p.keep_best = !p.code.schedule && params().boolean("keep_best");
+    return p;
+  }
+
   static std::size_t rows_of(const std::vector<Episode>& data) {
     std::size_t rows = 0;
-    for (const auto& e : data) rows += e.size();
+    for (const auto& e : data)
+      for (std::size_t t = 0; t < e.size(); ++t) rows += is_row(e, t);
     return rows;
+  }
+
+  // The targets from training starts: the tracker's successful episodes (the recordings of
+  // --demos, each start's choice moved into its frame and followed), without noise.
+  std::vector<Episode> tracker_targets(const LearnContext& c, std::string& followed) const {
+    ExpertConfig expert = learner_expert_config("tracker", params(), c);
+    expert.retry = expert_retries(params().choice("retry"), c.features);
+    RecordRequest request;
+    request.episodes = static_cast<int>(params().integer("episodes"));
+    request.seed = c.seed;
+    request.threads = c.threads;
+    std::vector<Episode> targets;
+    for (auto& e : record_expert("tracker", expert, c.world, request, *c.cluster))
+      if (e.outcome.realistic_success()) {
+        e.name = "target_" + std::to_string(targets.size());
+        targets.push_back(std::move(e));
+      }
+    if (targets.empty())
+      throw InputError("dad: the tracker stacked from none of " + std::to_string(request.episodes) + " training starts");
+    followed = followed_recordings(*expert.recordings);
+    return targets;
+  }
+
+  // What a refit after iteration k learns from: the data, and with the code's duplicates every
+  // correction once more for each refit since it was made.
+  static std::vector<Episode> fit_data(const std::vector<Episode>& data, const DadPlan& plan, int k) {
+    if (!plan.code.duplicates) return data;
+    std::vector<Episode> out;
+    for (const auto& e : data) {
+      const int made = made_at(e);
+      const int copies = made == 0 ? 1 : std::max(1, k - made + 1);
+      for (int i = 0; i < copies; ++i) out.push_back(e);
+    }
+    return out;
   }
 
   // Farthest-point selection on first states (the paper started from "three very different"
@@ -189,23 +363,34 @@ class Dad final : public Learner {
     return out;
   }
 
-  // Rolls the policy out from every target's first state and cuts its trajectory into windows
-  // of w steps: each starts from the policy's world at that step, aims at the target's states.
-  CorrectionTarget aim() const { return params().choice("target") == "cup" ? CorrectionTarget::cup : CorrectionTarget::state; }
-
-  static std::vector<Task> policy_windows(const Model& model, const std::vector<Episode>& targets, int window, int windows,
-                                          CorrectionTarget aim, EnvPool& envs, int threads) {
+  // Rolls the policy out from every target's first state (or the fixed start) and cuts its
+  // trajectory into windows: each starts from the policy's world at that step and aims at the
+  // target's next states. With the code's schedule the rollout covers only the window's prefix
+  // of the recording (window/windows of it) and is one window; with the code's labels every
+  // step is a window of one.
+  static std::vector<Task> policy_tasks(const Model& model, const std::vector<Episode>& targets, const DadPlan& plan,
+                                        int window, const std::optional<State>& fixed_start, EnvPool& envs, int threads,
+                                        std::vector<Episode>& rollouts) {
     std::vector<std::vector<Task>> per_demo(targets.size());
+    rollouts.assign(targets.size(), Episode{});
     parallel_for(targets.size(), threads, [&](std::size_t d, int w) {
       DiceEnv& env = envs.at(w);
       const Episode& demo = targets[d];
       const std::size_t len = demo.size();
-      const auto width = static_cast<std::size_t>(std::max(1.0, std::ceil(static_cast<double>(len) * window / windows)));
+      const std::size_t steps =
+          plan.code.schedule ? std::min(len - 1, len * static_cast<std::size_t>(window) / static_cast<std::size_t>(plan.windows))
+                             : len - 1;
+      if (steps == 0) return;
+      const std::size_t width =
+          plan.code.label ? 1
+          : plan.code.schedule
+              ? steps
+              : static_cast<std::size_t>(std::max(1.0, std::ceil(static_cast<double>(len) * window / plan.windows)));
       RolloutOptions options;
-      options.max_steps = len - 1;
+      options.max_steps = steps;
       options.before_step = [&](const DiceEnv& at, std::size_t t) {
-        if (t % width != 0) return;
-        Task task{d, t, {at.snapshot(), {}, {}, aim, {}, {}}};
+        if (t % width != 0 || t >= steps) return;
+        Task task{d, t, {at.snapshot(), {}, {}, plan.aim, {}, {}}};
         for (std::size_t j = t + 1; j < len && j <= t + width; ++j) {
           task.problem.target.push_back(demo.states[j]);
           task.problem.reference.push_back(demo.states[j - 1]);
@@ -214,9 +399,9 @@ class Dad final : public Learner {
         per_demo[d].push_back(std::move(task));
       };
       ModelPolicy policy(std::shared_ptr<const Model>(&model, [](const Model*) {}));  // borrowed for this rollout
-      const std::vector<Action> actions =
-          len > 1 ? rollout(env, policy, demo.states[0], demo.seed, StepSource::policy, options).actions
-                  : std::vector<Action>{};
+      const State& start = fixed_start ? *fixed_start : demo.states[0];
+      rollouts[d] = rollout(env, policy, start, demo.seed, StepSource::policy, options);
+      const std::vector<Action>& actions = rollouts[d].actions;
       for (auto& task : per_demo[d])  // the policy's own actions, held at zero past its episode's end
         for (std::size_t j = 0; j < task.problem.target.size(); ++j)
           task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j] : Action{0.0, 0.0, 0.0});
@@ -225,6 +410,30 @@ class Dad final : public Learner {
     for (auto& v : per_demo)
       for (auto& t : v) tasks.push_back(std::move(t));
     return tasks;
+  }
+
+  // One-step corrections of iteration k as one episode per rollout: the states the policy
+  // visited from its start, each labelled with the action the corrector found there (as DAgger
+  // labels a rollout), so every feature map sees them in their episode.
+  static std::vector<Episode> step_corrections(const std::vector<Task>& tasks, const std::vector<Correction>& fixes,
+                                               const std::vector<Episode>& targets, int k) {
+    std::vector<Episode> out;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      if (i == 0 || tasks[i].demo != tasks[i - 1].demo) {
+        const Episode& demo = targets[tasks[i].demo];
+        Episode e;
+        e.name = "dad_" + std::to_string(k) + "_" + demo.name + "_steps";
+        e.seed = demo.seed;
+        e.origin = std::string(kMadeAt) + std::to_string(k) + ": one-step corrections of a rollout towards " + demo.name;
+        out.push_back(std::move(e));
+      }
+      Episode& e = out.back();
+      e.states.push_back(fixes[i].states.front());
+      e.actions.push_back(fixes[i].actions.front());
+      e.sources.push_back(StepSource::correction);
+      e.outcome.steps = static_cast<int>(e.states.size());
+    }
+    return out;
   }
 
   static std::string pack_correction(const Correction& fix) {
@@ -244,14 +453,20 @@ class Dad final : public Learner {
     return fix;
   }
 
-  static Episode as_episode(const Correction& fix, const Episode& demo, std::size_t t, int iteration) {
+  // A window's correction; with `before`, after the rollout's first t steps (history, not rows).
+  static Episode as_episode(const Correction& fix, const Episode& demo, std::size_t t, int iteration, const Episode* before) {
     Episode e;
     e.name = "dad_" + std::to_string(iteration) + "_" + demo.name + "_" + std::to_string(t);
     e.seed = demo.seed;
-    e.origin = "dad correction of " + demo.name + " from step " + std::to_string(t);
-    e.states = fix.states;
-    e.actions = fix.actions;
-    e.sources.assign(e.states.size(), StepSource::correction);
+    e.origin = std::string(kMadeAt) + std::to_string(iteration) + ": correction of " + demo.name + " from step " + std::to_string(t);
+    if (before) {
+      e.states.assign(before->states.begin(), before->states.begin() + static_cast<std::ptrdiff_t>(t));
+      e.actions.assign(before->actions.begin(), before->actions.begin() + static_cast<std::ptrdiff_t>(t));
+      e.sources.assign(t, StepSource::policy);
+    }
+    e.states.insert(e.states.end(), fix.states.begin(), fix.states.end());
+    e.actions.insert(e.actions.end(), fix.actions.begin(), fix.actions.end());
+    e.sources.resize(e.states.size(), StepSource::correction);
     e.outcome.steps = static_cast<int>(e.states.size());
     return e;
   }

@@ -395,8 +395,8 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
       maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work
-      if (info.state_features_only && f != "state") {
-        if (!opt.features.empty()) say("note: " + l + " reads only the state; skipping features " + f, 0.0);
+      if (info.own_features_only && f != own) {
+        if (!opt.features.empty()) say("note: " + l + " reads only its own map (" + own + ") here; skipping features " + f, 0.0);
         continue;
       }
       if (opt.split == "rows" && f != "state" && opt.features.empty()) continue;  // a default map that needs episodes

@@ -66,9 +66,10 @@ std::string default_features(std::string_view learner, const std::vector<std::st
 
 namespace {
 
-std::shared_ptr<Model> fit_here(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
+std::shared_ptr<Model> fit_here(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed,
+                                const RowFilter& rows) {
   const FeatureMap& features = feature_map(c.features);
-  const Dataset d = make_dataset(data, features);
+  const Dataset d = make_dataset(data, features, rows);
   auto model = std::make_shared<Model>(
       Model::train(c.registry->create(c.regressor, c.regressor_sets), d.x, d.y, seed, nullptr, features));
   model->record["regressor_params"] = model->regressor().params().summary();
@@ -80,12 +81,13 @@ std::shared_ptr<Model> fit_here(const LearnContext& c, const std::vector<Episode
 
 }  // namespace
 
-std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed) {
+std::shared_ptr<Model> fit_model(const LearnContext& c, const std::vector<Episode>& data, std::uint64_t seed,
+                                 const RowFilter& rows) {
   if (data.empty()) throw InputError("no demonstrations to learn from");
-  if (c.cluster->size() == 1) return fit_here(c, data, seed);
+  if (c.cluster->size() == 1) return fit_here(c, data, seed, rows);
   std::shared_ptr<Model> model;
   const std::string bytes = on_root(*c.cluster, [&] {
-    model = fit_here(c, data, seed);
+    model = fit_here(c, data, seed, rows);
     return model_to_bytes(*model);
   });
   if (!model) model = std::make_shared<Model>(parse_model_file(bytes, "model broadcast by rank 0", *c.registry));

@@ -49,6 +49,9 @@ TrainReport train_model(const TrainRequest& request) {
   model.record["learner"] = request.learner;
   model.record["learner_options"] = learner->params().summary();
   model.record["demos"] = request.demos_name;
+  std::string names;  // the recordings it learned from, by name
+  for (const auto& e : c.demos) names += (names.empty() ? "" : ", ") + e.name;
+  model.record["recordings"] = std::to_string(c.demos.size()) + ": " + names;
   model.record["split"] = request.split;
   model.record["seed"] = std::to_string(request.seed);
   report.score = score(model, split);

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -6,6 +7,7 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/corrector.hpp>
@@ -75,6 +77,27 @@ TEST_P(CorrectorTest, LabelsAreInTheDemonstrationsUnits) {
 
 INSTANTIATE_TEST_SUITE_P(Dad, CorrectorTest, ::testing::ValuesIn(corrector_names()));
 
+TEST(Corrector, FromARandomStartItKeepsItsBestEvenWhereThePolicysActionsScoreBetter) {
+  // The paper's code: CMA-ES from a random point, its best returned whatever the policy did.
+  // From the demonstration's own world the policy's actions cost 0, which a short search from
+  // elsewhere does not reach; and the dice and the cup's velocity are what it aims at.
+  DiceEnv env(test::short_world());
+  const Episode& demo = demos()[0];
+  CorrectionProblem p = window_of(env, demo, 20, 1);
+  p.aim = CorrectionTarget::dice;
+  CorrectorOptions o;
+  o.evaluations = 40;
+  o.sigma0 = 0.8;
+  o.random_start = true;
+  const Correction fix = make_corrector("cmaes", o)->correct(env, p, 4);
+  EXPECT_EQ(fix.warm_cost, 0.0);
+  EXPECT_GT(fix.cost, 0.0);
+  EXPECT_LE(fix.evaluations, 40 + 7 + 2);  // the budget, its last generation, the warm start and the replay
+  EXPECT_NE(fix.actions[0], demo.actions[20]);
+  const Correction again = make_corrector("cmaes", o)->correct(env, p, 4);
+  EXPECT_EQ(again.actions, fix.actions);  // seeded
+}
+
 TEST(Dad, UnknownCorrectorIsRejected) {
   EXPECT_THROW(make_corrector("annealing", {}), ConfigError);
   EXPECT_THROW(LearnerRegistry::global().create("dad", {"corrector=annealing"}), ConfigError);
@@ -138,6 +161,99 @@ TEST(Dad, ResumeEqualsUninterrupted) {
   ASSERT_EQ(resumed.curve.size(), whole.curve.size());
   for (std::size_t k = 0; k < whole.curve.size(); ++k) EXPECT_EQ(resumed.curve[k].deviation, whole.curve[k].deviation);
   EXPECT_EQ(resumed.model->record.at("dad_iteration"), whole.model->record.at("dad_iteration"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Dad, FaithfulIsTrueFalseOrPartsOfThePapersCodeAndAnythingElseIsRefusedByPart) {
+  for (const char* ok : {"faithful=true", "faithful=false", "faithful=start", "faithful=label+cost+duplicates"})
+    EXPECT_NO_THROW(LearnerRegistry::global().create("dad", {ok})) << ok;
+  const std::string error =
+      test::error_of([] { LearnerRegistry::global().create("dad", {"faithful=start+labels"}); });
+  EXPECT_THAT(error, ::testing::HasSubstr("unknown part \"labels\""));
+  EXPECT_THAT(error, ::testing::HasSubstr("start, label, cost, schedule, search, duplicates"));
+  EXPECT_THROW(LearnerRegistry::global().create("dad", {"faithful=start+"}), ConfigError);
+  EXPECT_THAT(test::error_of([] { LearnerRegistry::global().create("dad", {"faithful=" + std::string(5000, 'x')}); }).size(),
+              ::testing::Lt(400u));  // a long value is not echoed whole
+}
+
+TEST(Dad, TheCodesDuplicatesAppendEveryCorrectionAgainAtEachRefit) {
+  // One-step labels at each of the 59 steps of 2 targets: 118 new corrections per iteration;
+  // with the code's duplicates, a refit after iteration k fits those of iteration j k - j + 1 times.
+  const std::vector<std::string> options{"windows=1", "iterations=3", "corrector_iterations=1", "demos=2",
+                                         "faithful=label+duplicates"};
+  const LearnResult r = LearnerRegistry::global().create("dad", options)->learn(dad_context(2));
+  ASSERT_EQ(r.curve.size(), 4u);
+  for (std::size_t k = 0; k < r.curve.size(); ++k) EXPECT_EQ(r.curve[k].dataset_rows, 120u + 118u * k * (k + 1) / 2) << k;
+  const LearnResult once = LearnerRegistry::global().create("dad", {"windows=1", "iterations=3", "corrector_iterations=1",
+                                                                     "demos=2", "faithful=label"})->learn(dad_context(2));
+  for (std::size_t k = 0; k < once.curve.size(); ++k) EXPECT_EQ(once.curve[k].dataset_rows, 120u + 118u * k) << k;
+}
+
+TEST(Dad, TheCodesScheduleCorrectsGrowingPrefixesFiveTimesEachAndKeepsTheLastRefit) {
+  const std::vector<std::string> options{"corrector_iterations=1", "demos=2", "faithful=schedule+label"};
+  const LearnResult r = LearnerRegistry::global().create("dad", options)->learn(dad_context(2));
+  ASSERT_EQ(r.curve.size(), 51u);  // 10 prefixes x 5 refits
+  for (std::size_t k = 1; k < r.curve.size(); ++k) {
+    const std::size_t window = (k - 1) / 5 + 1;
+    EXPECT_EQ(r.curve[k].window, static_cast<int>(window));
+    // The first 6 window steps of each 60-step target (the last prefix: its 59 steps with a next state).
+    EXPECT_EQ(r.curve[k].dataset_rows - r.curve[k - 1].dataset_rows, 2 * std::min<std::size_t>(59, 6 * window)) << k;
+  }
+  EXPECT_EQ(r.model->record.at("dad_iteration"), "50");
+  EXPECT_EQ(r.model->record.at("dad_faithful"), "schedule+label");
+}
+
+TEST(Dad, AWindowCarriesTheRolloutBeforeItAsHistoryForAMapThatReadsTheEpisode) {
+  const auto dir = test::scratch_path("dicestack_dad_history");
+  std::filesystem::remove_all(dir);
+  LearnContext c = dad_context(2);
+  c.checkpoint_dir = dir;
+  c.features = "state+clock+start_state";
+  const LearnResult r = LearnerRegistry::global()
+                            .create("dad", {"windows=2", "iterations=1", "corrector_iterations=1", "demos=2", "filter=false"})
+                            ->learn(c);
+  // As with the bare state: 59 corrected steps of each target, the rollout before a window not a row.
+  ASSERT_EQ(r.curve.size(), 3u);
+  EXPECT_EQ(r.curve[1].dataset_rows - r.curve[0].dataset_rows, 118u);
+  EXPECT_EQ(r.curve[2].dataset_rows - r.curve[1].dataset_rows, 118u);
+  const DemoSet data = read_demo_set(dir / "data-2");
+  std::size_t windows = 0;
+  for (const auto& e : data.episodes) {
+    const std::size_t from = e.origin.find(" from step ");
+    if (e.origin.rfind("dad iteration ", 0) != 0 || from == std::string::npos) continue;
+    ++windows;
+    const std::size_t t = std::stoul(e.origin.substr(from + 11));
+    ASSERT_GT(e.size(), t) << e.origin;
+    for (std::size_t k = 0; k < e.size(); ++k) EXPECT_EQ(e.sources[k], k < t ? StepSource::policy : StepSource::correction);
+    // It starts where a target's rollout started (the targets are two of the three demonstrations).
+    auto from_target = [&](const Episode& target) {
+      for (std::size_t k = 0; k < kStateDim; ++k)
+        if (std::abs(e.states[0][k] - target.states[0][k]) > 1e-6) return false;
+      return true;
+    };
+    EXPECT_TRUE(std::any_of(demos().begin(), demos().end(), from_target)) << e.origin;
+  }
+  EXPECT_GE(windows, 2u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Dad, TheCodesRolloutsStartFromTheOneFixedStartAndItsOneStepLabelsReadAnyFeatureMap) {
+  const auto dir = test::scratch_path("dicestack_dad_fixed_start");
+  std::filesystem::remove_all(dir);
+  LearnContext c = dad_context(2);
+  c.checkpoint_dir = dir;
+  c.features = "state+clock+start_state";
+  LearnerRegistry::global()
+      .create("dad", {"windows=1", "iterations=1", "corrector_iterations=1", "demos=2", "faithful=start+label"})
+      ->learn(c);
+  const DemoSet data = read_demo_set(dir / "data-1");
+  ASSERT_EQ(data.episodes.size(), 4u);  // the 2 targets, then one labelled rollout towards each
+  for (std::size_t i = 2; i < 4; ++i) {
+    const State start = paper_start_state(c.world);  // as Box2D holds it: in single precision
+    for (std::size_t k = 0; k < kStateDim; ++k) EXPECT_NEAR(data.episodes[i].states[0][k], start[k], 1e-6) << i << " " << k;
+    EXPECT_EQ(data.episodes[i].size(), 59u);
+    EXPECT_EQ(data.episodes[i].sources[0], StepSource::correction);
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -206,15 +206,5 @@ TEST(Dart, AModelFileAloneRollsOut) {
   EXPECT_EQ(a.mean_length, b.mean_length);
 }
 
-TEST(Dad, RefusesAFeatureMapBeyondTheState) {
-  LearnContext c;
-  c.world = test::short_world();
-  c.demos = record_expert("scripted", {}, c.world, test::record_request(2, 1, 1));
-  c.features = "state+clock";
-  const std::string error =
-      test::error_of([&] { LearnerRegistry::global().create("dad", {"windows=1", "iterations=1"})->learn(c); });
-  EXPECT_THAT(error, HasSubstr("dad: feature map \"state+clock\""));
-}
-
 }  // namespace
 }  // namespace dicestack

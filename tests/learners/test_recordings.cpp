@@ -86,6 +86,26 @@ TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
   EXPECT_EQ(tracker_paths_for(5, "state/position"), 5);
 }
 
+TEST(HonestLearning, DadAndDartFromThreeRecordingsBuildNoHandMadeExpertAndNameTheirRecordings) {
+  const Forbidden no({"mpc", "scripted"});
+  LearnContext c = recordings_context();
+  c.demos.resize(3);
+  c.features = "state+clock+start_state@dice+retry/position";
+  const std::vector<std::string> tracker{"tracker_probes=1", "tracker_robust=1", "tracker_variants=false"};
+  std::vector<std::string> dad{"starts=training", "episodes=2", "windows=1", "iterations=1", "corrector=track"};
+  dad.insert(dad.end(), tracker.begin(), tracker.end());
+  const auto from_dad = LearnerRegistry::global().create("dad", dad)->learn(c);
+  EXPECT_EQ(from_dad.model->record.at("dad_starts"), "training");
+  std::vector<std::string> dart{"expert=tracker", "episodes=2", "successes_only=false"};
+  dart.insert(dart.end(), tracker.begin(), tracker.end());
+  const auto from_dart = LearnerRegistry::global().create("dart", dart)->learn(c);
+  for (const auto* model : {from_dad.model.get(), from_dart.model.get()}) {
+    const std::string followed = model->record.at("tracker_followed");
+    EXPECT_TRUE(std::any_of(c.demos.begin(), c.demos.end(), [&](const Episode& e) { return followed.starts_with(e.name + " "); }))
+        << followed;
+  }
+}
+
 TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
   const Forbidden no({"mpc", "scripted"});
   const LearnContext c = recordings_context();

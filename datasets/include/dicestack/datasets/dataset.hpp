@@ -2,6 +2,7 @@
 // Demonstrations as matrices a regressor can fit: X (N x a feature map's width; the 24 state
 // numbers by default), Y (N x 3 actions), with episode boundaries, and the train/test splits of DESIGN.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -24,9 +25,14 @@ struct Dataset {
   std::size_t episodes() const { return episode_begin.size(); }
 };
 
+/// Which steps of an episode are rows: all when empty. The others are history only (DaD's
+/// corrections carry the rollout before them so that a map reads their whole episode).
+using RowFilter = std::function<bool(const Episode& episode, std::size_t step)>;
+
 /// Stacks the episodes in the given order; row t of an episode is `features` of its history up
-/// to step t. Throws InputError if an episode is malformed.
-Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features = state_features());
+/// to step t, for every t `rows` keeps. Throws InputError if an episode is malformed.
+Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features = state_features(),
+                     const RowFilter& rows = {});
 
 /// A train/test partition and how it was made (for reports).
 struct Split {

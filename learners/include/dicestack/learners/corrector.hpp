@@ -1,10 +1,11 @@
 #pragma once
 // DaD's corrector (paper eq. 11): from the world a policy drifted into, find the next w actions
-// whose simulated states follow the demonstration's next w states (all 24 numbers, as the paper)
-// or its cup path alone (issue 24: no cup motion brings bounced dice back onto their recorded
-// states). Any method of core/action_sequence.hpp: CMA-ES (ours), pagmo's differential
-// evolution, basin hopping, Bayesian optimisation; or "track": the tracker's feedback law
-// steering the cup back onto the recorded path, no search.
+// whose simulated states follow the demonstration's next w states (all 24 numbers, as the paper
+// wrote it; the dice and the cup's velocity, as the paper's code compared them) or its cup path
+// alone (no cup motion brings bounced dice back onto their recorded states). Any method of
+// core/action_sequence.hpp: CMA-ES (ours), pagmo's differential evolution, basin hopping,
+// Bayesian optimisation; or "track": the tracker's feedback law steering the cup back onto the
+// recorded path, no search.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -19,6 +20,7 @@ namespace dicestack {
 enum class CorrectionTarget {
   state,  ///< the demonstration's whole states (eq. 11 as the paper wrote it)
   cup,    ///< the demonstration's cup pose (x, y, angle) alone
+  dice,   ///< the dice' poses and velocities and the cup's velocity (state_distance: the paper's code)
 };
 
 /// One window to correct.
@@ -42,7 +44,7 @@ struct Correction {
   int evaluations = 0;          ///< window simulations spent
 };
 
-/// Squared scaled distance (all 24 dimensions, or the cup's 3 for CorrectionTarget::cup) summed
+/// Squared scaled distance (all 24 dimensions, the cup's 3 or state_distance's 21, by aim) summed
 /// over the window when `actions` are applied from `problem.start`; fills `states` (may be null)
 /// with the states before each action.
 double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
@@ -53,7 +55,8 @@ double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::ve
 class Corrector {
  public:
   virtual ~Corrector() = default;
-  /// `env` is scratch: its episode is overwritten. Never returns worse than the warm start.
+  /// `env` is scratch: its episode is overwritten. Never returns worse than the warm start
+  /// (unless CorrectorOptions::random_start).
   virtual Correction correct(DiceEnv& env, const CorrectionProblem& problem, std::uint64_t seed) const = 0;
 };
 
@@ -62,6 +65,11 @@ struct CorrectorOptions {
   double sigma0 = 0.25;  ///< initial spread in scaled action units
   int population = 0;    ///< 0: pycma's 4 + floor(3 ln n)
   double gain = 10.0;    ///< "track": feedback gain on the cup's pose, 1/s
+  int evaluations = 0;   ///< a budget of window simulations instead of `iterations` (0: iterations decide)
+  /// Start each search at a point drawn uniformly in [-1, 1]^n from its seed and keep its best
+  /// even where the policy's own actions score better (the paper's code); false: start at the
+  /// policy's actions and never return worse.
+  bool random_start = false;
 };
 
 /// The correctors' names: cmaes, de, basinhop, bayes, track.

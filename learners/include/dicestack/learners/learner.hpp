@@ -11,6 +11,7 @@
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/core/world_config.hpp>
+#include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/regressors/model.hpp>
 
@@ -92,7 +93,9 @@ struct LearnerInfo {
   std::function<std::unique_ptr<Learner>(std::string, Params)> factory;
   bool needs_trajectories = false;  ///< learns from whole episodes, so not from shuffled rows
   std::string default_features = "state";  ///< the feature map used when none is named (docs/learners.md)
-  bool state_features_only = false;        ///< reads no feature map but "state" (DaD's corrections are windows)
+  /// A leaderboard adds no map to its own (--features and the paper profile's extra maps skip it:
+  /// DaD's rows take minutes each).
+  bool own_features_only = false;
 };
 
 /// Learners by name ("bc", "dagger", "dad", "dart"); built-ins registered on first use.
@@ -130,7 +133,9 @@ std::string default_features(std::string_view learner, const std::vector<std::st
 /// Fits `context.regressor` on every step of `data`, each seen through `context.features`:
 /// behaviour cloning's one step. Collective over context.cluster: the root fits, the others
 /// receive its model file's bytes (so every rank acts with the very same model).
-std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed);
+/// `rows`: only the steps it keeps are rows (make_dataset).
+std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed,
+                                 const RowFilter& rows = {});
 
 /// The `perturb` option of the learners that record episodes (DART, DAgger): domain
 /// randomisation, each training episode in its own world drawn from its seed (LEVEL or FILE).
