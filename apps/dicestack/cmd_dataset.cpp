@@ -12,6 +12,7 @@
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/learning_curve.hpp>
 #include <dicestack/learners/results_page.hpp>
 #include <dicestack/learners/train.hpp>
 
@@ -35,6 +36,29 @@ struct ViewOptions {
   WorldOption world;
   std::filesystem::path set, out;
 };
+
+struct SubsetOptions {
+  WorldOption world;
+  std::filesystem::path set, out;
+  int recordings = 3;
+  std::uint64_t seed = 0;
+};
+
+// The recordings a learning curve's draw trains on, as a set of their own.
+int run_subset(const SubsetOptions& opt) {
+  check_demo_set_replaceable(opt.out);  // before any work
+  const auto folder = resolve_demo_set(opt.set, opt.world.load());
+  DemoSet set = read_demo_set(folder);
+  set.episodes = draw_recordings(set.episodes, opt.recordings, opt.seed);
+  std::string names;
+  for (const auto& e : set.episodes) names += (names.empty() ? "" : ", ") + e.name;
+  set.provenance = "dicestack dataset subset " + opt.set.string() + " --recordings " + std::to_string(opt.recordings) +
+                   " --seed " + std::to_string(opt.seed) + ": " + names + " of " + folder.string() +
+                   (set.provenance.empty() ? "" : "; that set: " + set.provenance);
+  write_demo_set(set, opt.out);
+  print_line("wrote " + std::to_string(set.episodes.size()) + " recordings to " + opt.out.string() + ": " + names);
+  return 0;
+}
 
 int run_view(const ViewOptions& opt) {
   const DemoSet set = read_demo_set(resolve_demo_set(opt.set, opt.world.load()));
@@ -207,6 +231,17 @@ void add_dataset_commands(CLI::App& app) {
   cmd->add_option("set", view->set, "Demonstration folder, builtin or human")->required();
   cmd->add_option("--out", view->out, "The page, PAGE.html; the episodes' data go to PAGE_files/ beside it")->required();
   cmd->callback([view] { run_view(*view); });
+  auto subset = std::make_shared<SubsetOptions>();
+  cmd = dataset->add_subcommand("subset",
+                                "A few recordings of a set drawn at random, as `leaderboard --recordings` draws them");
+  subset->world.add_to(*cmd);
+  cmd->add_option("set", subset->set, "Demonstration folder, builtin or human")->required();
+  cmd->add_option("--recordings", subset->recordings, "How many to draw (all of them: the whole set)")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  cmd->add_option("--seed", subset->seed, "Seed of the draw")->check(seed_check())->capture_default_str();
+  cmd->add_option("--out", subset->out, "The new set's folder")->required();
+  cmd->callback([subset] { run_subset(*subset); });
   add_interop_commands(*import, *dataset);
 }
 

@@ -5,7 +5,9 @@
 #include <iostream>
 
 #include <dicestack/learners/baseline.hpp>
+#include <dicestack/core/error.hpp>
 #include <dicestack/learners/leaderboard.hpp>
+#include <dicestack/learners/learning_curve.hpp>
 #include <dicestack/learners/profile.hpp>
 #include <dicestack/learners/train.hpp>
 
@@ -19,7 +21,37 @@ struct LeaderboardOptions {
   WorldOption world;
   DemosOption demos;
   LeaderboardRequest request;
+  std::vector<int> recordings;  // --recordings: a learning curve instead of the table
+  int draws = 3;
 };
+
+// `--recordings 1,3,10`: realistic success against the number of recordings (learning_curve.hpp).
+int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
+  for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb"})
+    if (cmd.count(unused) > 0) throw ConfigError(std::string("leaderboard --recordings draws a learning curve; ") + unused + " is for the table");
+  const LeaderboardRequest& t = opt.request;
+  if (t.format != "md" && t.format != "csv" && t.format != "json" && t.format != "html")
+    throw ConfigError("leaderboard --recordings: --format must be md, csv, json or html, got " + t.format);
+  if (!t.out.empty()) check_learning_curve_replaceable(t.out);
+  LearningCurveRequest r;
+  r.world = opt.world.load();
+  r.demos = opt.demos.resolve(r.world, cluster);
+  r.recordings = opt.recordings;
+  r.draws = opt.draws;
+  r.learners = t.learners;
+  r.regressors = t.regressors;
+  r.options = t.options;
+  r.episodes = t.episodes > 0 ? t.episodes : 100;
+  r.seed = t.seed;
+  r.threads = t.threads;
+  r.cluster = &cluster;
+  const LearningCurve curve = run_learning_curve(r, [](const std::string& text) { print_progress(text); });
+  if (!cluster.is_root()) return 0;
+  if (!t.out.empty()) write_learning_curve(curve, t.format, t.out);
+  std::cout << render_learning_curve(curve, t.out.empty() ? t.format : "md") << (t.out.empty() ? "" : "wrote " + t.out.string() + "\n")
+            << std::flush;
+  return 0;
+}
 
 int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
   LeaderboardRequest request = opt.request;
@@ -76,7 +108,7 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   auto opt = std::make_shared<LeaderboardOptions>();
   LeaderboardRequest& r = opt->request;
   CLI::App* cmd = app.add_subcommand("leaderboard", "Train every regressor under every learner and print Table I");
-  opt->world.add_to(*cmd);
+  opt->world.add_to(*cmd, true);
   opt->demos.add_to(*cmd);
   cmd->add_option("--regressors", r.regressors, "Regressors (comma-separated; default: all registered)")->delimiter(',');
   cmd->add_option("--learners", r.learners, "Learners (comma-separated; default: bc, dagger, dart)")->delimiter(',');
@@ -105,7 +137,19 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
                   "Roll out in perturbed worlds: none, easy, medium, hard or a perturbation file (docs/robustness.md); "
                   "training stays nominal")
       ->capture_default_str();
-  cmd->callback([opt, &cluster] { run_leaderboard(*opt, cluster); });
+  cmd->add_option("--recordings", opt->recordings,
+                  "Instead of the table, a learning curve: realistic success against the number of recordings each "
+                  "policy learns from (comma-separated numbers, e.g. 1,3,10,68; default learners dart:expert=tracker "
+                  "and dad, regressor gbt, 100 rollouts; formats md, csv, json, html with a plot)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--draws", opt->draws, "With --recordings: random draws of each number, seeds --seed, --seed + 1, ...")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->callback([opt, &cluster, cmd] {
+    if (opt->recordings.empty()) run_leaderboard(*opt, cluster);
+    else run_curve(*opt, *cmd, cluster);
+  });
 }
 
 }  // namespace dicestack::cli

@@ -21,7 +21,9 @@
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/hash.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/perturbation.hpp>
+#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/features.hpp>
 #include <dicestack/version.hpp>
 
@@ -152,6 +154,66 @@ TEST(CliLearning, TrainThenEvaluateEndToEnd) {
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["episodes"], 3);
   std::filesystem::remove(model);
+}
+
+TEST(CliLearning, PaperStartsAreNamedWhereTheyAreUsedAndAnotherNameIsRefused) {
+  const auto model = test::scratch_path("dicestack_cli_start.dsm");
+  const auto rollouts = test::scratch_path("dicestack_cli_start_rollouts");
+  std::filesystem::remove_all(rollouts);
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --split none --out " + model.string()).status, 0);
+  Process e = run("evaluate --model " + model.string() + " --episodes 2 --start paper --json --save-rollouts " +
+                  rollouts.string());
+  ASSERT_EQ(e.status, 0) << e.output;
+  EXPECT_EQ(nlohmann::json::parse(e.output)["start"], "paper");
+  const DemoSet set = read_demo_set(rollouts);
+  EXPECT_EQ(start_distribution_name(set.world), "paper");
+  EXPECT_THAT(set.provenance, HasSubstr("--start paper"));
+  const State home = paper_start_state(set.world);
+  for (const auto& ep : set.episodes) EXPECT_NEAR(ep.states[0][1], home[1], 1e-6);  // at the paper's height
+  e = run("evaluate --model " + model.string() + " --episodes 2");
+  EXPECT_THAT(e.output, Not(HasSubstr("paper")));
+  EXPECT_FALSE(nlohmann::json::parse(run("evaluate --model " + model.string() + " --episodes 2 --json").output).contains("start"));
+  for (const std::string& cmd : {"evaluate --model " + model.string(), "record --expert scripted --episodes 1 --out " +
+                                                                         rollouts.string() + "x"}) {
+    const Process bad = run(cmd + " --start papers");
+    EXPECT_NE(bad.status, 0) << cmd;
+    EXPECT_THAT(bad.output, HasSubstr("--start")) << cmd;
+  }
+  std::filesystem::remove(model);
+  std::filesystem::remove_all(rollouts);
+}
+
+TEST(CliLearning, LeaderboardRecordingsDrawsALearningCurveFromTheDrawsDatasetSubsetWrites) {
+  const auto out = test::scratch_path("dicestack_cli_curve.csv");
+  const auto subset = test::scratch_path("dicestack_cli_subset");
+  std::filesystem::remove(out);
+  std::filesystem::remove_all(subset);
+  Process p = run("leaderboard --recordings 1 --draws 2 --seed 4 --learners bc --regressors knn --episodes 2 --demos " + kTinyDemos +
+                  " --format csv --out " + out.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("| bc | knn | 1 | 2 |"));  // the summary, printed as md
+  std::ifstream in(out);
+  std::string header, first;
+  std::getline(in, header);
+  std::getline(in, first);
+  EXPECT_EQ(header.rfind("learner,regressor,recordings,draw_seed", 0), 0u);
+  EXPECT_EQ(first.rfind("bc,knn,1,4,2,", 0), 0u) << first;
+  p = run("dataset subset " + kTinyDemos + " --recordings 1 --seed 4 --out " + subset.string());
+  ASSERT_EQ(p.status, 0) << p.output;
+  const DemoSet drawn = read_demo_set(subset);
+  ASSERT_EQ(drawn.episodes.size(), 1u);
+  // The curve's draw 4 is the recording the subset of seed 4 holds.
+  const std::size_t quote = first.find('"');
+  ASSERT_NE(quote, std::string::npos) << first;
+  const std::string name = first.substr(quote + 1, first.find('"', quote + 1) - quote - 1);
+  EXPECT_THAT(drawn.provenance, HasSubstr("--recordings 1 --seed 4: " + name + " of "));
+  p = run("leaderboard --recordings 1 --baselines cmaes --demos " + kTinyDemos);
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("--baselines is for the table"));
+  p = run("leaderboard --recordings 0 --demos " + kTinyDemos);
+  EXPECT_NE(p.status, 0);
+  std::filesystem::remove(out);
+  std::filesystem::remove_all(subset);
 }
 
 TEST(CliLearning, WithoutATestEpisodeEveryCommandReportsNoTestErrorRatherThanZero) {
@@ -377,7 +439,8 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("unknown feature map \"state+tomorrow\""));
   std::filesystem::remove(model);
-  // A row per learner and map it can read; DaD reads only the state, so its state+clock row is skipped.
+  // A row per learner and map; DaD keeps to its own map in a table (its rows take minutes), so its
+  // state+clock row is skipped.
   p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr --learners bc,dad --features state,state+clock "
           "--option windows=1 --option iterations=1 --option corrector_iterations=2 --episodes 2 --format json", false);
   ASSERT_EQ(p.status, 0) << p.output;
