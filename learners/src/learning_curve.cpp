@@ -23,12 +23,12 @@ namespace {
 
 using json = nlohmann::json;
 
-constexpr std::uint64_t kDrawStream = 0x647261770000ULL;  // "draw": apart from training and evaluation starts
-constexpr const char* kMarker = "<!-- dicestack learning curve -->";
-constexpr const char* kCsvHeader =
+constexpr std::uint64_t kCurveDrawStream = 0x647261770000ULL;  // "draw": apart from training and evaluation starts
+constexpr const char* kCurveMarker = "<!-- dicestack learning curve -->";
+constexpr const char* kCurveCsvHeader =
     "learner,regressor,recordings,draw_seed,episodes,realistic_success,realistic_success_low,realistic_success_high,"
     "wall_contact,dice_in_cup_mean,train_seconds,recordings_drawn,followed";
-constexpr const char* kJsonFormat = "dicestack-learning-curve";
+constexpr const char* kCurveJsonFormat = "dicestack-learning-curve";
 
 std::string percent(double v) {
   char out[16];
@@ -85,7 +85,7 @@ std::string draw_names(const LearningCurvePoint& p) {
 
 std::string render_md(const LearningCurve& c) {
   std::ostringstream os;
-  os << kMarker << "\n" << c.header << "\n\n";
+  os << kCurveMarker << "\n" << c.header << "\n\n";
   os << "| learner | regressor | recordings | draws | realistic success (mean) | lowest | highest | wall contact (mean) |\n"
         "|---|---|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& s : summarise(c))
@@ -113,7 +113,7 @@ std::string csv_field(const std::string& s) {
 std::string render_csv(const LearningCurve& c) {
   std::ostringstream os;
   os.precision(6);
-  os << kCsvHeader << "\n";
+  os << kCurveCsvHeader << "\n";
   for (const auto& p : c.points)
     os << p.learner << ',' << p.regressor << ',' << p.recordings << ',' << p.draw_seed << ',' << p.episodes << ','
        << p.success.value << ',' << p.success.low << ',' << p.success.high << ',' << p.walls.value << ',' << p.dice_in_cup
@@ -129,7 +129,7 @@ json to_json(const LearningCurve& c) {
                       {"realistic_success", p.success.value}, {"realistic_success_ci95", {p.success.value, p.success.low, p.success.high}},
                       {"wall_contact", p.walls.value}, {"dice_in_cup_mean", p.dice_in_cup},
                       {"train_seconds", p.train_seconds}, {"followed", p.followed}});
-  return {{"format", kJsonFormat}, {"version", 1}, {"dicestack_version", DICESTACK_VERSION}, {"header", c.header}, {"points", points}};
+  return {{"format", kCurveJsonFormat}, {"version", 1}, {"dicestack_version", DICESTACK_VERSION}, {"header", c.header}, {"points", points}};
 }
 
 std::string escape_html(const std::string& s) {
@@ -194,7 +194,7 @@ std::string svg_plot(const LearningCurve& c) {
 
 std::string render_html(const LearningCurve& c) {
   std::ostringstream os;
-  os << "<!DOCTYPE html>" << kMarker << "\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>dicestack learning curve</title>\n"
+  os << "<!DOCTYPE html>" << kCurveMarker << "\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>dicestack learning curve</title>\n"
      << "<style>body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;max-width:60em}table{border-collapse:collapse;margin:1em 0}"
         "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}td:first-child,th:first-child{text-align:left}"
         "svg{max-width:100%;height:auto}</style></head><body>\n<h1>Realistic success against recordings</h1>\n<p>"
@@ -218,8 +218,8 @@ std::string render_html(const LearningCurve& c) {
 // The first line of each format: the marker (md, html), the header (csv), the JSON object.
 Ownership curve_ownership() {
   const Ownership lines = Ownership::first_line(
-      "dicestack learning curve", {kMarker, std::string("<!DOCTYPE html>") + kMarker, kCsvHeader});
-  const Ownership object = Ownership::json_first_line("dicestack learning curve", kJsonFormat);
+      "dicestack learning curve", {kCurveMarker, std::string("<!DOCTYPE html>") + kCurveMarker, kCurveCsvHeader});
+  const Ownership object = Ownership::json_first_line("dicestack learning curve", kCurveJsonFormat);
   return {"dicestack learning curve",
           [lines, object](const std::filesystem::path& p) { return lines.recognises(p) || object.recognises(p); }};
 }
@@ -231,7 +231,7 @@ std::vector<Episode> draw_recordings(const std::vector<Episode>& episodes, int k
   if (static_cast<std::size_t>(k) >= episodes.size()) return episodes;
   std::vector<std::size_t> index(episodes.size());
   for (std::size_t i = 0; i < index.size(); ++i) index[i] = i;
-  Rng rng(derive_seed(seed, kDrawStream));
+  Rng rng(derive_seed(seed, kCurveDrawStream));
   for (std::size_t i = 0; i < static_cast<std::size_t>(k); ++i) std::swap(index[i], index[i + rng.below(index.size() - i)]);
   index.resize(static_cast<std::size_t>(k));
   std::sort(index.begin(), index.end());
