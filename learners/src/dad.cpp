@@ -31,10 +31,33 @@ struct CodeParts {
   bool schedule = false;    // growing prefixes of each recording, several refits each; the last refit kept
   bool search = false;      // CMA-ES from a random point, wide, to a budget of evaluations; its best always kept
   bool duplicates = false;  // every refit appends every correction so far again
-  bool any() const { return start || label || cost || schedule || search || duplicates; }
+  bool units = false;       // its units: the policy's actions applied 100, 10, 0.5 times over, labels the optimiser's x
+  bool any() const { return start || label || cost || schedule || search || duplicates || units; }
 };
 
-constexpr const char* kCodePartNames[] = {"start", "label", "cost", "schedule", "search", "duplicates"};
+constexpr const char* kCodePartNames[] = {"start", "label", "cost", "schedule", "search", "duplicates", "units"};
+
+// The paper's code applied the policy's output (in the recordings' units) times the optimiser's
+// scale again, and stored the optimiser's x (action / scale, unitless) beside the recordings'
+// actions: in SI, rollouts run actions 100, 10 and 0.5 times the policy's, and corrections are
+// labelled 0.01, 0.1 and 2 times the actions they found.
+constexpr Action kCodeRolloutUnits{100.0, 10.0, 0.5}, kCodeLabelUnits{0.01, 0.1, 2.0};
+
+Action scaled(Action a, const Action& by) {
+  for (std::size_t k = 0; k < kActionDim; ++k) a[k] *= by[k];
+  return a;
+}
+
+// A policy acting with the paper's code's units.
+class CodeUnitsPolicy final : public Policy {
+ public:
+  explicit CodeUnitsPolicy(std::shared_ptr<const Model> model) : inner_(std::move(model)) {}
+  Action act(const History& history) override { return scaled(inner_.act(history), kCodeRolloutUnits); }
+  std::string name() const override { return inner_.name() + " in the paper's code's units"; }
+
+ private:
+  ModelPolicy inner_;
+};
 
 // The code's constants: 10 prefixes x 5 sub-iterations; CMA-ES sigma0 0.8, maxfevals 5000.
 constexpr int kCodeWindows = 10, kCodeRefits = 5, kCodeEvaluations = 5000;
@@ -43,15 +66,15 @@ constexpr double kCodeSigma0 = 0.8;
 CodeParts code_parts(const std::string& text) {
   CodeParts p;
   if (text == "false") return p;
-  if (text == "true") return {true, true, true, true, true, true};
-  bool* fields[] = {&p.start, &p.label, &p.cost, &p.schedule, &p.search, &p.duplicates};
+  if (text == "true") return {true, true, true, true, true, true, true};
+  bool* fields[] = {&p.start, &p.label, &p.cost, &p.schedule, &p.search, &p.duplicates, &p.units};
   for (std::size_t from = 0; from <= text.size();) {
     const std::size_t plus = std::min(text.find('+', from), text.size());
     const std::string part = text.substr(from, plus - from);
     const auto* it = std::find(std::begin(kCodePartNames), std::end(kCodePartNames), part);
     if (it == std::end(kCodePartNames))
       throw ConfigError("dad: parameter \"faithful\": unknown part \"" + part.substr(0, 40) + (part.size() > 40 ? "...\"" : "\"") +
-                        "; expected true, false, or parts joined by '+': start, label, cost, schedule, search, duplicates");
+                        "; expected true, false, or parts joined by '+': start, label, cost, schedule, search, duplicates, units");
     *fields[it - std::begin(kCodePartNames)] = true;
     from = plus + 1;
   }
@@ -186,8 +209,9 @@ class Dad final : public Learner {
           },
           pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
 
+      std::vector<Episode> made;
       if (plan.code.label) {
-        for (auto& e : step_corrections(tasks, fixes, targets, k)) data.push_back(std::move(e));
+        made = step_corrections(tasks, fixes, targets, k);
         corrections += tasks.size();
       } else {
         for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -195,10 +219,16 @@ class Dad final : public Learner {
             ++filtered;
             continue;
           }
-          data.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
+          made.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
                                     with_history ? &rollouts[tasks[i].demo] : nullptr));
           ++corrections;
         }
+      }
+      for (auto& e : made) {
+        if (plan.code.units)
+          for (std::size_t t = 0; t < e.size(); ++t)
+            if (e.sources[t] == StepSource::correction) e.actions[t] = scaled(e.actions[t], kCodeLabelUnits);
+        data.push_back(std::move(e));
       }
       report("fit", 0, 1);
       const std::vector<Episode> fitted = fit_data(data, plan, k);
@@ -270,7 +300,8 @@ class Dad final : public Learner {
              "true: run DaD as the paper's code does; or some of its parts joined by '+': start (one fixed start), label "
              "(one step at every step, to the recording's next state), cost (the dice and the cup's velocity), schedule "
              "(10 growing prefixes x 5 refits, the last kept), search (CMA-ES from a random point, sigma0 0.8, 5000 "
-             "evaluations), duplicates (every refit appends every correction again)", {}}};
+             "evaluations), duplicates (every refit appends every correction again), units (its units: rollouts act 100, "
+             "10, 0.5 times the policy's actions, corrections are labelled 0.01, 0.1, 2 times theirs)", {}}};
     for (auto& p : tracker_param_specs()) out.push_back(std::move(p));
     return out;
   }
@@ -398,7 +429,10 @@ class Dad final : public Learner {
         }
         per_demo[d].push_back(std::move(task));
       };
-      ModelPolicy policy(std::shared_ptr<const Model>(&model, [](const Model*) {}));  // borrowed for this rollout
+      const std::shared_ptr<const Model> borrowed(&model, [](const Model*) {});  // for this rollout
+      ModelPolicy own(borrowed);
+      CodeUnitsPolicy code(borrowed);
+      Policy& policy = plan.code.units ? static_cast<Policy&>(code) : own;
       const State& start = fixed_start ? *fixed_start : demo.states[0];
       rollouts[d] = rollout(env, policy, start, demo.seed, StepSource::policy, options);
       const std::vector<Action>& actions = rollouts[d].actions;

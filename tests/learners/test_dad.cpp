@@ -170,7 +170,7 @@ TEST(Dad, FaithfulIsTrueFalseOrPartsOfThePapersCodeAndAnythingElseIsRefusedByPar
   const std::string error =
       test::error_of([] { LearnerRegistry::global().create("dad", {"faithful=start+labels"}); });
   EXPECT_THAT(error, ::testing::HasSubstr("unknown part \"labels\""));
-  EXPECT_THAT(error, ::testing::HasSubstr("start, label, cost, schedule, search, duplicates"));
+  EXPECT_THAT(error, ::testing::HasSubstr("start, label, cost, schedule, search, duplicates, units"));
   EXPECT_THROW(LearnerRegistry::global().create("dad", {"faithful=start+"}), ConfigError);
   EXPECT_THAT(test::error_of([] { LearnerRegistry::global().create("dad", {"faithful=" + std::string(5000, 'x')}); }).size(),
               ::testing::Lt(400u));  // a long value is not echoed whole
@@ -234,6 +234,26 @@ TEST(Dad, AWindowCarriesTheRolloutBeforeItAsHistoryForAMapThatReadsTheEpisode) {
     EXPECT_TRUE(std::any_of(demos().begin(), demos().end(), from_target)) << e.origin;
   }
   EXPECT_GE(windows, 2u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Dad, TheCodesUnitsLabelACorrectionWithTheOptimisersVariableInTheRecordingsUnits) {
+  const auto dir = test::scratch_path("dicestack_dad_units");
+  std::filesystem::remove_all(dir);
+  LearnContext c = dad_context(1);
+  c.checkpoint_dir = dir;
+  LearnerRegistry::global()
+      .create("dad", {"windows=1", "iterations=1", "corrector_iterations=2", "demos=1", "filter=false", "faithful=units"})
+      ->learn(c);
+  const DemoSet data = read_demo_set(dir / "data-1");
+  ASSERT_EQ(data.episodes.size(), 2u);  // the target, then its one window
+  const Episode& fix = data.episodes[1];
+  // Undone, the label is the action the corrector found: replayed, it gives the window's next state.
+  DiceEnv env(c.world);
+  env.reset_to(fix.states[0], fix.seed);
+  const Action found{fix.actions[0][0] / 0.01, fix.actions[0][1] / 0.1, fix.actions[0][2] / 2.0};
+  env.step(found);
+  for (std::size_t k = 0; k < kStateDim; ++k) EXPECT_NEAR(env.get_state()[k], fix.states[1][k], 1e-5) << k;
   std::filesystem::remove_all(dir);
 }
 
