@@ -9,6 +9,9 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/rng.hpp>
+#include <dicestack/datasets/dataset.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/train.hpp>
 
 namespace dicestack {
 namespace {
@@ -82,6 +85,8 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_paths", ParamType::integer, std::to_string(d.keep), -1, 1000000,
            "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all; "
            "-1: 1 with a /position map, else 3)", {}},
+          {"tracker_demos", ParamType::text, "same", 0, 0,
+           "tracker: follow the training episodes of this set (builtin, human or a folder; same: the run's --demos)", {}},
           {"tracker_recordings", ParamType::integer, "0", 0, 1000000,
            "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}},
           {"tracker_smooth", ParamType::real, number_text(d.smooth), 0, 1000,
@@ -137,8 +142,6 @@ int tracker_paths_for(int paths, const std::string& features) {
 ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
   ExpertConfig config;
   if (name == "tracker") {
-    if (c.demos.empty())
-      throw InputError("expert tracker: no demonstrations to follow (give a set with --demos)");
     TrackerConfig tracker;
     tracker.probes = static_cast<int>(params.integer("tracker_probes"));
     tracker.optimise = params.boolean("tracker_optimise");
@@ -154,7 +157,12 @@ ExpertConfig learner_expert_config(const std::string& name, const Params& params
     tracker.smooth_variants.clear();
     if (params.boolean("tracker_variants")) tracker.smooth_variants.assign(kVariantWidths.begin(), kVariantWidths.end());
     tracker.finalist_probes = 4 * tracker.probes;
-    const auto followed = pick_recordings(c.demos, static_cast<int>(params.integer("tracker_recordings")),
+    // Another set's training episodes (the episode split's), as --demos would give them.
+    const std::string& other = params.choice("tracker_demos");
+    const std::vector<Episode> own =
+        other == "same" ? c.demos : DemoSplit(read_demo_set(resolve_demo_set(other, c.world)).episodes, "episodes").train();
+    if (own.empty()) throw InputError("expert tracker: no demonstrations to follow (give a set with --demos)");
+    const auto followed = pick_recordings(own, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
     config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);
   }

@@ -11,10 +11,11 @@ std::vector<Profile> make_profiles() {
   quick.rollouts = 20;
   // The tracker's gbt row with dart's own defaults (1200 episodes: 66 s of the main job).
   quick.learner_options = {{"dagger", {"iterations=2", "rollouts=10"}},
-                           {"dad", {"windows=2", "iterations=1", "corrector_iterations=10"}}};
+                           {"dad", {"windows=2", "iterations=1", "corrector_iterations=10"}},
+                           {"dart:expert=tracker", {"tracker_demos=human"}}};
   // A kernel SVR fitted on DART's ~60,000 rows alone would take longer than the rest (its rows are O(n^2)).
-  // Learning from the recordings alone: DART labelled by the tracker, which follows the set's own
-  // cup paths (no hand-made expert). One regressor keeps the main job within its minutes.
+  // Learning from the recordings alone: DART labelled by the tracker, which follows the paper's
+  // human recordings' cup paths (no hand-made expert). One regressor keeps the main job within its minutes.
   quick.learners = {"bc", "dagger", "dart", "dart:expert=tracker"};
   quick.left_out = {{"dart", "rbf_svr"}};
   for (const char* r : {"knn", "linear_svr", "mlp", "random_forest"}) quick.left_out.emplace_back("dart:expert=tracker", r);

@@ -24,6 +24,7 @@ namespace dicestack {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 namespace fs = std::filesystem;
 
 // Six of the paper's human recordings (made in Chipmunk, imported once into the cache).
@@ -106,6 +107,30 @@ TEST(HonestLearning, DadAndDartFromThreeRecordingsBuildNoHandMadeExpertAndNameTh
     EXPECT_TRUE(std::any_of(c.demos.begin(), c.demos.end(), [&](const Episode& e) { return followed.starts_with(e.name + " "); }))
         << followed;
   }
+}
+
+TEST(HonestLearning, TheTrackerFollowsAnotherSetsTrainingEpisodesWhenToldTo) {
+  const auto dir = test::scratch_path("dicestack_tracker_demos");
+  fs::remove_all(dir);
+  DemoSet set;
+  set.world = WorldConfig{};
+  set.episodes = human_six();
+  write_demo_set(set, dir);
+  LearnContext c = recordings_context();
+  c.demos.clear();  // the run's own set holds nothing the tracker could follow
+  const std::vector<std::string> options{"expert=tracker", "episodes=2", "successes_only=false", "tracker_probes=1",
+                                         "tracker_optimise=false", "tracker_variants=false"};
+  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", options)->learn(c); }),
+              HasSubstr("no demonstrations to follow"));
+  std::vector<std::string> other = options;
+  other.push_back("tracker_demos=" + dir.string());
+  const auto learned = LearnerRegistry::global().create("dart", other)->learn(c);
+  // Its training episodes: five of the six (episode 4 is the split's test episode).
+  EXPECT_THAT(learned.model->record.at("tracker_followed"), HasSubstr("probe trials"));
+  EXPECT_THAT(learned.model->record.at("tracker_followed"), Not(HasSubstr("episode_0004")));
+  other.back() = "tracker_demos=" + (dir / "missing").string();
+  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", other)->learn(c); }), HasSubstr("missing"));
+  fs::remove_all(dir);
 }
 
 TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
