@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""knn at any width (issue 27): predict_row of knn's two exact searches side by side, on dart's
+"""knn at any width: predict_row of knn's two exact searches side by side, on dart's
 49-input map and on the 24 state numbers, timed on held-out states and on a policy's own
 rollouts (which stray far from every training row). Prints the median over RUNS runs of
 `dicestack bench regressors` (each itself the median of batches of 50 calls).

@@ -1,4 +1,4 @@
-// Results pages at scale (issue 26): writes a leaderboard page of ROWS rows (default 40), each with
+// Results pages at scale: writes a leaderboard page of ROWS rows (default 40), each with
 // 100 rollouts' results and two previews (a built-in demonstration that stacks, and a rollout
 // of the zero action), and prints the time to write it, the page's size and the media's.
 // bench/pages_bench.py then loads it in headless Chromium and measures the first render.

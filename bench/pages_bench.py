@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Time to first render of results pages and episode viewers in headless Chromium (issue 26):
+"""Time to first render of results pages and episode viewers in headless Chromium:
 loads each page RUNS times from file:// and prints the median of the first contentful paint and
 of the moment the page's script has built it (body[data-ready]), with the page's size without media.
 

@@ -1,4 +1,4 @@
-"""Steps per second from Python beside the C++ simulator (issue 15's aims: DiceStackEnv.step from
+"""Steps per second from Python beside the C++ simulator (the targets: DiceStackEnv.step from
 Python >= 50 % of C++ on one thread; DiceStackVectorEnv >= 90 % of C++ on 2 threads).
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python_bench.py [--exe build/apps/dicestack]

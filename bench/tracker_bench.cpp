@@ -1,4 +1,4 @@
-// Measures the tracker, the demonstrator made of demonstrations (issue 24; docs/learners.md):
+// Measures the tracker, the demonstrator made of demonstrations (docs/learners.md):
 // realistic success, wall contact, which recordings it chose and how many simulations its
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]

@@ -1,5 +1,5 @@
 // `dicestack robustness`: a model's or an expert's realistic success in perturbed worlds, factor
-// by factor and level by level (issue 25; docs/robustness.md). The work is the library's
+// by factor and level by level (docs/robustness.md). The work is the library's
 // (learners/robustness.hpp): this parses, calls it and prints.
 #include <iostream>
 #include <memory>

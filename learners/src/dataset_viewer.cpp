@@ -1,4 +1,4 @@
-// The episode viewer (`dicestack dataset view`, issue 26): results_page.hpp says what it holds.
+// The episode viewer (`dicestack dataset view`): results_page.hpp says what it holds.
 #include <cmath>
 #include <cstdio>
 

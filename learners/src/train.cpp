@@ -17,7 +17,7 @@ std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const 
 
 TrainReport train_model(const TrainRequest& request) {
   const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
-  // An unknown regressor or a bad --set value (issue 27: it used to surface only at the first fit,
+  // An unknown regressor or a bad --set value (it used to surface only at the first fit,
   // after DART had recorded its episodes) fails here, before any work.
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(

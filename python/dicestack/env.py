@@ -74,7 +74,7 @@ class DiceStackEnv(_EnvBase):
     every start from the paper's instead (its pose at rest, the whole scene shifted in x by
     U(-2 cm, 2 cm)), as `dicestack evaluate --start paper`.
 
-    perturb (issue 25; docs/robustness.md): None, a level ("easy", "medium", "hard"), a
+    perturb (docs/robustness.md): None, a level ("easy", "medium", "hard"), a
     perturbation file or a dict of its fields. Each episode then runs in the world drawn from its
     seed (frictions, masses, gravity, wider starts), its observations arrive late and noisy and
     its actions late, biased and noisy, exactly as `dicestack evaluate --perturb` runs it.

@@ -31,7 +31,7 @@ class EpisodeSeeds {
 };
 
 /// A DiceEnv with its seed stream and what the Python info dict reports. Under a perturbation
-/// (issue 25) each episode runs in the world drawn from its seed, and observations and actions
+/// each episode runs in the world drawn from its seed, and observations and actions
 /// pass through the draw's PerturbedChannel, as in rollout(): the same episodes as C++.
 class EnvCore {
  public:

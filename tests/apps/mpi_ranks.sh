@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Same seed, same result, on any number of MPI ranks (issue 17): one subcommand run alone and
+# Same seed, same result, on any number of MPI ranks: one subcommand run alone and
 # under mpirun -np 2 and -np 3 (with 1 and 2 threads per rank), outputs compared byte for byte
 # (timing fields removed from JSON). `failure` checks that a rank that fails or dies ends the
 # whole run quickly with a clear message.

@@ -578,7 +578,7 @@ TEST(CliRender, VideoFramesAndPlotOfARecordedEpisode) {
 namespace dicestack {
 namespace {
 
-// Issue 18: outputs replace only what dicestack wrote.
+// Outputs replace only what dicestack wrote: a user's file or folder at --out is refused and left as it was.
 std::filesystem::path user_folder(const std::string& name) {
   const auto root = std::filesystem::temp_directory_path() / ("dicestack_cli_safe_" + name + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(root);

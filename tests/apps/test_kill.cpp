@@ -1,4 +1,4 @@
-// kill -9 at several points of every writer (issue 27): each writer of the `dicestack` tool is run
+// kill -9 at several points of every writer: each writer of the `dicestack` tool is run
 // over an output an earlier run made, and killed 0.05 s and 0.2 s after it starts, when its first
 // scratch file or folder appears, and just before each commit to that output (the test-only
 // library stop_at_commit.cpp stops the process there, so the kill does not race the rename).

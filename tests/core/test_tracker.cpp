@@ -1,4 +1,4 @@
-// The tracker (issue 24): recorded cup paths followed by feedback on the cup, chosen by
+// The tracker: recorded cup paths followed by feedback on the cup, chosen by
 // simulation; and the expert registry it is built through.
 #include <gtest/gtest.h>
 

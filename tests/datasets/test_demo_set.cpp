@@ -289,7 +289,7 @@ TEST(DemoSetBadInput, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
   const fs::path dir = unique_dir("unreadable");
   fs::copy(kData / "good", dir / "set");
   const fs::path episode = dir / "set" / "episode_0001.csv";
-  // The episode file without read permission (issue 27: "cannot open" said nothing more).
+  // The episode file without read permission: the error says why, not a bare "cannot open".
   fs::permissions(episode, fs::perms::none);
   const auto denied = test::unprivileged([&] { return test::error_of([&] { read_demo_set(dir / "set"); }); });
   fs::permissions(episode, fs::perms::owner_read | fs::perms::owner_write);

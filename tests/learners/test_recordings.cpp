@@ -1,4 +1,4 @@
-// Learning from recordings alone (issue 24): the tracker as the expert of DART and DAgger, with
+// Learning from recordings alone: the tracker as the expert of DART and DAgger, with
 // the hand-made experts impossible to build, and a model that then acts on its own.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

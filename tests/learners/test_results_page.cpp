@@ -1,5 +1,5 @@
 // The leaderboard's formats as one table, the html page's files, and the robustness table's
-// page (issue 26). The pages in a browser: tests/python/test_pages.py.
+// page. The pages in a browser: tests/python/test_pages.py.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-"""The pages only the command line made before (issue 26), from Python: dicestack.view_dataset
+"""The pages only the command line made before, from Python: dicestack.view_dataset
 (`dicestack dataset view`) and evaluate(report=...) (`dicestack evaluate --report`). Both go
 through the same C++ functions as the command line, so they write the same files and refuse the
 same things with the same messages. The pages in a browser: test_pages.py."""

@@ -1,4 +1,4 @@
-"""Results pages (issue 26) loaded in headless Chromium as a person would open them, from
+"""Results pages loaded in headless Chromium as a person would open them, from
 file:// with no network: the rows shown are the rows of the JSON, sorting works, a preview
 loads, text from the demonstrations and models shows as text, and the console has no errors.
 Pages: the leaderboard's, evaluate --report's, the episode viewer and the robustness table's.

@@ -1,4 +1,4 @@
-"""Perturbed worlds from Python (issue 25): DiceStackEnv(perturb=...), the reset option, the
+"""Perturbed worlds from Python: DiceStackEnv(perturb=...), the reset option, the
 vector env's per-environment draws, evaluate(perturb=...), and bad perturbations refused."""
 import json
 

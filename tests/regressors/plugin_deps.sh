@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A regressor plugin links only the regressor interface and the foundation (issue 14): loading
+# A regressor plugin links only the regressor interface and the foundation: loading
 # it must not load the simulator, the optimisers, OpenCV or xgboost. Fails if `ldd` of any
 # library given lists Box2D, pagmo, NLopt, OpenCV or xgboost, or cannot resolve a dependency.
 # Used by CTest on the in-tree example plugin and by plugin_sdk.sh on the out-of-tree one.

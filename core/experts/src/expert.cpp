@@ -22,7 +22,7 @@ namespace si = state_index;
 using detail::SwingPlan;
 
 // The simulator an expert plans in: a world like `env`'s, made again when an episode brings
-// another (a perturbed world, issue 25), so a plan never depends on which episode came first.
+// another (a perturbed world), so a plan never depends on which episode came first.
 DiceEnv& planning_sim(std::optional<DiceEnv>& sim, const DiceEnv& env) {
   if (!sim || sim->config() != env.config()) sim.emplace(env.config());
   return *sim;

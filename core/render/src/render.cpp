@@ -118,7 +118,7 @@ void write_png(const Image& image, const std::filesystem::path& path) {
   } catch (const cv::Exception& e) {
     throw InputError(path.string() + ": PNG encoding failed: " + e.what());
   }
-  AtomicFile file(path, Ownership::unchecked("PNG image"));  // rendered images are not guarded (issue 18)
+  AtomicFile file(path, Ownership::unchecked("PNG image"));  // rendered images are deliberately not guarded
   file.stream().write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   file.commit();
 }

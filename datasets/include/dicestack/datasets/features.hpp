@@ -23,7 +23,7 @@ struct History {
   /// world applied; in training rows (make_dataset) the recorded labels, which differ under DART
   /// noise and DAgger: no built-in map reads them for that reason.
   std::span<const Action> actions;
-  /// Under an action delay (issue 25), what was chosen earlier and runs before the action chosen
+  /// Under an action delay, what was chosen earlier and runs before the action chosen
   /// now, in the order it runs (zeros for the steps before the first choice lands); empty
   /// without a delay. An expert simulates through it to the state its action lands in.
   std::span<const Action> pending = {};

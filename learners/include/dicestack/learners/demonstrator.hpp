@@ -1,5 +1,5 @@
 #pragma once
-// The demonstrator made of demonstrations (issue 24): a demonstration set turned into the
+// The demonstrator made of demonstrations: a demonstration set turned into the
 // tracker expert's Recordings (core/tracker.hpp), for record, DART, DAgger, the leaderboard and
 // Python.
 #include <cstdint>

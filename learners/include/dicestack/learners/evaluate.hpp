@@ -1,5 +1,5 @@
 #pragma once
-// Rolling policies out and measuring what they achieve (DESIGN "evaluate", issue 7).
+// Rolling policies out and measuring what they achieve (DESIGN "evaluate").
 #include <functional>
 #include <memory>
 #include <optional>
@@ -31,7 +31,7 @@ struct RolloutOptions {
   /// Called before each step's action is chosen, with the environment and the step index
   /// (DaD snapshots the world there). May be empty.
   std::function<void(const DiceEnv&, std::size_t)> before_step;
-  /// Actuation and sensing of a perturbed world (issue 25), or null: the policy sees each state
+  /// Actuation and sensing of a perturbed world, or null: the policy sees each state
   /// with the draw's observation noise and delay; what it chooses runs action_delay steps late,
   /// plus the bias and per-step noise. The episode records the true states. The draw's physics
   /// is the environment's own (made from draw.world).

@@ -36,7 +36,7 @@ struct LeaderboardRequest {
   int seeds = 1;                  ///< training seeds per row, >= 1
   std::uint64_t seed = 0;         ///< the first training seed, and the seed of the rollouts' starts
   int threads = 0;                ///< 0 = all cores; results do not depend on it
-  /// The rollouts' worlds (issue 25): "none" (the nominal world: today's table byte for byte),
+  /// The rollouts' worlds: "none" (the nominal world: today's table byte for byte),
   /// a level or a perturbation file; training stays nominal (learners take perturb= for that).
   std::string perturb = "none";
   /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
@@ -46,7 +46,7 @@ struct LeaderboardRequest {
   /// The table's format at `out`: a name of leaderboard_formats() (md, csv, latex, json, html).
   /// html also keeps one successful and one failed rollout of each row for its previews.
   std::string format = "md";
-  /// The ranks that share the run (issue 17, docs/scaling.md). Every rank calls run_leaderboard
+  /// The ranks that share the run (docs/scaling.md). Every rank calls run_leaderboard
   /// with the same request; each training seed of a row (and each baseline) is trained and
   /// rolled out whole on one rank (dealt by estimated_row_cost, longest first), the root writes
   /// <out>.partial.json as rows complete, and every rank returns the same table, identical to a

@@ -58,7 +58,7 @@ struct LearnContext {
   std::function<void(const Progress&)> progress;  ///< may be empty
   std::filesystem::path checkpoint_dir;      ///< empty: no checkpoints
   bool resume = false;                       ///< continue from checkpoint_dir's last iteration
-  /// The ranks that share the work (issue 17): rollouts and corrections are dealt among them,
+  /// The ranks that share the work: rollouts and corrections are dealt among them,
   /// the root refits and broadcasts the model, only the root writes checkpoints. Every rank runs
   /// learn() with the same context; the result is the same on each and for any number of ranks.
   Cluster* cluster = &local_cluster();

@@ -1,5 +1,5 @@
 #pragma once
-// Results pages (issue 26): a leaderboard (or one model's evaluation) as one self-contained HTML
+// Results pages: a leaderboard (or one model's evaluation) as one self-contained HTML
 // page that works from file:// with no network, and its media folder beside it: each row's
 // per-episode results in the shape of LeRobot's eval_info.json, and a looping GIF of one
 // successful and one failed rollout. docs/results-pages.md shows one.

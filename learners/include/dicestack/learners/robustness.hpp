@@ -1,5 +1,5 @@
 #pragma once
-// The robustness table (issue 25): a policy's realistic success in perturbed worlds, factor by
+// The robustness table: a policy's realistic success in perturbed worlds, factor by
 // factor and level by level, with Wilson intervals (docs/robustness.md).
 #include <cstdint>
 #include <filesystem>

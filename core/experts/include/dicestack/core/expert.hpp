@@ -1,6 +1,6 @@
 #pragma once
 // Automatic experts: controllers that stack the dice the realistic way (paper III-C, no wall)
-// from any state, to generate demonstrations and to answer DAgger's queries (issue 4).
+// from any state, to generate demonstrations and to answer DAgger's queries.
 //
 // Both experts drive the cup the way the human recordings do (data/cupdice: every one of the
 // 17,603 legacy frames and all three final ones keep the cup mouth-down): the cup hovers

@@ -1,5 +1,5 @@
 #pragma once
-// The demonstrator made of demonstrations (issue 24): recorded cup paths, moved into a start's
+// The demonstrator made of demonstrations: recorded cup paths, moved into a start's
 // frame and followed by feedback on the cup alone, chosen by simulating them from the start.
 // It reads nothing but the recordings, the world and the simulator: no swing plan, no mpc.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Several processes working on one job (issue 17): the MPI-free interface the libraries see.
+// Several processes working on one job: the MPI-free interface the libraries see.
 // A Cluster is a fixed set of ranks 0..size()-1 that run the same program on the same inputs
 // and meet in collective calls (all_gather, broadcast, barrier), which every rank must make in
 // the same order. Rank 0 is the root: it alone writes files and reports progress.

@@ -1,5 +1,5 @@
 #pragma once
-// Ctrl-C for the command line (issue 27). Once install_interrupt_handler() has run, SIGINT only
+// Ctrl-C for the command line. Once install_interrupt_handler() has run, SIGINT only
 // raises a flag, and the long loops (parallel_for, before each item) throw
 // Interrupted when it is up: the run unwinds as it does for any error, so scratch files and
 // folders are removed and nothing is committed; the tool then exits 130. A second signal ends

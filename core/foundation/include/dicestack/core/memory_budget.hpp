@@ -1,5 +1,5 @@
 #pragma once
-// Counts from users, checked against this machine's memory before any work (issue 27): a run
+// Counts from users, checked against this machine's memory before any work: a run
 // that would hold more than it can is refused saying what it would need, not ended by
 // std::bad_alloc halfway.
 #include <cstdint>

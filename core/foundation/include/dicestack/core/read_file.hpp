@@ -1,5 +1,5 @@
 #pragma once
-// Reading a file the user named, saying why it failed (issue 27): every reader opens through
+// Reading a file the user named, saying why it failed: every reader opens through
 // here, so a missing file, a folder given for a file or a file without read permission is
 // reported as "PATH: cannot open for reading: <reason>" or "PATH: read failed: <reason>", with
 // the path the user gave and the operating system's words (as AtomicFile does for writes).

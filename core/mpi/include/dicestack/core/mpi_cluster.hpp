@@ -1,5 +1,5 @@
 #pragma once
-// The MPI implementation of Cluster (issue 17). Its own library target, dicestack::mpi, linked
+// The MPI implementation of Cluster. Its own library target, dicestack::mpi, linked
 // by the `dicestack` tool and the MPI tests only: the other libraries, the Python module and
 // regressor plugins neither link MPI nor include <mpi.h> (this header does not).
 //

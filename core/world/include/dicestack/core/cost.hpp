@@ -18,7 +18,7 @@ double state_distance(const State& a, const State& b, const CostConfig& cost);
 double tracking_distance_sq(const State& a, const State& b, const CostConfig& cost);
 
 /// The same over the cup's pose alone (x, y, angle): how far the cup is from a recorded cup path,
-/// whatever the dice do (DaD's corrections towards the recording's cup path, issue 24).
+/// whatever the dice do (DaD's corrections towards the recording's cup path).
 double cup_distance_sq(const State& a, const State& b, const CostConfig& cost);
 
 /// Eq. 6 for one trajectory s_1..s_T: sum_j gamma^(T - j) d(s_j, goal).

@@ -34,7 +34,7 @@ bool failed_at_rest(const State& state, const WorldConfig& config);
 /// on, that ends `rest_steps` states in a row failed_at_rest (the dice are left as a failed
 /// attempt left them, and a new attempt may scoop them again). A function of the states alone,
 /// so that a demonstrator that tries again and a feature map that restarts its clock there
-/// (issue 24) agree on every step.
+/// agree on every step.
 struct AttemptRule {
   int earliest = 60;    ///< no attempt begins before this step (the dice rest before the first scoop)
   int rest_steps = 10;  ///< failed_at_rest for this many states in a row

@@ -1,5 +1,5 @@
 #pragma once
-// Perturbed worlds (issue 25): named factors, each with a magnitude, drawn per episode from the
+// Perturbed worlds: named factors, each with a magnitude, drawn per episode from the
 // episode's seed. A Perturbation says how far each factor may go; a PerturbationDraw is what
 // one episode got. Physics and starts change the world; actuation and sensing change what the
 // rollout executes and what the policy sees (learners/evaluate.hpp). docs/robustness.md has the
