@@ -237,15 +237,21 @@ TEST(Dad, AWindowCarriesTheRolloutBeforeItAsHistoryForAMapThatReadsTheEpisode) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(Dad, TheCodesUnitsLabelACorrectionWithTheOptimisersVariableInTheRecordingsUnits) {
-  const auto dir = test::scratch_path("dicestack_dad_units");
+// DaD's data after its first refit (the checkpoint's `data-1`), trained in a scratch folder.
+DemoSet first_round_data(LearnContext c, const std::string& scratch, const std::vector<std::string>& options) {
+  const auto dir = test::scratch_path(scratch);
   std::filesystem::remove_all(dir);
-  LearnContext c = dad_context(1);
   c.checkpoint_dir = dir;
-  LearnerRegistry::global()
-      .create("dad", {"windows=1", "iterations=1", "corrector_iterations=2", "demos=1", "filter=false", "faithful=units"})
-      ->learn(c);
-  const DemoSet data = read_demo_set(dir / "data-1");
+  LearnerRegistry::global().create("dad", options)->learn(c);
+  DemoSet data = read_demo_set(dir / "data-1");
+  std::filesystem::remove_all(dir);
+  return data;
+}
+
+TEST(Dad, TheCodesUnitsLabelACorrectionWithTheOptimisersVariableInTheRecordingsUnits) {
+  const LearnContext c = dad_context(1);
+  const DemoSet data = first_round_data(
+      c, "dicestack_dad_units", {"windows=1", "iterations=1", "corrector_iterations=2", "demos=1", "filter=false", "faithful=units"});
   ASSERT_EQ(data.episodes.size(), 2u);  // the target, then its one window
   const Episode& fix = data.episodes[1];
   // Undone, the label is the action the corrector found: replayed, it gives the window's next state.
@@ -254,19 +260,13 @@ TEST(Dad, TheCodesUnitsLabelACorrectionWithTheOptimisersVariableInTheRecordingsU
   const Action found{fix.actions[0][0] / 0.01, fix.actions[0][1] / 0.1, fix.actions[0][2] / 2.0};
   env.step(found);
   for (std::size_t k = 0; k < kStateDim; ++k) EXPECT_NEAR(env.get_state()[k], fix.states[1][k], 1e-5) << k;
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Dad, TheCodesRolloutsStartFromTheOneFixedStartAndItsOneStepLabelsReadAnyFeatureMap) {
-  const auto dir = test::scratch_path("dicestack_dad_fixed_start");
-  std::filesystem::remove_all(dir);
   LearnContext c = dad_context(2);
-  c.checkpoint_dir = dir;
   c.features = "state+clock+start_state";
-  LearnerRegistry::global()
-      .create("dad", {"windows=1", "iterations=1", "corrector_iterations=1", "demos=2", "faithful=start+label"})
-      ->learn(c);
-  const DemoSet data = read_demo_set(dir / "data-1");
+  const DemoSet data = first_round_data(c, "dicestack_dad_fixed_start",
+                                        {"windows=1", "iterations=1", "corrector_iterations=1", "demos=2", "faithful=start+label"});
   ASSERT_EQ(data.episodes.size(), 4u);  // the 2 targets, then one labelled rollout towards each
   for (std::size_t i = 2; i < 4; ++i) {
     const State start = paper_start_state(c.world);  // as Box2D holds it: in single precision
@@ -274,7 +274,6 @@ TEST(Dad, TheCodesRolloutsStartFromTheOneFixedStartAndItsOneStepLabelsReadAnyFea
     EXPECT_EQ(data.episodes[i].size(), 59u);
     EXPECT_EQ(data.episodes[i].sources[0], StepSource::correction);
   }
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
