@@ -17,6 +17,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/memory_budget.hpp>
 #include <dicestack/core/json_depth.hpp>
+#include <dicestack/core/read_file.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/baseline.hpp>
@@ -451,7 +452,7 @@ json rows_already_measured(Cluster& cluster, const std::filesystem::path& partia
     json rows_done = json::object();
     if (partial.empty() || !std::filesystem::exists(partial)) return rows_done.dump();
     try {
-      json p = parse_json_limited<json>(std::ifstream(partial), partial.string());
+      json p = parse_json_limited<json>(read_file(partial), partial.string());
       // Rows of another version or other settings are not reused.
       if (p.value("version", json(1)) == 1 && p.value("meta", json()) == meta) rows_done = p.value("rows", json::object());
       if (!rows_done.is_object()) rows_done = json::object();

@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,6 +14,8 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
+#include <vector>
 #include <chrono>
 #include <iterator>
 
@@ -40,11 +43,10 @@ struct Process {
   std::string output;  // stdout and stderr
 };
 
-// Runs dicestack with `args`; stderr joins stdout unless `keep_stderr` is false.
-Process run(const std::string& args, bool keep_stderr = true) {
+// Runs the shell command `cmd`; stderr joins stdout unless `keep_stderr` is false.
+Process run_command(const std::string& cmd, bool keep_stderr) {
   Process r;
-  const std::string cmd = std::string(DICESTACK_EXE) + " " + args + (keep_stderr ? " 2>&1" : " 2>/dev/null");
-  FILE* pipe = popen(cmd.c_str(), "r");
+  FILE* pipe = popen((cmd + (keep_stderr ? " 2>&1" : " 2>/dev/null")).c_str(), "r");
   if (!pipe) return r;
   char buf[4096];
   std::size_t n;
@@ -52,6 +54,21 @@ Process run(const std::string& args, bool keep_stderr = true) {
   const int raw = pclose(pipe);
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return r;
+}
+
+// Runs dicestack with `args`; stderr joins stdout unless `keep_stderr` is false.
+Process run(const std::string& args, bool keep_stderr = true) {
+  return run_command(std::string(DICESTACK_EXE) + " " + args, keep_stderr);
+}
+
+// As run, killed after `seconds` (exit status 124): a command that would hang fails instead.
+Process run_within(int seconds, const std::string& args) {
+  return run_command("timeout -k 2 " + std::to_string(seconds) + " " + std::string(DICESTACK_EXE) + " " + args, true);
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 TEST(Cli, VersionAndHelp) {
@@ -122,6 +139,78 @@ TEST(Cli, BadWorldConfigIsReportedWithTheField) {
   EXPECT_EQ(run("config --check " + good.string()).status, 0);
   std::filesystem::remove(good);
   std::filesystem::remove(bad);
+}
+
+// Every file a user names goes through one checked reader: a FIFO (which would block at its
+// open) or a device (which never ends) is refused at once, naming the file, by every command.
+TEST(CliInput, AFifoOrADeviceGivenForAnyFileIsRefusedAtOnce) {
+  namespace fs = std::filesystem;
+  const fs::path dir = test::scratch_path("dicestack_cli_fifo");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path fifo = dir / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // A set whose meta.json is a FIFO, and one whose episode is.
+  const fs::path good = fs::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good";
+  for (const char* set : {"meta_fifo", "episode_fifo"}) fs::copy(good, dir / set);
+  fs::remove(dir / "meta_fifo" / "meta.json");
+  ASSERT_EQ(::mkfifo((dir / "meta_fifo" / "meta.json").c_str(), 0600), 0);
+  fs::remove(dir / "episode_fifo" / "episode_0000.csv");
+  ASSERT_EQ(::mkfifo((dir / "episode_fifo" / "episode_0000.csv").c_str(), 0600), 0);
+  const std::string f = fifo.string(), out = (dir / "out").string();
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"rollout --steps 1 --world " + f, f},
+      {"evaluate --episodes 1 --model " + f, f},
+      {"evaluate --episodes 1 --model /dev/zero", "/dev/zero"},
+      {"record --expert scripted --episodes 1 --perturb " + f + " --out " + out, f},
+      {"config --check " + f, f},
+      {"dataset info " + (dir / "meta_fifo").string(), (dir / "meta_fifo" / "meta.json").string()},
+      {"dataset validate " + (dir / "episode_fifo").string(), (dir / "episode_fifo" / "episode_0000.csv").string()},
+      {"train --regressor knn --split none --demos " + (dir / "episode_fifo").string() + " --out " + out + ".dsm",
+       (dir / "episode_fifo" / "episode_0000.csv").string()}};
+  for (const auto& [args, file] : cases) {
+    // `timeout` turns a hang into a failure (exit 124) rather than a stuck suite.
+    const Process p = run_within(20, args);
+    EXPECT_EQ(p.status, 1) << args << "\n" << p.output;
+    EXPECT_THAT(p.output, HasSubstr(file + ": not a regular file (")) << args;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out")) << "nothing written";
+  fs::remove_all(dir);
+}
+
+// A key given twice in a JSON file a user writes is refused, naming the file and the key,
+// instead of the last one silently winning.
+TEST(CliInput, AKeyGivenTwiceInAnyJsonFileIsRefusedNamingIt) {
+  namespace fs = std::filesystem;
+  const fs::path dir = test::scratch_path("dicestack_cli_twice");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path perturbation = dir / "p.json", world = dir / "w.json", set = dir / "set";
+  std::ofstream(perturbation) << R"({"format": "dicestack-perturbation", "version": 2, "gravity": 0.4, "gravity": 0})";
+  ASSERT_EQ(run("config --out " + world.string()).status, 0);
+  {
+    std::string text = read_text(world);
+    text.insert(text.find('{') + 1, "\"episode\": {}, ");
+    std::ofstream(world) << text;
+  }
+  fs::copy(fs::path(DICESTACK_SOURCE_DIR) / "tests/datasets/data/good", set);
+  {
+    std::string text = read_text(set / "meta.json");
+    text.insert(text.find('{') + 1, "\"format\": \"x\", ");
+    std::ofstream(set / "meta.json") << text;
+  }
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      {"record --expert scripted --episodes 1 --perturb " + perturbation.string() + " --out " + (dir / "out").string(),
+       perturbation.string(), "gravity"},
+      {"rollout --steps 1 --world " + world.string(), world.string(), "episode"},
+      {"dataset info " + set.string(), (set / "meta.json").string(), "format"}};
+  for (const auto& [args, file, key] : cases) {
+    const Process p = run_within(20, args);
+    EXPECT_EQ(p.status, 1) << args << "\n" << p.output;
+    EXPECT_THAT(p.output, HasSubstr(file)) << args;
+    EXPECT_THAT(p.output, HasSubstr("key \"" + key + "\" appears twice in one object")) << args;
+  }
+  fs::remove_all(dir);
 }
 
 TEST(Cli, RolloutWritesAPng) {

@@ -1,6 +1,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -65,6 +67,29 @@ TEST(ReadFile, AReadThatFailsMidwayGivesTheSystemsReason) {
   const std::string error = test::error_of([] { read_file("/proc/self/mem"); });
   if (error.find("cannot open for reading") != std::string::npos) GTEST_SKIP() << error;
   EXPECT_EQ(error, "/proc/self/mem: read failed: Input/output error");
+}
+
+TEST(ReadFile, AFifoOrADeviceIsRefusedBeforeItIsOpened) {
+  // Opening a FIFO with no writer waits forever, and /dev/zero never ends: both refused at once.
+  const fs::path fifo = test::scratch_path("dicestack_read_fifo");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(test::error_of([&] { read_file(fifo); }), fifo.string() + ": not a regular file (a FIFO); give a file");
+  EXPECT_EQ(test::error_of([&] { open_for_reading(fifo); }), fifo.string() + ": not a regular file (a FIFO); give a file");
+  fs::remove(fifo);
+  EXPECT_EQ(test::error_of([] { read_file("/dev/zero"); }), "/dev/zero: not a regular file (a character device); give a file");
+  EXPECT_THROW(read_file("/dev/null"), InputError);
+}
+
+TEST(ReadFile, AFileLargerThanItsBoundIsRefusedBeforeItIsRead) {
+  const fs::path path = test::scratch_path("dicestack_read_bound.json");
+  { std::ofstream(path, std::ios::binary) << std::string(100, 'x'); }
+  EXPECT_EQ(read_file(path, 100).size(), 100u);
+  EXPECT_EQ(test::error_of([&] { read_file(path, 99); }),
+            path.string() + ": more than 99 bytes (the most dicestack reads from one file)");
+  fs::remove(path);
+  // A file whose size the file system does not know (0 in /proc) is bounded as it is read.
+  EXPECT_THAT(test::error_of([] { read_file("/proc/self/maps", 10); }), HasSubstr(": more than 10 bytes"));
 }
 
 }  // namespace

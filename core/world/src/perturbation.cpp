@@ -229,7 +229,7 @@ Perturbation load_perturbation(const std::string& level_or_file, const WorldConf
   std::error_code ec;
   if (std::filesystem::status(path, ec).type() == std::filesystem::file_type::not_found)
     throw InputError(level_or_file + ": not a perturbation level (none, easy, medium, hard) nor a file");
-  return perturbation_from_json(read_file(path), level_or_file, world);
+  return perturbation_from_json(read_file(path, kMaxSettingsFileBytes), level_or_file, world);
 }
 
 const State& observation_spread() {

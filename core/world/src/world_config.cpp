@@ -379,7 +379,7 @@ std::string to_json(const WorldConfig& config) {
 std::uint64_t world_hash(const WorldConfig& config) { return fnv1a(fields_json(config).dump(2) + "\n"); }
 
 WorldConfig load_world_config(const std::filesystem::path& path) {
-  return world_config_from_json(read_file(path), path.string());
+  return world_config_from_json(read_file(path, kMaxSettingsFileBytes), path.string());
 }
 
 void save_world_config(const WorldConfig& config, const std::filesystem::path& path) {
