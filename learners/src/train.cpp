@@ -25,6 +25,9 @@ TrainReport train_model(const TrainRequest& request) {
   check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
+  if (request.demos.empty())
+    throw InputError((request.demos_name.empty() ? std::string("the demonstrations") : request.demos_name) +
+                     ": no episode to train on");
   const DemoSplit split(request.demos, request.split);
   LearnContext c;
   c.demos = split.train();

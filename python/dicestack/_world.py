@@ -42,10 +42,17 @@ def resolve_perturbation(perturb, world):
         return perturb
     if isinstance(perturb, dict):
         fields = {"format": "dicestack-perturbation", "version": 2, **perturb}
-        try:
-            text = json.dumps(fields, allow_nan=False)
-        except (TypeError, ValueError) as e:
-            raise ValueError(f"perturbation <dict>: not JSON: {e}") from None
+        for key, value in fields.items():
+            if not isinstance(key, str):
+                raise ValueError(f"perturbation <dict>: a field name must be a string, got {type(key).__name__}")
+            try:
+                json.dumps(value, allow_nan=False)
+            except (TypeError, ValueError):
+                shown = repr(value)
+                shown = shown if len(shown) <= 40 else shown[:40] + "..."
+                raise ValueError(f'perturbation <dict>: field "{key[:40]}" must be a finite number, a boolean or '
+                                 f"a string, got {shown}") from None
+        text = json.dumps(fields, allow_nan=False)
         return _dicestack.Perturbation.from_json(text, "perturbation <dict>", world)
     if isinstance(perturb, (str, os.PathLike)):
         return _dicestack.Perturbation.load(os.fspath(perturb), world)

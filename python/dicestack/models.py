@@ -64,9 +64,14 @@ def _assignments(values, what):
 def _demos_argument(demos):
     if isinstance(demos, (str, os.PathLike)):
         return os.fspath(demos)
-    episodes = list(demos)
-    if not all(isinstance(e, Episode) for e in episodes):
-        raise TypeError("demos must be 'builtin', 'human', a folder, or a list of dicestack.Episode")
+    what = "demos must be 'builtin', 'human', a folder, or a list of dicestack.Episode"
+    try:
+        episodes = list(demos)
+    except TypeError:
+        raise TypeError(f"{what}, got {type(demos).__name__}") from None
+    for i, e in enumerate(episodes):
+        if not isinstance(e, Episode):
+            raise TypeError(f"{what}; item {i} is a {type(e).__name__}")
     return _records(episodes)
 
 

@@ -100,3 +100,24 @@ def test_bad_seeds_and_counts(started, builtin_episodes):
 def test_thread_counts_out_of_range_are_refused_before_any_work(threads):
     with pytest.raises(ValueError, match=r"threads must be (in|a whole number in) \[0, 1024\]"):
         dicestack.DiceStackVectorEnv(2, threads=threads)
+
+
+def test_a_perturbation_dict_names_the_field_that_is_not_a_finite_value():
+    for value in (float("nan"), float("inf"), object()):
+        with pytest.raises(ValueError, match='perturbation <dict>: field "gravity" must be a finite number'):
+            dicestack.DiceStackEnv(perturb={"gravity": value})
+    with pytest.raises(ValueError) as e:
+        dicestack.DiceStackEnv(perturb={"friction": [float("nan")] * 100000})
+    assert len(str(e.value)) < 200, "a long value is not echoed whole"
+
+
+def test_demos_that_are_not_recordings_say_what_they_are():
+    with pytest.raises(TypeError, match="demos must be .*, got int"):
+        dicestack.expert("tracker", demos=42)
+    with pytest.raises(TypeError, match="item 1 is a str"):
+        dicestack.train("knn", demos=[dicestack.load_demos("builtin")[0], "x"])
+
+
+def test_training_on_no_episode_names_the_demonstrations():
+    with pytest.raises(ValueError, match="<episodes from Python>: no episode to train on"):
+        dicestack.train("knn", demos=[], split="none")
