@@ -2,6 +2,7 @@
 // learner, with train and test error (eq. 9), rollout outcomes with 95% intervals, fit time and
 // time per step. Interrupted runs resume from <out>.partial.json. The work is the library's
 // run_leaderboard (learners/leaderboard.hpp), shared with the Python package.
+#include <algorithm>
 #include <iostream>
 
 #include <dicestack/learners/baseline.hpp>
@@ -30,7 +31,8 @@ int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
   for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb"})
     if (cmd.count(unused) > 0) throw ConfigError(std::string("leaderboard --recordings draws a learning curve; ") + unused + " is for the table");
   const LeaderboardRequest& t = opt.request;
-  if (t.format != "md" && t.format != "csv" && t.format != "json" && t.format != "html")
+  const auto formats = learning_curve_formats();
+  if (std::find(formats.begin(), formats.end(), t.format) == formats.end())
     throw ConfigError("leaderboard --recordings: --format must be md, csv, json or html, got " + t.format);
   if (!t.out.empty()) check_learning_curve_replaceable(t.out);
   LearningCurveRequest r;

@@ -93,13 +93,13 @@ std::string render_md(const LearningCurve& c) {
        << " | " << percent(s.low) << " | " << percent(s.high) << " | " << percent(s.walls) << " |\n";
   os << "\nEvery draw:\n\n| learner | regressor | recordings | draw seed | realistic success [95% CI] | wall contact | "
         "dice in cup | train s | followed |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
+  // Streamed, not formatted into a buffer: the followed paths of a tracker that keeps several are long.
   for (const auto& p : c.points) {
-    char line[512];
-    std::snprintf(line, sizeof line, "| %s | %s | %d | %llu | %s [%s-%s] | %s | %.2f | %.0f | %s |\n", p.learner.c_str(),
-                  p.regressor.c_str(), p.recordings, static_cast<unsigned long long>(p.draw_seed),
-                  percent(p.success.value).c_str(), percent(p.success.low).c_str(), percent(p.success.high).c_str(),
-                  percent(p.walls.value).c_str(), p.dice_in_cup, p.train_seconds, p.followed.empty() ? "-" : p.followed.c_str());
-    os << line;
+    char numbers[64];
+    std::snprintf(numbers, sizeof numbers, "%.2f | %.0f", p.dice_in_cup, p.train_seconds);
+    os << "| " << p.learner << " | " << p.regressor << " | " << p.recordings << " | " << p.draw_seed << " | "
+       << percent(p.success.value) << " [" << percent(p.success.low) << "-" << percent(p.success.high) << "] | "
+       << percent(p.walls.value) << " | " << numbers << " | " << (p.followed.empty() ? "-" : p.followed) << " |\n";
   }
   return os.str();
 }

@@ -127,6 +127,10 @@ TEST(LearningCurve, EachFormatCarriesItsMarkerAndOnlyACurveIsReplaced) {
   const std::string md = render_learning_curve(c, "md");
   EXPECT_EQ(md.rfind("<!-- dicestack learning curve -->", 0), 0u);
   EXPECT_THAT(md, HasSubstr("| dart:expert=tracker | gbt | 3 | 1 | 85% | 85% | 85% |"));
+  // A long list of followed paths stays whole, its row closed.
+  LearningCurve many = c;
+  many.points[0].followed = std::string(3000, 'f');
+  EXPECT_THAT(render_learning_curve(many, "md"), HasSubstr(" | " + std::string(3000, 'f') + " |\n"));
   EXPECT_EQ(render_learning_curve(c, "csv").rfind("learner,regressor,recordings,draw_seed", 0), 0u);
   const auto j = nlohmann::json::parse(render_learning_curve(c, "json"));
   EXPECT_EQ(j["format"], "dicestack-learning-curve");
