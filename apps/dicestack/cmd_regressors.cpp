@@ -57,19 +57,16 @@ int run_learners() {
     if (name.find('/') != std::string::npos) continue;  // the twins are listed once, below
     const FeatureMap& m = feature_map(name);
     char line[256];
-    std::snprintf(line, sizeof line, "  %-28s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
+    std::snprintf(line, sizeof line, "  %-35s v%d, %2zu inputs: %s", name.c_str(), m.version(), m.width(),
                   m.description().c_str());
     print_line(line);
   }
-  print_line("each also as NAME" + std::string(kVelocityTargetSuffix) +
-             " (the regressor answers the cup velocity to set; the action is that less the cup's velocity), NAME" +
-             std::string(kPositionTargetSuffix) +
-             " (it answers the cup pose to servo to; the action sets the velocity 10/s times the pose error), NAME" +
-             std::string(kAheadSuffix) +
-             " (under delays, the cup moved ahead to where it is when the action lands), NAME" +
-             std::string(kLandingSuffix) + " (that, and the clock of the step it lands at) and NAME" +
-             std::string(kVelocityTargetSuffix) + std::string(kAheadSuffix) + " or NAME" +
-             std::string(kPositionTargetSuffix) + std::string(kLandingSuffix) + " (both)");
+  print_line("each also as NAME/velocity (the regressor answers the cup velocity to set), NAME/position (the cup pose "
+             "to servo to) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
+             "clock of that step), as in NAME/position/landing");
+  print_line("a name is parts joined by +, each once and in this order: state or cup, clock, start or start_state "
+             "(either may end in @dice: x measured from the start's mean die x), history, retry (the clock and the "
+             "start restart at each attempt); any such name is a map (docs/learners.md, \"Feature-map names\")");
   return 0;
 }
 

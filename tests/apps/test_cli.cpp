@@ -526,7 +526,7 @@ TEST(CliLearning, DartTrainsAHistoryModelThatEvaluateAndTheLeaderboardShow) {
   std::filesystem::remove_all(rollouts);
   p = run("train --demos " + kTinyDemos + " --regressor knn --features state+tomorrow --out " + model.string());
   EXPECT_EQ(p.status, 1);
-  EXPECT_THAT(p.output, HasSubstr("unknown feature map \"state+tomorrow\""));
+  EXPECT_THAT(p.output, HasSubstr("feature map \"state+tomorrow\": unknown part \"tomorrow\""));
   std::filesystem::remove(model);
   // A row per learner and map; DaD keeps to its own map in a table (its rows take minutes), so its
   // state+clock row is skipped.

@@ -17,6 +17,7 @@ namespace dicestack {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 State numbered(double base) {
   State s;
@@ -104,7 +105,88 @@ TEST(Features, StateAndClockWidths) {
     feature_map("state+clok");
     FAIL() << "an unknown map was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("unknown feature map \"state+clok\"; known: state, state+clock"));
+    EXPECT_THAT(e.what(), HasSubstr("feature map \"state+clok\": unknown part \"clok\""));
+    EXPECT_THAT(e.what(), Not(HasSubstr("state+clock+start_state@dice/velocity"))) << "the part, not every name";
+  }
+}
+
+TEST(FeatureSpec, EveryListedNameReadsBackAsItself) {
+  for (const auto& n : feature_map_names()) {
+    EXPECT_EQ(to_string(parse_feature_spec(n)), n);
+    EXPECT_EQ(feature_map(n).name(), n);
+    EXPECT_EQ(&feature_map(n), &feature_map(n)) << "one object per name: models keep a reference";
+  }
+  EXPECT_EQ(feature_map_names().size(), 99u);
+}
+
+TEST(FeatureSpec, ANameIsReadPartByPart) {
+  const FeatureSpec f = parse_feature_spec("state+clock+start_state@dice+retry/position/landing");
+  EXPECT_EQ(f.current, FeatureSpec::Current::state);
+  EXPECT_TRUE(f.clock);
+  EXPECT_EQ(f.start, FeatureSpec::Start::whole);
+  EXPECT_TRUE(f.dice_frame);
+  EXPECT_FALSE(f.previous);
+  EXPECT_TRUE(f.restart);
+  EXPECT_EQ(f.target, ActionTarget::position);
+  EXPECT_EQ(f.timing, FeatureSpec::Timing::landing);
+  const FeatureSpec open = parse_feature_spec("clock+start");
+  EXPECT_EQ(open.current, FeatureSpec::Current::none);
+  EXPECT_EQ(open.start, FeatureSpec::Start::summary);
+  EXPECT_EQ(open.target, ActionTarget::impulse);
+  EXPECT_EQ(open.timing, FeatureSpec::Timing::now);
+}
+
+TEST(FeatureSpec, AnyNameTheGrammarAllowsIsAMapWithItsPartsColumns) {
+  // Not among the listed maps: the start and the previous state together, at the widest.
+  const FeatureMap& m = feature_map("state+clock+start_state@dice+history/velocity");
+  EXPECT_EQ(m.width(), 3 * kStateDim + 2);
+  EXPECT_LE(m.width(), kMaxFeatureWidth);
+  const auto columns = m.column_names();
+  ASSERT_EQ(columns.size(), m.width());
+  EXPECT_EQ(columns[kStateDim], "t");
+  EXPECT_EQ(columns[kStateDim + 1], "start_" + std::string(state_names()[0]));
+  EXPECT_EQ(columns[2 * kStateDim + 1], "prev_" + std::string(state_names()[0]));
+  EXPECT_EQ(columns.back(), "origin_x");
+  EXPECT_EQ(m.target(), ActionTarget::velocity);
+  const std::vector<State> states{numbered(100), numbered(200)};
+  const auto row = row_of(m, History{states, {}});
+  const double x0 = mean_dice_x(states[0]);
+  EXPECT_DOUBLE_EQ(row[kStateDim], 1.0);
+  EXPECT_DOUBLE_EQ(row[kStateDim + 1 + state_index::kCupX], 100.0 - x0) << "the start, in the dice frame";
+  EXPECT_DOUBLE_EQ(row[2 * kStateDim + 1 + state_index::kCupY], 101.0) << "the previous state is the start";
+  EXPECT_DOUBLE_EQ(row.back(), x0);
+  EXPECT_EQ(feature_map("clock").width(), 1u) << "nothing but the clock: open loop";
+}
+
+TEST(FeatureSpec, AWrongNameIsRefusedNamingThePartThatBreaksTheGrammar) {
+  const auto error_of = [](const std::string& name) {
+    try {
+      parse_feature_spec(name);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::pair<const char*, const char*> cases[] = {
+      {"state+tomorrow", "unknown part \"tomorrow\""},
+      {"clock+state", "\"state\" must come before \"clock\""},
+      {"state+cup", "\"cup\" after \"state\": give one of them"},
+      {"state+clock+clock", "\"clock\" given twice"},
+      {"state+start+start_state", "\"start_state\" after \"start\""},
+      {"state@dice", "\"@dice\" follows start or start_state, not \"state\""},
+      {"state+retry", "\"retry\" restarts the clock and the start"},
+      {"state++clock", "an empty part"},
+      {"", "an empty part"},
+      {"state/", "unknown suffix \"/\""},
+      {"state/speed", "unknown suffix \"/speed\""},
+      {"state/ahead/velocity", "\"/velocity\" must come before the timing"},
+      {"state/velocity/position", "\"/position\" given with another target"},
+      {"state/ahead/landing", "\"/landing\" given with another timing"},
+  };
+  for (const auto& [name, what] : cases) {
+    const std::string e = error_of(name);
+    EXPECT_THAT(e, HasSubstr("feature map \"" + std::string(name) + "\": " + what)) << name;
+    EXPECT_THAT(e, HasSubstr("each once and in this order")) << "the grammar, in one line";
   }
 }
 

@@ -116,7 +116,7 @@ TEST(ModelFile, RefusesAFeatureMapThatDoesNotMatchTheRegressorsWidth) {
   header["features"] = "state+tomorrow";
   reseal(header, payload);
   write_parts(path, header, payload);
-  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("unknown feature map \"state+tomorrow\""));
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("feature map \"state+tomorrow\": unknown part \"tomorrow\""));
   EXPECT_THROW(load_model(path), InputError);
   fs::remove(path);
 }

@@ -36,8 +36,9 @@ struct History {
   const State& start() const { return states.front(); }
 };
 
-/// The widest row any built-in map produces (a stack buffer on the hot path).
-inline constexpr std::size_t kMaxFeatureWidth = 64;
+/// The widest row any map produces (a stack buffer on the hot path): the state, the clock, the
+/// whole start, the previous state and the dice frame's origin.
+inline constexpr std::size_t kMaxFeatureWidth = 80;
 
 /// What a policy's regressor answers: the action itself (the cup's velocity change, the paper's
 /// impulse), the cup velocity the action is to set (the action is then that velocity minus
@@ -47,6 +48,43 @@ inline constexpr std::size_t kMaxFeatureWidth = 64;
 /// velocities they are smooth; as poses, for a tracker of the same gain, the same wherever the
 /// cup is (so a learner's errors do not add up into a drift).
 enum class ActionTarget { impulse, velocity, position };
+
+/// What a feature map is made of: its name, read part by part. The grammar of a name
+/// (docs/learners.md, "Feature-map names"):
+///
+///     NAME   := INPUTS [TARGET] [TIMING]
+///     INPUTS := PART ("+" PART)*     each part at most once, in the order below
+///     PART   := "state" | "cup"       the current state, or only the cup's six numbers of it
+///             | "clock"               the step index t
+///             | START ["@dice"]       "@dice": every x measured from the start's mean die x
+///             | "history"             the previous state (the start repeated at t = 0)
+///             | "retry"               the clock and the start restart with each attempt
+///     START  := "start"               the start's cup x and mean die x
+///             | "start_state"         the whole start state
+///     TARGET := "/velocity" | "/position"   the regressor answers a cup velocity or a pose
+///     TIMING := "/ahead" | "/landing"       under delays, the cup where the action lands
+///
+/// A map with no current-state part is open loop. "retry" needs a clock or a start to restart.
+struct FeatureSpec {
+  enum class Current { none, state, cup };
+  enum class Start { none, summary, whole };
+  enum class Timing { now, ahead, landing };
+  Current current = Current::none;
+  bool clock = false;
+  Start start = Start::none;
+  bool dice_frame = false;  ///< "@dice": x measured from the start's mean die x, that origin the last column
+  bool previous = false;    ///< "history"
+  bool restart = false;     ///< "retry": the clock and the start restart at each attempt (attempt_start)
+  ActionTarget target = ActionTarget::impulse;
+  Timing timing = Timing::now;
+  bool operator==(const FeatureSpec&) const = default;
+};
+
+/// Reads a map's name. Throws ConfigError naming the name and the part that breaks the grammar
+/// (unknown, repeated, out of order, or a suffix that does not belong there).
+FeatureSpec parse_feature_spec(std::string_view name);
+/// The name of `spec`: parse_feature_spec's inverse, so a model file's name reads back the same.
+std::string to_string(const FeatureSpec& spec);
 
 /// A named, versioned map from a History to one input row, and from the regressor's answer to
 /// an action. Immutable; thread-safe.
@@ -93,34 +131,11 @@ State cup_ahead(const History& history);
 /// substeps) is not the default world's, which cup_ahead() moves the cup in.
 void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
 
-/// The built-in maps, by name:
-///  - "state": the 24 state numbers (the paper's input; what every model before format 2 used)
-///  - "state+clock": + the step index t (control steps since the start)
-///  - "state+clock+start": + t, the start's cup x and the start's mean die x
-///  - "state+history": + the previous state (the start repeated at t = 0): the last step's
-///    velocity changes, which carry the previous action
-///  - "state+clock+start_state": + t and the whole start state
-///  - "clock+start_state", "cup+clock+start_state": open loop, and feedback on the cup alone
-///  - "state+clock+start_state@dice", "clock+start_state@dice": every x measured from the
-///    start's mean die x, that origin a last column (origin_x()): a recording the tracker moves
-///    to each start is then the same rows and poses for every start
-///  - "state+clock+start_state+retry", "state+clock+start_state@dice+retry": the clock and the
-///    start (and the frame's origin) restart where a failed attempt has come to rest
-///    (attempt_start, judged in the default world), for an expert that then tries again
-///    (ExpertConfig::retry): its second attempt is then the rows of a first one
-/// Each also as NAME + "/velocity" (kVelocityTargetSuffix): the same inputs, the regressor
-/// answering the cup velocity to set, and as NAME + "/position" (kPositionTargetSuffix):
-/// answering the pose to servo the cup to ("state+clock+start_state@dice+retry/position" is dart's
-/// default with the tracker).
-/// Each of these also as NAME + "/ahead" (kAheadSuffix): under delays, the row shows
-/// cup_ahead() instead of the current cup (with no delay, the same rows as NAME). The clock
-/// stays t, the choices made so far: a policy's episode is then the nominal one, d steps late.
-/// (Shown the step its action lands at, a policy trained without delay meets at t = d a cup
-/// that has not moved yet, which it never saw: measured, docs/robustness.md.)
-/// And as NAME + "/landing" (kLandingSuffix): the "/ahead" row with the clock of the step the
-/// action lands at (t plus the pending actions): for a policy trained under delays drawn per
-/// episode, which then reads one clock for the cup it meets, whatever the delay.
-/// Throws ConfigError for another name, listing these.
+/// The map a name describes (FeatureSpec's grammar), e.g. "state+clock+start_state@dice+retry/position",
+/// dart's default with the tracker. Every valid name is a map; the same name, the same object.
+/// "/ahead" maps show cup_ahead() instead of the current cup and keep the clock of the choices
+/// made so far; "/landing" maps show the clock of the step the action lands at too (for a
+/// policy trained under delays drawn per episode). Throws ConfigError as parse_feature_spec.
 const FeatureMap& feature_map(std::string_view name);
 
 /// The suffix of a map whose regressor answers the cup velocity to set (ActionTarget::velocity).
@@ -136,7 +151,8 @@ inline constexpr std::string_view kAheadSuffix = "/ahead";
 /// The suffix of an "/ahead" map whose clock is the step its action lands at.
 inline constexpr std::string_view kLandingSuffix = "/landing";
 
-/// Names feature_map() accepts, in listing order.
+/// The maps `dicestack learners` lists, in its order: eleven input sets, each with every target
+/// and timing (99 names). feature_map() accepts any other name the grammar allows too.
 std::vector<std::string> feature_map_names();
 
 /// The "state" map: the default of every learner that does not name one.
