@@ -1,8 +1,8 @@
 # Finds the OpenCV 4 modules dicestack uses and defines imported targets named as OpenCV's own
-# config does (opencv_core, opencv_imgproc, opencv_imgcodecs, opencv_videoio, opencv_ml).
+# config does (opencv_core, opencv_imgproc, opencv_videoio, opencv_ml).
 # Debian ships OpenCVConfig.cmake only in the libopencv-dev meta package, which pulls in every
 # contrib module; the per-module -dev packages we install have headers and libraries only.
-find_package(OpenCV 4 QUIET CONFIG COMPONENTS core imgproc imgcodecs videoio ml)
+find_package(OpenCV 4 QUIET CONFIG COMPONENTS core imgproc videoio ml)
 if(OpenCV_FOUND)
   set(OpenCVModules_FOUND TRUE)
   return()
@@ -10,7 +10,7 @@ endif()
 
 find_path(OpenCVModules_INCLUDE_DIR opencv2/core.hpp PATH_SUFFIXES opencv4)
 set(_ocv_required OpenCVModules_INCLUDE_DIR)
-foreach(_m core imgproc imgcodecs videoio ml)
+foreach(_m core imgproc videoio ml)
   find_library(OpenCVModules_${_m}_LIBRARY opencv_${_m})
   list(APPEND _ocv_required OpenCVModules_${_m}_LIBRARY)
   if(OpenCVModules_${_m}_LIBRARY AND OpenCVModules_INCLUDE_DIR AND NOT TARGET opencv_${_m})

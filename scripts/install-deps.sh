@@ -9,7 +9,7 @@ packages=(
   cmake g++ make pkg-config
   libbox2d-dev            # physics (Box2D 2.4)
   libeigen3-dev           # linear algebra
-  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-videoio-dev  # drawing; videos (a module loaded on use)
   libopencv-ml-dev        # SVR, MLP, random forest
   libxgboost-dev          # gradient-boosted trees
   xgboost                 # (libxgboost-dev's CMake config checks for its /usr/bin/xgboost)
@@ -21,6 +21,7 @@ packages=(
   libtbb-dev              # threads
   libsdl2-dev             # the interactive player
   libgif-dev              # GIF output of `dicestack render`
+  zlib1g-dev              # PNG output
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xdotool            # the headless test of `dicestack play`
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ and libFuzzer

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -5,6 +6,7 @@
 
 #include <gif_lib.h>
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/initial_state.hpp>
@@ -42,6 +44,63 @@ TEST(Render, WritesAPngAtomically) {
   char magic[4]{};
   in.read(magic, 4);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  std::filesystem::remove(path);
+}
+
+// Reads back what write_png wrote, chunk by chunk: each CRC, the header, and the pixels.
+std::vector<std::uint8_t> png_pixels_as_bgr(const std::string& bytes, int& width, int& height) {
+  const auto u32 = [&](std::size_t at) {
+    return (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at])) << 24) |
+           (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 1])) << 16) |
+           (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 2])) << 8) |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 3]));
+  };
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  std::string idat;
+  for (std::size_t at = 8; at + 12 <= bytes.size();) {
+    const std::uint32_t length = u32(at);
+    const std::string type = bytes.substr(at + 4, 4);
+    const auto* typed = reinterpret_cast<const Bytef*>(bytes.data() + at + 4);
+    EXPECT_EQ(crc32(crc32(0L, Z_NULL, 0), typed, length + 4), u32(at + 8 + length)) << type;
+    if (type == "IHDR") {
+      width = static_cast<int>(u32(at + 8));
+      height = static_cast<int>(u32(at + 12));
+      EXPECT_EQ(bytes.substr(at + 16, 5), std::string("\x08\x02\0\0\0", 5)) << "8-bit RGB, not interlaced";
+    }
+    if (type == "IDAT") idat += bytes.substr(at + 8, length);
+    at += 12 + length;
+  }
+  const auto w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
+  std::vector<std::uint8_t> raw(h * (1 + 3 * w));
+  uLongf size = raw.size();
+  EXPECT_EQ(uncompress(raw.data(), &size, reinterpret_cast<const Bytef*>(idat.data()), idat.size()), Z_OK);
+  EXPECT_EQ(size, raw.size());
+  std::vector<std::uint8_t> bgr;
+  for (std::size_t y = 0; y < h; ++y) {
+    EXPECT_EQ(raw[y * (1 + 3 * w)], 0) << "row " << y << ": no filter";
+    for (std::size_t x = 0; x < w; ++x) {
+      const std::uint8_t* rgb = &raw[y * (1 + 3 * w) + 1 + 3 * x];
+      bgr.insert(bgr.end(), {rgb[2], rgb[1], rgb[0]});
+    }
+  }
+  return bgr;
+}
+
+TEST(Render, APngHoldsTheImagesPixelsExactly) {
+  const WorldConfig c;
+  const Image img = render_state(paper_start_state(c), c, {3, {}, "png"});
+  const auto path = test::scratch_path("dicestack_render_pixels.png");
+  write_png(img, path);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  int width = 0, height = 0;
+  const auto pixels = png_pixels_as_bgr(bytes, width, height);
+  EXPECT_EQ(width, img.width);
+  EXPECT_EQ(height, img.height);
+  EXPECT_TRUE(pixels == img.bgr) << "the decoded pixels differ from the image drawn";
+  Image odd{3, 2, {}};
+  odd.bgr.resize(17);
+  EXPECT_THAT(test::error_of([&] { write_png(odd, path); }), ::testing::HasSubstr("3 x 2 pixels holds 17 bytes"));
   std::filesystem::remove(path);
 }
 

@@ -3,12 +3,13 @@
 #include <cmath>
 #include <cstdio>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
+
+#include "png_encoder.hpp"
 
 namespace dicestack {
 namespace {
@@ -108,15 +109,11 @@ void render_state_into(Image& out, const State& s, const WorldConfig& config, co
 }
 
 void write_png(const Image& image, const std::filesystem::path& path) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.bgr.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
-    throw InputError(path.string() + ": image has inconsistent size");
-  const cv::Mat mat(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.bgr.data()));
   std::vector<std::uint8_t> png;
   try {
-    if (!cv::imencode(".png", mat, png)) throw InputError(path.string() + ": PNG encoding failed");
-  } catch (const cv::Exception& e) {
-    throw InputError(path.string() + ": PNG encoding failed: " + e.what());
+    png = encode_png(image);
+  } catch (const InputError& e) {
+    throw InputError(path.string() + ": " + e.what());
   }
   AtomicFile file(path, Ownership::unchecked("PNG image"));  // rendered images are deliberately not guarded
   file.stream().write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));

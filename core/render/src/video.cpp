@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include <opencv2/videoio.hpp>
+#include <dlfcn.h>
+
+#include <memory>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/judge.hpp>
@@ -14,10 +16,38 @@
 #include <dicestack/core/world.hpp>
 
 #include "gif_writer.hpp"
+#include "video_sink.hpp"
 
 namespace dicestack {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+using OpenVideo = VideoSink* (*)(const char*, int, double, int, int);
+
+// The video module's entry, loaded once from beside this library (the build tree and an
+// install keep them in one folder). Throws InputError naming `out` when it cannot be loaded.
+OpenVideo video_module(const fs::path& out) {
+  static const std::pair<OpenVideo, std::string> loaded = [] {
+    Dl_info self{};
+    const fs::path here = dladdr(reinterpret_cast<void*>(&write_frames), &self) != 0 && self.dli_fname != nullptr
+                              ? fs::path(self.dli_fname).parent_path()
+                              : fs::path();
+    const fs::path module = here / kVideoModuleFile;
+    void* handle = dlopen(module.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) return std::pair<OpenVideo, std::string>{nullptr, dlerror()};
+    auto* entry = reinterpret_cast<OpenVideo>(dlsym(handle, kOpenVideoSymbol));
+    if (entry == nullptr) return std::pair<OpenVideo, std::string>{nullptr, module.string() + ": no " + kOpenVideoSymbol};
+    return std::pair<OpenVideo, std::string>{entry, ""};
+  }();
+  if (loaded.first == nullptr)
+    throw InputError(out.string() + ": videos are written by " + kVideoModuleFile +
+                     ", which did not load (" + loaded.second + "); write a .gif or PNG frames instead");
+  return loaded.first;
+}
+
+}  // namespace
 
 void write_frames(const std::vector<State>& states, const WorldConfig& world, const std::string& title, const fs::path& out,
                   const FrameOptions& options) {
@@ -68,15 +98,15 @@ void write_frames(const std::vector<State>& states, const WorldConfig& world, co
     fs::rename(tmp, out);
     return;
   }
-  const int fourcc = ext == ".mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v') : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
-  cv::VideoWriter video(tmp.string(), cv::CAP_FFMPEG, fourcc, 1.0 / (world.physics.control_dt * options.every),
-                        cv::Size(img.width, img.height));
-  if (!video.isOpened()) throw InputError(out.string() + ": OpenCV cannot write this video format here");
+  const std::unique_ptr<VideoSink> video(video_module(out)(tmp.c_str(), ext == ".mp4" ? 1 : 0,
+                                                          1.0 / (world.physics.control_dt * options.every), img.width,
+                                                          img.height));
+  if (!video) throw InputError(out.string() + ": OpenCV cannot write this video format here");
   for (std::size_t t = 0; t < states.size(); t += every) {
     render_state_into(img, states[t], world, {static_cast<int>(t), outcomes[t], title}, look);
-    video.write(cv::Mat(img.height, img.width, CV_8UC3, img.bgr.data()));
+    video->add(img.bgr.data());
   }
-  video.release();
+  video->close();
   fs::rename(tmp, out);
 }
 
