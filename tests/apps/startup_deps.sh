@@ -15,7 +15,8 @@ module="$(dirname "$render")/libdicestack_videoio.so"
 if [[ ! -f "$module" ]]; then
   echo "FAIL: $module: the video module is not beside $render"; exit 1
 fi
-if ! ldd "$module" | grep -q 'libopencv_videoio\.so'; then
+module_deps="$(ldd "$module")"
+if ! grep -q 'libopencv_videoio\.so' <<<"$module_deps"; then
   echo "FAIL: $module does not load OpenCV's video I/O"; exit 1
 fi
 echo "ok: $exe starts with $(wc -l <<<"$deps") libraries, none of them a video codec; $module writes videos"
