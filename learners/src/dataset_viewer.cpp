@@ -219,7 +219,7 @@ std::string viewer_html(const DemoSet& set, const std::string& name, const std::
                     {"wall_contact", e.outcome.wall_contact},
                     {"dice_in_cup", e.outcome.dice_in_cup},
                     {"origin", e.origin},
-                    {"script", page::url_segment(media) + "/" + episode_script(i)}});
+                    {"script", media + "/" + episode_script(i)}});
   }
   const auto& w = set.world.walls;
   const int width = 450, height = static_cast<int>(std::lround(width * (w.ceiling_y + w.left_x) / (w.right_x + w.left_x)));
@@ -250,24 +250,20 @@ std::string viewer_html(const DemoSet& set, const std::string& name, const std::
 }  // namespace
 
 void write_dataset_viewer(const DemoSet& set, const std::string& name, const fs::path& page_path) {
-  const fs::path media = page_media_folder(page_path);
-  check_replaceable(page_path, results_page_ownership());  // before anything is written
-  page::check_marked_folder(media, kViewerMarker, kViewerFormat, "episode viewer's folder");
-  replace_folder(
-      media, [](const fs::path& p) { return page::is_marked_folder(p, kViewerMarker, kViewerFormat); },
-      [](const fs::path& p) { page::check_marked_folder(p, kViewerMarker, kViewerFormat, "episode viewer's folder"); },
-      [&](const fs::path& tmp) {
-        fs::create_directories(tmp / "episodes");
+  const page::MediaFolder media{page_media_folder(page_path), kViewerMarker, kViewerFormat, "episode viewer's folder"};
+  page::write_page_with_media(
+      page_path, results_page_ownership(), media,
+      [&](const fs::path& folder) {
+        fs::create_directories(folder / "episodes");
         for (std::size_t i = 0; i < set.episodes.size(); ++i) {
-          AtomicFile f(tmp / episode_script(i), Ownership::unchecked("episode data"), AtomicFile::Leftovers::skip);
+          AtomicFile f(folder / episode_script(i), Ownership::unchecked("episode data"), AtomicFile::Leftovers::skip);
           f.stream() << episode_data(set.episodes[i], i);
           f.commit();
         }
-        page::write_marker(tmp / kViewerMarker, kViewerFormat);
+      },
+      [&](const std::string& media_url) {
+        return std::string(kResultsPageMarker) + "\n" + viewer_html(set, name, media_url);
       });
-  AtomicFile f(page_path, results_page_ownership());
-  f.stream() << kResultsPageMarker << '\n' << viewer_html(set, name, media.filename().string());
-  f.commit();
 }
 
 }  // namespace dicestack

@@ -269,9 +269,9 @@ const std::vector<LeaderboardFormat>& leaderboard_formats() {
                  ""});
     LeaderboardFormat html{"html", ".html",
                            "a page for a browser: sortable table, previews, per-episode results in <page>_files/ (docs/results-pages.md)",
-                           [](const Leaderboard& b, Path out) { return results_page_html(b, out.empty() ? "" : page_media_folder(out).filename().string()); },
+                           [](const Leaderboard& b, Path) { return results_page_html(b, ""); },
                            [] { return results_page_ownership(); }, std::string(kResultsPageMarker) + "\n"};
-    html.write_beside = [](const Leaderboard& b, Path out) { write_page_media(b, page_media_folder(out)); };
+    html.write = [](const Leaderboard& b, Path out) { write_results_page(b, out); };
     html.check_beside = [](Path out) { check_page_media_replaceable(page_media_folder(out)); };
     html.echo = "md";
     f.push_back(std::move(html));
@@ -708,12 +708,14 @@ std::string leaderboard_row_json(const LeaderboardRow& row) { return row_json(ro
 
 void write_leaderboard(const Leaderboard& board, const std::string& format_name, const std::filesystem::path& out) {
   const LeaderboardFormat& format = leaderboard_format(format_name);
-  const std::string table = format.render(board, out);
-  check_replaceable(out, format.ownership());  // before anything beside it is written
-  if (format.write_beside) format.write_beside(board, out);
-  AtomicFile f(out, format.ownership());
-  f.stream() << format.marker << table;
-  f.commit();
+  if (format.write) {
+    format.write(board, out);
+  } else {
+    const std::string table = format.render(board, out);
+    AtomicFile f(out, format.ownership());
+    f.stream() << format.marker << table;
+    f.commit();
+  }
   const std::filesystem::path partial = out.string() + ".partial.json";
   if (partial_ownership().recognises(partial)) std::filesystem::remove(partial);
 }

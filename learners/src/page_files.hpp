@@ -3,7 +3,10 @@
 // files that make a page's folder ours to replace, and the sortable table page that the
 // leaderboard's page and the robustness page are made of.
 #include <filesystem>
+#include <functional>
 #include <string>
+
+#include <dicestack/core/atomic_file.hpp>
 
 namespace dicestack::page {
 
@@ -30,7 +33,30 @@ void check_marked_folder(const std::filesystem::path& folder, const char* marker
 /// style and scripts are inside the page. Without the marker line (the caller writes it).
 std::string table_page_html(const std::string& data_json, const char* script);
 
-/// Writes the marker file `file` ({"format": format, "version": 1, ...}).
-void write_marker(const std::filesystem::path& file, const char* format);
+/// Writes the marker file `file` ({"format": format, "version": version, ...}).
+void write_marker(const std::filesystem::path& file, const char* format, int version = 1);
+
+/// A page's media folder: where it is and the marker that makes it ours.
+struct MediaFolder {
+  std::filesystem::path folder;  ///< "<stem>_files" beside the page
+  const char* marker;            ///< the marker file's name inside it
+  const char* format;            ///< the marker's "format"
+  std::string what;              ///< what it is, for messages ("results page's media folder")
+};
+
+/// The version of a media folder written by write_page_with_media: its files sit in a generation
+/// folder inside it ("m-" and 16 hex digits of their digest), which the page links.
+inline constexpr int kMediaGenerationsVersion = 2;
+
+/// Writes a page and its media as one unit. `fill` writes the media into an empty folder, which
+/// becomes a new generation folder inside `media.folder`; `html` gets the generation's URL
+/// relative to the page and returns the page. The page's rename over `page` is the commit: a
+/// run killed before it leaves the old page and the generation it links, one killed after it the
+/// new pair. Then every generation no page links is removed, and the leftovers of dead runs.
+/// Replaces only a page that `page_owner` recognises and a media folder with our marker
+/// (InputError, before anything is written). Throws InputError naming the page or the folder.
+void write_page_with_media(const std::filesystem::path& page, const Ownership& page_owner, const MediaFolder& media,
+                           const std::function<void(const std::filesystem::path&)>& fill,
+                           const std::function<std::string(const std::string& media_url)>& html);
 
 }  // namespace dicestack::page

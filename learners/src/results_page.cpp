@@ -277,9 +277,9 @@ void check_marked_folder(const fs::path& folder, const char* marker, const char*
                    " dicestack wrote; refusing to replace it: choose another --out or remove it yourself");
 }
 
-void write_marker(const fs::path& file, const char* format) {
+void write_marker(const fs::path& file, const char* format, int version) {
   AtomicFile f(file, Ownership::json_object("", format), AtomicFile::Leftovers::skip);
-  f.stream() << json{{"format", format}, {"version", 1}, {"dicestack_version", DICESTACK_VERSION}}.dump(2) << '\n';
+  f.stream() << json{{"format", format}, {"version", version}, {"dicestack_version", DICESTACK_VERSION}}.dump(2) << '\n';
   f.commit();
 }
 
@@ -342,7 +342,7 @@ std::string results_page_html(const Leaderboard& board, const std::string& media
   const auto& w = board.world.walls;
   const double aspect = (w.ceiling_y + w.left_x) / (w.right_x + w.left_x);
   json rows = json::array();
-  const std::string prefix = media.empty() ? "" : page::url_segment(media) + "/";
+  const std::string prefix = media.empty() ? "" : media + "/";
   for (std::size_t i = 0; i < board.rows.size(); ++i) {
     const LeaderboardRow& r = board.rows[i];
     json row = json::parse(leaderboard_row_json(r));
@@ -376,10 +376,13 @@ void check_page_media_replaceable(const fs::path& folder) {
   check_marked_folder(folder, kMediaMarker, kMediaFormat, "results page's media folder");
 }
 
-void write_page_media(const Leaderboard& board, const fs::path& folder) {
-  replace_folder(
-      folder, [](const fs::path& p) { return is_marked_folder(p, kMediaMarker, kMediaFormat); },
-      check_page_media_replaceable, [&](const fs::path& tmp) { fill_media(board, tmp); });
+void write_results_page(const Leaderboard& board, const fs::path& page) {
+  const page::MediaFolder media{page_media_folder(page), kMediaMarker, kMediaFormat, "results page's media folder"};
+  page::write_page_with_media(
+      page, results_page_ownership(), media, [&](const fs::path& folder) { fill_media(board, folder); },
+      [&](const std::string& media_url) {
+        return std::string(kResultsPageMarker) + "\n" + results_page_html(board, media_url);
+      });
 }
 
 void check_report_replaceable(const fs::path& dir) {

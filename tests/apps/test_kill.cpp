@@ -41,7 +41,7 @@ struct Writer {
   std::string first;                 // the earlier run: makes the old output
   std::string again;                 // the run that is killed at each point, then run whole
   std::vector<std::string> outputs;  // what must stay old together (under the case's folder)
-  bool may_grow = false;             // a checkpoint: a complete new iteration may appear beside the old state
+  bool may_grow = false;             // a checkpoint or a page: new entries (an iteration, media) may appear beside the old ones
 };
 
 void PrintTo(const Writer& w, std::ostream* os) { *os << w.name; }
@@ -332,6 +332,16 @@ INSTANTIATE_TEST_SUITE_P(
                "leaderboard --demos {demos} --regressors knn,linear_svr --learners bc --episodes 1 --seed 2 --format json "
                "--out {root}/lb.json",
                {"lb.json"}},
+        // A page and its media folder: the old page with the media it links, or the new pair. A
+        // new generation of media may appear beside the old one before the page's commit.
+        Writer{"leaderboard_html", {},
+               "leaderboard --demos {demos} --regressors knn --learners bc --episodes 1 --seed 1 --format html "
+               "--out {root}/lb.html",
+               "leaderboard --demos {demos} --regressors knn --learners bc --episodes 2 --seed 2 --format html "
+               "--out {root}/lb.html",
+               {"lb.html", "lb_files"}, true},
+        Writer{"dataset_view", kTwoSets, "dataset view {root}/demos1 --out {root}/view.html",
+               "dataset view {root}/demos2 --out {root}/view.html", {"view.html", "view_files"}, true},
         Writer{"export_minari", kTwoSets, "dataset export {root}/demos1 --format minari --out {root}/minari",
                "dataset export {root}/demos2 --format minari --out {root}/minari", {"minari"}},
         Writer{"export_robomimic", kTwoSets, "dataset export {root}/demos1 --format robomimic --out {root}/set.hdf5",

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -94,12 +95,30 @@ TEST(LeaderboardFormats, EachWrittenFileIsRecognisedAsOursAndReplacedAgain) {
   fs::remove_all(dir);
 }
 
+// The generation folder of PAGE_files/ that the page at `page` links (empty if none).
+fs::path linked_media(const fs::path& page) {
+  const std::string text = read(page);
+  const std::string folder = page.stem().string() + "_files/";
+  const std::size_t at = text.find("\"" + folder + "m-");
+  if (at == std::string::npos) return {};
+  return page.parent_path() / (page.stem().string() + "_files") / text.substr(at + 1 + folder.size(), 18);
+}
+
+std::vector<std::string> entries_of(const fs::path& folder) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(folder)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 TEST(ResultsPage, WritesEvalInfoPerLearnedRowAndPreviewsWhereKept) {
   const fs::path dir = test::scratch_path("dicestack_page_test");
   fs::remove_all(dir);
   fs::create_directories(dir);
   write_leaderboard(small_board(), "html", dir / "board.html");
-  const fs::path media = dir / "board_files";
+  const fs::path media = linked_media(dir / "board.html");
+  ASSERT_FALSE(media.empty()) << "the page links no generation of its media";
+  EXPECT_EQ(entries_of(dir / "board_files"), (std::vector<std::string>{"dicestack-page.json", media.filename().string()}));
   EXPECT_TRUE(fs::exists(media / "previews" / "row-01-success.gif"));
   EXPECT_TRUE(fs::exists(media / "previews" / "row-01-failure.gif"));
   EXPECT_FALSE(fs::exists(media / "previews" / "row-02-success.gif")) << "row 2 kept no previews";
@@ -114,7 +133,48 @@ TEST(ResultsPage, WritesEvalInfoPerLearnedRowAndPreviewsWhereKept) {
   EXPECT_EQ(info["video_paths"], (nlohmann::json{"previews/row-01-success.gif", "previews/row-01-failure.gif"}));
   // The page refers to its media by the folder's name, relative to itself.
   const std::string page = read(dir / "board.html");
-  EXPECT_NE(page.find("\"board_files/previews/row-01-success.gif\""), std::string::npos);
+  EXPECT_NE(page.find("\"board_files/" + media.filename().string() + "/previews/row-01-success.gif\""), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(ResultsPage, APageAndItsMediaAreOneUnitAndOnlyTheLinkedMediaStay) {
+  const fs::path dir = test::scratch_path("dicestack_page_pair_test");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path page = dir / "board.html";
+  write_leaderboard(small_board(), "html", page);
+  const std::string first_page = read(page);
+  const fs::path first = linked_media(page);
+  // The same board again: the same media, the same generation, the same page.
+  write_leaderboard(small_board(), "html", page);
+  EXPECT_EQ(read(page), first_page);
+  EXPECT_EQ(linked_media(page), first);
+  // Another board: a new generation, linked; the old one is gone; a dead run's scratch too.
+  const fs::path dead_scratch = dir / "board_files" / ".generation.tmp-999999999-x";
+  fs::create_directories(dead_scratch);
+  write_leaderboard(small_board("another"), "html", page);
+  const fs::path second = linked_media(page);
+  ASSERT_FALSE(second.empty());
+  EXPECT_NE(second, first);
+  EXPECT_EQ(entries_of(dir / "board_files"), (std::vector<std::string>{"dicestack-page.json", second.filename().string()}));
+  EXPECT_TRUE(fs::exists(second / "previews" / "row-01-success.gif"));
+  const auto marker = nlohmann::json::parse(read(dir / "board_files" / "dicestack-page.json"));
+  EXPECT_EQ(marker["version"], 2) << "a folder of generations";
+  fs::remove_all(dir);
+}
+
+TEST(ResultsPage, AMediaFolderOfTheOlderLayoutBecomesOneOfGenerations) {
+  // Version 1 wrote the media at the folder's top; the page that linked them is replaced whole.
+  const fs::path dir = test::scratch_path("dicestack_page_v1_test");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "board_files" / "previews");
+  std::ofstream(dir / "board_files" / "dicestack-page.json") << R"({"format": "dicestack-page-media", "version": 1})";
+  std::ofstream(dir / "board_files" / "previews" / "row-01-success.gif") << "GIF89a";
+  std::ofstream(dir / "board.html") << kResultsPageMarker << "\n<p>old</p>";
+  write_leaderboard(small_board(), "html", dir / "board.html");
+  const fs::path media = linked_media(dir / "board.html");
+  EXPECT_EQ(entries_of(dir / "board_files"), (std::vector<std::string>{"dicestack-page.json", media.filename().string()}));
+  EXPECT_EQ(nlohmann::json::parse(read(dir / "board_files" / "dicestack-page.json"))["version"], 2);
   fs::remove_all(dir);
 }
 
@@ -131,9 +191,18 @@ TEST(ResultsPage, NoTextFromTheRunCanCloseItsScript) {
 }
 
 TEST(ResultsPage, RefersToAMediaFolderWhateverItsName) {
-  const std::string page = results_page_html(small_board(), "my #1 b\xc3\xb6" "ard_files");
-  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/previews/row-01-success.gif\""), std::string::npos);
-  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/eval_info/row-01.json\""), std::string::npos);
+  const fs::path dir = test::scratch_path("dicestack_page_name_test");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_leaderboard(small_board(), "html", dir / "my #1 b\xc3\xb6" "ard.html");
+  const std::string page = read(dir / "my #1 b\xc3\xb6" "ard.html");
+  const std::size_t at = page.find("\"my%20%231%20b%C3%B6ard_files/m-");
+  ASSERT_NE(at, std::string::npos);
+  const std::string generation = page.substr(at + 1 + std::string("my%20%231%20b%C3%B6ard_files/").size(), 18);
+  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/" + generation + "/previews/row-01-success.gif\""), std::string::npos);
+  EXPECT_NE(page.find("\"my%20%231%20b%C3%B6ard_files/" + generation + "/eval_info/row-01.json\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "my #1 b\xc3\xb6" "ard_files" / generation / "previews" / "row-01-success.gif"));
+  fs::remove_all(dir);
 }
 
 TEST(ResultsPage, AUsersFolderBesideThePageIsRefusedBeforeAnythingIsWritten) {

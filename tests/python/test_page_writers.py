@@ -49,8 +49,10 @@ def test_view_dataset_writes_the_clis_page_for_a_folder(few_folder, few, tmp_pat
     assert data["title"] == f"dicestack episodes: {few_folder}"
     assert "four <b>built-in</b> episodes" in data["facts"]
     assert "<b>built-in</b>" not in text  # inlined as \u003c escapes, never as markup
-    scripts = sorted(p.name for p in (tmp_path / "view_files" / "episodes").iterdir())
-    assert scripts == [f"episode_{i:06d}.js" for i in range(len(few))]
+    # Each episode's script sits in the media generation the page links, in view_files/.
+    scripts = [tmp_path / e["script"] for e in data["episodes"]]
+    assert all(s.parent.parent.parent == tmp_path / "view_files" and s.is_file() for s in scripts)
+    assert sorted(p.name for p in scripts[0].parent.iterdir()) == [f"episode_{i:06d}.js" for i in range(len(few))]
     dicestack.view_dataset(few_folder, page)  # its own page: replaced
 
 
@@ -61,8 +63,8 @@ def test_view_dataset_is_byte_for_byte_the_command_lines(few_folder, tmp_path, c
     dicestack.view_dataset(few_folder, ours)
     subprocess.run([cli, "dataset", "view", str(few_folder), "--out", str(theirs)], check=True, capture_output=True)
     assert ours.read_bytes() == theirs.read_bytes()
-    for script in (theirs.parent / "view_files" / "episodes").iterdir():
-        assert (ours.parent / "view_files" / "episodes" / script.name).read_bytes() == script.read_bytes()
+    for e in page_data(theirs)["episodes"]:
+        assert (ours.parent / e["script"]).read_bytes() == (theirs.parent / e["script"]).read_bytes()
 
 
 def test_view_dataset_takes_episodes(few, tmp_path):

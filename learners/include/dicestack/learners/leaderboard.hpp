@@ -108,8 +108,9 @@ struct LeaderboardFormat {
   std::function<Ownership()> ownership;
   /// The first line of a written file (a marker comment), or empty.
   std::string marker;
-  /// Files written beside the table before it (the html page's media folder), or empty.
-  std::function<void(const Leaderboard&, const std::filesystem::path& out)> write_beside{};
+  /// Writes the file `out` and what goes beside it as one unit (the html page and its media
+  /// folder); empty: `marker` and render()'s text are written to `out`.
+  std::function<void(const Leaderboard&, const std::filesystem::path& out)> write{};
   /// Files beside --out that it writes, checked before any work (empty: none).
   std::function<void(const std::filesystem::path& out)> check_beside{};
   /// The format the command line prints after writing the file (empty: this one).

@@ -17,7 +17,7 @@ inline constexpr const char* kResultsPageMarker = "<!-- dicestack results page -
 
 /// The page: the header facts, the table (sortable by any column, rates with their intervals)
 /// and, per row, its previews and a link to its per-episode results, all under `media` (the
-/// media folder as the page refers to it; empty: a page without media). Its data is inlined as
+/// media's URL relative to the page, escaped: url_segment; empty: a page without media). Its data is inlined as
 /// JSON and every text from the run (names, paths, options) is shown as text, never as markup.
 std::string results_page_html(const Leaderboard& board, const std::string& media);
 
@@ -30,10 +30,12 @@ Ownership results_page_ownership();
 /// Throws InputError unless nothing exists at `folder` or it is a media folder dicestack wrote.
 void check_page_media_replaceable(const std::filesystem::path& folder);
 
-/// Writes the media folder whole (replacing only one of ours): eval_info/row-NN.json per row
-/// with rollouts, previews/row-NN-success.gif and -failure.gif per row with previews, and the
-/// marker file dicestack-page.json. Throws InputError.
-void write_page_media(const Leaderboard& board, const std::filesystem::path& folder);
+/// `leaderboard --format html --out PAGE.html`: the page and its media folder PAGE_files/, written
+/// as one unit (a run killed at any point leaves the old page with its media, or the new pair).
+/// The media sit in PAGE_files/m-<digest>/: eval_info/row-NN.json per row with rollouts,
+/// previews/row-NN-success.gif and -failure.gif per row with previews; PAGE_files/ holds the
+/// marker file dicestack-page.json. Replaces only a page and folder of ours. Throws InputError.
+void write_results_page(const Leaderboard& board, const std::filesystem::path& page);
 
 /// Throws InputError unless nothing exists at `dir` or it is a report dicestack wrote.
 void check_report_replaceable(const std::filesystem::path& dir);
@@ -46,8 +48,9 @@ void write_report_folder(const Leaderboard& board, const std::filesystem::path& 
 /// lists the episodes with their outcomes; the chosen one plays as an animation drawn from its
 /// recorded states, in step with plots of the cup's x, y and angle, the dice's heights and the
 /// three actions, a cursor following the playback. Each episode's numbers are a script in
-/// <page>_files/episodes/ that the page loads when it is chosen (a file:// page cannot fetch),
-/// so the page stays small for any number of episodes. Replaces only a page and folder of ours.
+/// <page>_files/m-<digest>/episodes/ that the page loads when it is chosen (a file:// page cannot
+/// fetch), so the page stays small for any number of episodes. The page and that folder are
+/// written as one unit, as write_results_page's. Replaces only a page and folder of ours.
 void write_dataset_viewer(const DemoSet& set, const std::string& name, const std::filesystem::path& page);
 
 }  // namespace dicestack
