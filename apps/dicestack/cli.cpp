@@ -20,11 +20,16 @@ struct RootOnly {};
 }  // namespace
 
 int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
-  const FailFn fail = fail_fn ? fail_fn : [](const std::string& message, int code) {
-    std::cerr << message << '\n';
+  // Every message is shown with any overlong value a user gave cut short (readable_message).
+  const FailFn fail = [&fail_fn](const std::string& message, int code) {
+    if (fail_fn) return fail_fn(readable_message(message), code);
+    std::cerr << readable_message(message) << '\n';
     return code;
   };
   CLI::App app{"dicestack: imitation learning for dynamic dice stacking", "dicestack"};
+  app.failure_message([](const CLI::App* parsed, const CLI::Error& e) {
+    return readable_message(CLI::FailureMessage::simple(parsed, e));
+  });
   app.set_version_flag("--version", "dicestack " DICESTACK_VERSION);
   app.require_subcommand(1);
   app.fallthrough();  // --plugin may follow any subcommand

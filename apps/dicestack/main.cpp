@@ -1,6 +1,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <dicestack/core/error.hpp>
+
 #include "cli.hpp"
 
 #ifdef DICESTACK_WITH_MPI
@@ -44,7 +46,7 @@ int main(int argc, char** argv) {
     try {
       return run_as_rank(argc, argv);
     } catch (const std::exception& e) {  // MPI itself failed to start
-      std::fprintf(stderr, "dicestack: error: %s\n", e.what());
+      std::fprintf(stderr, "dicestack: error: %s\n", dicestack::readable_message(e.what()).c_str());
       return 1;
     }
   }

@@ -213,6 +213,26 @@ TEST(CliInput, AKeyGivenTwiceInAnyJsonFileIsRefusedNamingIt) {
   fs::remove_all(dir);
 }
 
+// A value far longer than any name (a pasted file, a runaway script) is cut in the message,
+// whichever parser refuses it: the message stays readable, the value's start and end shown.
+TEST(CliInput, AnOverlongValueInAnyOptionIsCutInTheMessage) {
+  const std::string v(50000, 'v');
+  const std::string out = " --out " + test::scratch_path("dicestack_cli_overlong.dsm").string();
+  const std::vector<std::string> cases{"train --regressor knn --set k=" + v + out,
+                                       "train --regressor " + v + out,
+                                       "train --regressor knn --learner dart --option expert=" + v + out,
+                                       "train --regressor knn --features state+" + v + out,
+                                       "leaderboard --learners dart:" + v,
+                                       "train --regressor knn --episodes " + v + out,
+                                       "evaluate --model /nonexistent/" + v};
+  for (const auto& args : cases) {
+    const Process p = run_within(20, args);
+    EXPECT_NE(p.status, 0) << args.substr(0, 60);
+    EXPECT_LT(p.output.size(), 2000u) << args.substr(0, 60) << "\n" << p.output.substr(0, 400);
+    EXPECT_THAT(p.output, HasSubstr("characters cut]...")) << args.substr(0, 60) << "\n" << p.output.substr(0, 400);
+  }
+}
+
 TEST(Cli, RolloutWritesAPng) {
   const auto png = test::scratch_path("dicestack_cli_rollout.png");
   std::filesystem::remove(png);

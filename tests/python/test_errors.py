@@ -121,3 +121,10 @@ def test_demos_that_are_not_recordings_say_what_they_are():
 def test_training_on_no_episode_names_the_demonstrations():
     with pytest.raises(ValueError, match="<episodes from Python>: no episode to train on"):
         dicestack.train("knn", demos=[], split="none")
+
+
+def test_an_overlong_value_is_cut_in_the_message(builtin_episodes):
+    # A value far longer than any name is shown by its start and end, not in full.
+    with pytest.raises(ValueError) as e:
+        dicestack.train("knn", demos=builtin_episodes[:2], features="state+" + "v" * 1_000_000)
+    assert len(str(e.value)) < 2000 and "characters cut]..." in str(e.value)

@@ -1,6 +1,7 @@
 #pragma once
 // Error taxonomy shared by every dicestack library (STYLE 7). Libraries throw; apps/ turns an
 // Error into "dicestack: error: <what>" and exit status 1.
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -29,5 +30,14 @@ class PluginError : public Error {
  public:
   using Error::Error;
 };
+
+/// The longest word (a run without spaces) a message shows whole: longer ones are values a
+/// user gave (a 1 MB option, a pasted file) and would bury the message.
+inline constexpr std::size_t kLongestWordShown = 200;
+
+/// `message` with every word longer than `longest` cut to its start and end around
+/// "...[N characters cut]...", at UTF-8 character boundaries: how the tool and the Python module
+/// show any error, whichever library or parser wrote it.
+std::string readable_message(const std::string& message, std::size_t longest = kLongestWordShown);
 
 }  // namespace dicestack
