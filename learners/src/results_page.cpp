@@ -86,8 +86,8 @@ constexpr const char* kLeaderboardScript = R"JS(
 const columns = [
   { key: "rank", label: "#", value: (r) => r.rank, text: (r) => String(r.rank) },
   { key: "regressor", label: "regressor" },
-  { key: "learner", label: "learner" },
-  { key: "features", label: "features" },
+  { key: "learner", label: "learner", text: (r) => breakable(r.learner) },
+  { key: "features", label: "features", text: (r) => breakable(r.features) },
   { key: "train_error", label: "train error", value: (r) => r.train_error, text: (r) => fixed(3)(r.train_error) },
   { key: "test_error", label: "test error", value: (r) => r.test_error, text: (r) => fixed(3)(r.test_error) },
   { key: "dice_in_cup_mean", label: "dice in cup", value: (r) => r.dice_in_cup_mean, text: (r) => fixed(2)(r.dice_in_cup_mean) },
@@ -132,8 +132,22 @@ const pct = (v) => Math.round(100 * v) + "%";
 const fixed = (digits) => (v) => (v < 0 ? "-" : v.toFixed(digits));
 const rate = (key) => ({
   value: (r) => r[key + "_rate"],
-  text: (r) => pct(r[key + "_rate"]) + " [" + pct(r[key + "_ci95"][0]).slice(0, -1) + "-" + pct(r[key + "_ci95"][1]).slice(0, -1) + "]",
+  // The interval may go under the rate, whole: the table fits a laptop's width.
+  text: (r) => {
+    const f = document.createDocumentFragment();
+    f.append(pct(r[key + "_rate"]) + " ", el("span", { class: "interval" },
+             "[" + pct(r[key + "_ci95"][0]).slice(0, -1) + "-" + pct(r[key + "_ci95"][1]).slice(0, -1) + "]"));
+    return f;
+  },
+  className: "num rate",
 });
+// `text` with a line break allowed after each "+", "/" and ":" (a feature map's or a learner
+// spec's long name).
+function breakable(text) {
+  const f = document.createDocumentFragment();
+  text.split(/(?<=[+\/:])/).forEach((part, i) => { if (i > 0) f.append(el("wbr")); f.append(part); });
+  return f;
+}
 function el(tag, attrs, ...children) {
   const e = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
@@ -142,7 +156,9 @@ function el(tag, attrs, ...children) {
 }
 document.title = data.title;
 document.getElementById("title").textContent = data.title;
-document.getElementById("header").textContent = data.header;
+// The header line says what the facts say: shown only on a page without facts.
+if (data.facts.length === 0) document.getElementById("header").textContent = data.header;
+else document.getElementById("header").remove();
 const facts = document.getElementById("facts");
 for (const [k, v] of data.facts) facts.append(el("dt", {}, k), el("dd", {}, typeof v === "string" ? v : JSON.stringify(v)));
 // columns: {key, label, value(row), text(row), className}: value (a number, kept in data-value)
@@ -200,6 +216,7 @@ dl#facts dd { margin: 0; word-break: break-word; }
 table { border-collapse: collapse; margin-top: 1em; }
 th, td { border-bottom: 1px solid #ddd; padding: .3em .6em; text-align: left; vertical-align: top; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.rate { white-space: normal; } span.interval { white-space: nowrap; }
 th button { font: inherit; font-weight: 600; background: none; border: none; cursor: pointer; padding: 0; }
 th[aria-sort="ascending"] button::after { content: " \25B2"; }
 th[aria-sort="descending"] button::after { content: " \25BC"; }
@@ -207,6 +224,7 @@ div.media { display: flex; gap: .5em; }
 figure { margin: 0; }
 figcaption, .none { font-size: .8em; color: #666; }
 img.preview { display: block; background: #eee; }
+@media (max-width: 1700px) { img.preview { width: 150px; height: auto; } figure { max-width: 150px; } }
 img.success { outline: 2px solid #2a8; } img.failure { outline: 2px solid #c44; }
 )CSS";
 

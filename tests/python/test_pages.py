@@ -165,6 +165,25 @@ def test_text_from_the_demonstrations_shows_as_text(browser, board, demos):
     assert no_console_errors(browser) == []
 
 
+def test_the_leaderboard_page_fits_a_laptops_width_and_says_its_facts_once(browser, demos, tmp_path):
+    # At 1,400 px the table, its longest names and its previews fit without a horizontal
+    # scrollbar; the header line is not repeated above the facts that say the same.
+    page = tmp_path / "wide.html"
+    dicestack.leaderboard(["knn", "linear_svr"], ["bc"], demos, features=["state+clock+start_state@dice+retry/position"],
+                          episodes=4, seed=1, out=page, progress=False)
+    browser.set_window_size(1400, 900)
+    try:
+        open_page(browser, page)
+        widths = browser.execute_script(
+            "return [document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+        assert widths[0] <= widths[1], widths
+        assert browser.find_elements(By.ID, "header") == []
+        assert "state+clock+start_state@dice+retry/position" in browser.find_element(By.ID, "facts").text
+        assert no_console_errors(browser) == []
+    finally:
+        browser.set_window_size(1600, 1000)
+
+
 def test_the_page_needs_no_network(board):
     page, _ = board
     text = page.read_text()
