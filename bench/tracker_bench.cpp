@@ -2,17 +2,20 @@
 // realistic success, wall contact, which recordings it chose and how many simulations its
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
-//       [--recordings K [--subset-seed S]] [--probes P] [--paths N] [--no-optimise]
+//       [--recordings K [--subset-seed S]] [--preset plain|distill] [--set NAME=VALUE]... [--probes P] [--paths N] [--no-optimise]
 //       [--noise F [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path] [--json]
 //       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv] [--retry]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
+// The tracker is the preset (tracker_preset, default plain) with each setting on top, in order:
+// --set NAME=VALUE for any (tracker_setting_names), and --probes, --paths, ... for the same
+// names with dashes.
 // --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
 // from each start instead, with and without that noise, and lists them by successes.
-// --rescue N runs the tracker expert with rescue_interval N (closed loop on the dice) instead of
+// --rescue N runs the tracker expert with rescue N (closed loop on the dice) instead of
 // the chosen path's follower; --retry runs it trying again once a failed attempt has come to rest
-// (ExpertConfig::retry). --robust K makes robust choices (TrackerConfig::robust_trials);
+// (ExpertConfig::retry). --robust K makes robust choices (TrackerConfig::robust);
 // --choices writes each start's dice x, chosen recording, warp and outcome.
 #include <algorithm>
 #include <chrono>
@@ -37,9 +40,11 @@ namespace {
 
 struct Options {
   std::string demos = "human";
-  int starts = 100, threads = 0, keep = 0;
+  int starts = 100, threads = 0, recordings = 0;
   std::uint64_t seed = 1000, subset_seed = 0;
-  TrackerConfig tracker;
+  std::string preset = "plain";        // --preset: tracker_preset's name
+  std::vector<std::string> settings;   // NAME=VALUE on top, in the order given
+  TrackerConfig tracker;               // the preset with the settings
   double noise = 0.0, noise_from = 0.0, noise_to = 1e9;
   bool per_path = false, json = false, retry = false;
   std::string choices;  // --choices FILE: one CSV line per start
@@ -57,19 +62,19 @@ Options parse(int argc, char** argv) {
     else if (a == "--starts") o.starts = std::stoi(next());
     else if (a == "--seed") o.seed = std::stoull(next());
     else if (a == "--threads") o.threads = std::stoi(next());
-    else if (a == "--recordings") o.keep = std::stoi(next());
+    else if (a == "--recordings") o.recordings = std::stoi(next());
     else if (a == "--subset-seed") o.subset_seed = std::stoull(next());
-    else if (a == "--probes") o.tracker.probes = std::stoi(next());
-    else if (a == "--paths") o.tracker.keep = std::stoi(next());
-    else if (a == "--no-optimise") o.tracker.optimise = false;
-    else if (a == "--rescue") o.tracker.rescue_interval = std::stoi(next());
+    else if (a == "--preset") o.preset = next();
+    else if (a == "--set") o.settings.push_back(next());
+    else if (a == "--no-optimise") o.settings.push_back("optimise=false");
+    else if (a == "--keep-extremes") o.settings.push_back("keep_extremes=true");
     else if (a == "--retry") o.retry = true;
-    else if (a == "--smooth") o.tracker.smooth = std::stod(next());
-    else if (a == "--robust") o.tracker.robust_trials = std::stoi(next());
-    else if (a == "--robust-noise") o.tracker.robust_noise = std::stod(next());
-    else if (a == "--robust-warp") o.tracker.robust_warp = std::stod(next());
-    else if (a == "--keep-extremes") o.tracker.keep_extremes = true;
-    else if (a == "--shrink") o.tracker.shrink_steps = std::stoi(next());
+    else if (a == "--probes" || a == "--paths" || a == "--rescue" || a == "--smooth" || a == "--robust" ||
+             a == "--robust-noise" || a == "--robust-warp" || a == "--shrink") {
+      std::string name = a.substr(2);
+      std::replace(name.begin(), name.end(), '-', '_');  // the setting's own name
+      o.settings.push_back(name + "=" + next());
+    }
     else if (a == "--noise") o.noise = std::stod(next());
     else if (a == "--noise-window") {
       const std::string v = next();
@@ -80,6 +85,7 @@ Options parse(int argc, char** argv) {
     else throw std::runtime_error("unknown argument " + a);
   }
   if (o.starts < 1) throw std::runtime_error("--starts must be >= 1");
+  o.tracker = tracker_config(o.preset, o.settings);
   return o;
 }
 
@@ -135,7 +141,7 @@ int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
   const WorldConfig world;
   const std::vector<Episode> episodes =
-      pick_recordings(read_demo_set(resolve_demo_set(o.demos, world)).episodes, o.keep, o.subset_seed);
+      pick_recordings(read_demo_set(resolve_demo_set(o.demos, world)).episodes, o.recordings, o.subset_seed);
   if (o.per_path) return per_path(episodes, world, o);
 
   using clock = std::chrono::steady_clock;
@@ -163,7 +169,7 @@ int main(int argc, char** argv) try {
     r.choice = choose_path(*recordings, env, sims.at(w), s);
     const PathFollower follower(recordings->paths()[r.choice.path], r.choice.warp, env.get_state(), env.t(),
                                 o.tracker.gain, o.tracker.keep_extremes);
-    Expert* expert = o.tracker.rescue_interval > 0 || o.retry ? experts[static_cast<std::size_t>(w)].get() : nullptr;
+    Expert* expert = o.tracker.rescue > 0 || o.retry ? experts[static_cast<std::size_t>(w)].get() : nullptr;
     if (expert) expert->reset(s);
     r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);
   });

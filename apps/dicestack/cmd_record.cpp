@@ -28,6 +28,7 @@ struct RecordOptions {
   int threads = 0;
   double noise = 0.0;
   std::string perturb = "none";
+  TrackerOption tracker;
   bool successes_only = false, no_replan = false, retry = false;
   bool json = false;
 };
@@ -48,11 +49,13 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
     if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
     const auto dir = resolve_demo_set(opt.demos, world);
     const DemoSet demos = read_demo_set(dir);
-    expert.recordings = make_recordings(demos.episodes, world, {}, opt.seed, opt.threads, cluster);
+    expert.recordings = make_recordings(demos.episodes, world, opt.tracker.config(), opt.seed, opt.threads, cluster);
     recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
                  " (" + (demos.description.empty() ? "no description" : demos.description) + ")";
   } else if (!opt.demos.empty()) {
     throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
+  } else if (opt.tracker.given()) {
+    throw ConfigError("record: --tracker-preset and --tracker set --expert tracker; expert " + opt.expert + " has neither");
   }
   RecordRequest request;
   request.seed = opt.seed;
@@ -64,13 +67,14 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   require_memory("recording", static_cast<std::uint64_t>(opt.episodes), kEpisodeEntryBytes, "episodes");
   DemoSet header;
   header.world = world;
-  header.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string());
+  header.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
+                       opt.tracker.as_arguments();
   header.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
                       std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
                       (opt.no_replan ? " --no-replan" : "") + (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
                       (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
                       (opt.world.start == "random" ? "" : " --start " + opt.world.start) +
-                      (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
+                      (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) + opt.tracker.as_arguments() +
                       "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
                       (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
                                              std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
@@ -144,6 +148,7 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--out", opt->out, "Demonstration folder to write (missing, empty, or a dicestack set, which is replaced whole)")->required();
   cmd->add_option("--demos", opt->demos,
                   "tracker: the recordings it follows (a demonstration folder, builtin or human)");
+  opt->tracker.add_to(*cmd);
   cmd->add_option("--threads", opt->threads, "Threads (0 = all cores); results do not depend on it")->check(threads_check())->capture_default_str();
   cmd->add_option("--perturb", opt->perturb,
                   "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "

@@ -27,6 +27,7 @@ struct RobustnessOptions {
   std::uint64_t seed = 0;
   int threads = 0;
   std::vector<std::string> factors;
+  TrackerOption tracker;
 };
 
 void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
@@ -34,6 +35,8 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   if (opt.model.empty() == opt.expert.empty()) throw ConfigError("robustness: give one of --model M or --expert NAME");
   if (!opt.demos.empty() && opt.expert != "tracker")
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
+  if (opt.tracker.given() && opt.expert != "tracker")
+    throw ConfigError("robustness: --tracker-preset and --tracker set --expert tracker");
   const bool sensed = opt.expert_feedback == "observations";
   if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
@@ -65,12 +68,14 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     if (opt.expert == "tracker") {
       if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
       config.recordings =
-          make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, {}, opt.seed, opt.threads, cluster);
+          make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, opt.tracker.config(), opt.seed,
+                          opt.threads, cluster);
     }
     make_expert(opt.expert, config);  // an unknown name fails here, before any row
     const ExpertFeedback feedback = sensed ? ExpertFeedback::observations : ExpertFeedback::world;
     factory = [name = opt.expert, config, feedback] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config), feedback); };
     run.policy = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")") +
+                 opt.tracker.as_arguments() +
                  (sensed ? ", feedback on the observations" : "");
     request.reads_world = !sensed;
   }
@@ -109,6 +114,7 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--model", opt->model, "Model file written by `dicestack train`")->check(CLI::ExistingFile);
   cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
+  opt->tracker.add_to(*cmd);
   cmd->add_option("--expert-feedback", opt->expert_feedback,
                   "What the expert's feedback acts on: world (its own privilege; the sensing factors are left out) or "
                   "observations (what a policy is shown; its choices still read the world)")

@@ -27,6 +27,24 @@ WorldConfig WorldOption::load() const {
   return with_starts(path.empty() ? WorldConfig{} : load_world_config(path), start);
 }
 
+void TrackerOption::add_to(CLI::App& app) {
+  std::string presets;
+  for (const auto& n : tracker_preset_names()) presets += (presets.empty() ? "" : ", ") + n;
+  std::string names;
+  for (const auto& n : tracker_setting_names()) names += (names.empty() ? "" : ", ") + n;
+  app.add_option("--tracker-preset", preset,
+                 "tracker: its named settings (" + presets + "; distill is the learners' default, docs/expert.md)")
+      ->check(CLI::IsMember(tracker_preset_names()))
+      ->capture_default_str();
+  app.add_option("--tracker", settings, "tracker: a setting on top of the preset, NAME=VALUE, repeatable (" + names + ")");
+}
+
+std::string TrackerOption::as_arguments() const {
+  std::string out = preset == "plain" ? "" : " --tracker-preset " + preset;
+  for (const auto& s : settings) out += " --tracker " + s;
+  return out;
+}
+
 void print_line(const std::string& text) { std::cout << text << '\n' << std::flush; }
 
 void print_progress(const std::string& text) {

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <dicestack/core/cluster.hpp>
+#include <dicestack/core/tracker.hpp>
 #include <dicestack/core/world_config.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 
@@ -22,6 +23,20 @@ struct WorldOption {
   /// The config from the file, or the defaults when no file was given, with `--start`'s
   /// distribution.
   WorldConfig load() const;
+};
+
+/// `--tracker-preset NAME` and `--tracker NAME=VALUE` (repeatable): the tracker expert's settings,
+/// by the names the learners' tracker_* options and the bench use (tracker_preset, tracker_config).
+struct TrackerOption {
+  std::string preset = "plain";
+  std::vector<std::string> settings;
+  void add_to(CLI::App& app);
+  /// Whether any was given (for an expert that is not the tracker, an error).
+  bool given() const { return preset != "plain" || !settings.empty(); }
+  /// The preset with the settings on top; throws ConfigError naming a bad one.
+  TrackerConfig config() const { return tracker_config(preset, settings); }
+  /// " --tracker-preset P --tracker K=V ..." as given, for a set's provenance.
+  std::string as_arguments() const;
 };
 
 /// `--seed`: a whole number in [0, 2^64 - 1], written in digits without leading zeros (CLI11

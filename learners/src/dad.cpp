@@ -343,7 +343,7 @@ class Dad final : public Learner {
   // The targets from training starts: the tracker's successful episodes (the recordings of
   // --demos, each start's choice moved into its frame and followed), without noise.
   std::vector<Episode> tracker_targets(const LearnContext& c, std::string& followed) const {
-    ExpertConfig expert = learner_expert_config("tracker", params(), c);
+    ExpertConfig expert = learner_expert_config("tracker", *this, c);
     expert.retry = expert_retries(params().choice("retry"), c.features);
     RecordRequest request;
     request.episodes = static_cast<int>(params().integer("episodes"));

@@ -29,7 +29,7 @@ class Dagger final : public Learner {
     const int iterations = static_cast<int>(params().integer("iterations"));
     const int rollouts = static_cast<int>(params().integer("rollouts"));
     const std::string expert_name = params().choice("expert");
-    ExpertConfig expert_config = learner_expert_config(expert_name, params(), c);
+    ExpertConfig expert_config = learner_expert_config(expert_name, *this, c);
     // Without replanning, mpc's labels are a function of the start, the step and the state: the
     // same on and off its own path (docs/learners.md).
     expert_config.replan = params().boolean("replan");

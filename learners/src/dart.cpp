@@ -37,7 +37,7 @@ class Dart final : public Learner {
       if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
     if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
     std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
-    ExpertConfig expert = learner_expert_config(params().choice("expert"), params(), c);
+    ExpertConfig expert = learner_expert_config(params().choice("expert"), *this, c);
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = params().boolean("replan");
@@ -67,8 +67,7 @@ class Dart final : public Learner {
     r.model->record["expert"] = params().choice("expert");
     r.model->record["dart_episodes"] = std::to_string(episodes);
     if (params().choice("expert") == "tracker") {  // the option may say -1: the map's default
-      r.model->record["tracker_paths"] = std::to_string(
-          tracker_paths_for(static_cast<int>(params().integer("tracker_paths")), c.features));
+      r.model->record["tracker_paths"] = std::to_string(expert.recordings->config().paths);
       r.model->record["tracker_followed"] = followed_recordings(*expert.recordings);
     }
     r.model->record["dart_expert_successes"] = std::to_string(successes);

@@ -3,6 +3,7 @@
 #include <dicestack/datasets/features.hpp>
 
 #include <array>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -57,32 +58,23 @@ std::string number_text(double v) {
 // path alone: 38-43 % as velocities). Measured in docs/learners.md.
 constexpr int kServoPaths = 1, kOtherPaths = 3;
 
-// The smoothing widths the learners' tracker ranks each recording at, besides tracker_smooth.
-constexpr std::array<double, 7> kVariantWidths{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0};
-
-// The tracker as the learners' expert: the bare tracker's settings but for what was tuned for
-// DART on the tuning seeds (docs/learners.md, "Policies from the human recordings"): the
-// best-ranked recordings, smoothed, chosen robust to a learner's errors, narrowed before
+// The learners' tracker preset: tuned for DART on the tuning seeds (docs/learners.md, "Policies
+// from the human recordings"): smoothed, chosen robust to a learner's errors, narrowed before
 // warped where none succeeds as recorded (in the dice frame 80.8 -> 83.0 %, and a 3x faster
 // search), each recording's smoothing chosen among variants (from 3 recordings 36 -> 81 %).
-TrackerConfig learner_tracker_defaults() {
-  TrackerConfig d;
-  d.shrink_steps = 5;
-  d.keep = -1;  // kServoPaths or kOtherPaths
-  d.smooth = 4.0;
-  d.robust_trials = 5;
-  d.robust_warp = 0.02;
-  d.smooth_variants.assign(kVariantWidths.begin(), kVariantWidths.end());
-  return d;
-}
+constexpr const char* kLearnerPreset = "distill";
 
 std::vector<ParamSpec> tracker_param_specs() {
-  const TrackerConfig d = learner_tracker_defaults();
-  return {{"tracker_probes", ParamType::integer, std::to_string(d.probes), 0, 100000,
+  const TrackerConfig d = tracker_preset(kLearnerPreset);
+  return {{"tracker_preset", ParamType::choice, kLearnerPreset, 0, 0,
+           "tracker: the named settings the other tracker_* options change (distill: tuned for a learner, the "
+           "defaults shown; plain: the tracker of record and robustness)",
+           tracker_preset_names()},
+          {"tracker_probes", ParamType::integer, std::to_string(d.probes), 0, 100000,
            "tracker: training starts that rank the recordings (most successes first)", {}},
           {"tracker_optimise", ParamType::boolean, d.optimise ? "true" : "false", 0, 1,
            "tracker: search timing, offset and amplitude when no recording succeeds as recorded", {}},
-          {"tracker_paths", ParamType::integer, std::to_string(d.keep), -1, 1000000,
+          {"tracker_paths", ParamType::integer, "-1", -1, 1000000,
            "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all; "
            "-1: 1 with a /position map, else 3)", {}},
           {"tracker_demos", ParamType::text, "same", 0, 0,
@@ -91,10 +83,10 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: follow only this many of the demonstrations, drawn with the seed (0: all)", {}},
           {"tracker_smooth", ParamType::real, number_text(d.smooth), 0, 1000,
            "tracker: smooth each path by a Gaussian of this std in steps before following it (0: as recorded)", {}},
-          {"tracker_rescue", ParamType::integer, std::to_string(d.rescue_interval), 0, 100000,
+          {"tracker_rescue", ParamType::integer, std::to_string(d.rescue), 0, 100000,
            "tracker: every this many steps, check the path's rest still succeeds and join another recording "
            "midway when not (0: choose once per episode)", {}},
-          {"tracker_robust", ParamType::integer, std::to_string(d.robust_trials), 0, 1000,
+          {"tracker_robust", ParamType::integer, std::to_string(d.robust), 0, 1000,
            "tracker: noisy trials a choice must also pass, and that rank the recordings (0: off)", {}},
           {"tracker_robust_noise", ParamType::real, number_text(d.robust_noise), 0, 10,
            "tracker: the std of those trials' executed-action noise, as a fraction of action.scale", {}},
@@ -102,16 +94,16 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: std of each noisy trial's random warp (time scale, offset m, amplitude; 0: none)", {}},
           {"tracker_keep_extremes", ParamType::boolean, d.keep_extremes ? "true" : "false", 0, 1,
            "tracker: narrow a moved path's swing to reach no further than the recording's", {}},
-          {"tracker_shrink", ParamType::integer, std::to_string(d.shrink_steps), 0, 100,
+          {"tracker_shrink", ParamType::integer, std::to_string(d.shrink), 0, 100,
            "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}},
-          {"tracker_variants", ParamType::boolean, d.smooth_variants.empty() ? "false" : "true", 0, 1,
+          {"tracker_variants", ParamType::boolean, d.variants.empty() ? "false" : "true", 0, 1,
            "tracker: also rank the 8 best-ranked recordings smoothed by each of 0, 1, 2, 3, 4, 6 and 8 steps, score "
            "the 4 best paths again from 4 x tracker_probes more probe starts, and follow the best", {}}};
 }
 
 std::string followed_recordings(const Recordings& recordings) {
   const TrackerConfig& c = recordings.config();
-  const int most = c.probes * (1 + c.robust_trials);  // each probe, and each of its noisy trials
+  const int most = c.probes * (1 + c.robust);  // each probe, and each of its noisy trials
   std::string out;
   for (const std::size_t p : recordings.order()) {
     out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;
@@ -139,24 +131,28 @@ int tracker_paths_for(int paths, const std::string& features) {
   return servo_targets(features) ? kServoPaths : kOtherPaths;
 }
 
-ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& c) {
+TrackerConfig learner_tracker_config(const Learner& learner, const std::string& features) {
+  const Params& params = learner.params();
+  const std::string& preset = params.choice("tracker_preset");
+  TrackerConfig tracker = tracker_preset(preset);
+  // The options given set the preset's settings of their name; "paths" -1 is the map's count.
+  std::map<std::string, std::string> text(params.as_text().begin(), params.as_text().end());
+  for (const auto& setting : tracker_setting_names()) {
+    const std::string key = "tracker_" + setting;
+    if (setting == "paths" || !learner.given(key)) continue;
+    set_tracker_setting(tracker, setting, text.at(key));
+  }
+  const int paths = static_cast<int>(params.integer("tracker_paths"));
+  if (learner.given("tracker_paths") || preset == kLearnerPreset) tracker.paths = tracker_paths_for(paths, features);
+  validate(tracker);
+  return tracker;
+}
+
+ExpertConfig learner_expert_config(const std::string& name, const Learner& learner, const LearnContext& c) {
   ExpertConfig config;
+  const Params& params = learner.params();
   if (name == "tracker") {
-    TrackerConfig tracker;
-    tracker.probes = static_cast<int>(params.integer("tracker_probes"));
-    tracker.optimise = params.boolean("tracker_optimise");
-    tracker.keep = tracker_paths_for(static_cast<int>(params.integer("tracker_paths")), c.features);
-    tracker.rescue_interval = static_cast<int>(params.integer("tracker_rescue"));
-    tracker.smooth = params.real("tracker_smooth");
-    tracker.robust_trials = static_cast<int>(params.integer("tracker_robust"));
-    tracker.robust_noise = params.real("tracker_robust_noise");
-    tracker.robust_warp = params.real("tracker_robust_warp");
-    tracker.keep_extremes = params.boolean("tracker_keep_extremes");
-    tracker.shrink_steps = static_cast<int>(params.integer("tracker_shrink"));
-    // The finalists are scored from four times the ranking's probe starts.
-    tracker.smooth_variants.clear();
-    if (params.boolean("tracker_variants")) tracker.smooth_variants.assign(kVariantWidths.begin(), kVariantWidths.end());
-    tracker.finalist_probes = 4 * tracker.probes;
+    const TrackerConfig tracker = learner_tracker_config(learner, c.features);
     // Another set's training episodes (the episode split's), as --demos would give them.
     const std::string& other = params.choice("tracker_demos");
     const std::vector<Episode> own =

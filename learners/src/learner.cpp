@@ -1,5 +1,7 @@
 #include <dicestack/learners/learner.hpp>
 
+#include <algorithm>
+
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/registry_lookup.hpp>
@@ -35,8 +37,14 @@ const LearnerInfo& LearnerRegistry::info(std::string_view name) const { return r
 
 std::unique_ptr<Learner> LearnerRegistry::create(std::string_view name, const std::vector<std::string>& assignments) const {
   const LearnerInfo& i = info(name);
-  return i.factory(i.name, Params(i.params, assignments, i.name));
+  auto learner = i.factory(i.name, Params(i.params, assignments, i.name));
+  std::vector<std::string> keys;
+  for (const auto& a : assignments) keys.push_back(a.substr(0, a.find('=')));
+  learner->set_given(std::move(keys));
+  return learner;
 }
+
+bool Learner::given(std::string_view key) const { return std::find(given_.begin(), given_.end(), key) != given_.end(); }
 
 std::vector<std::string> LearnerRegistry::names() const { return registered_names(entries_); }
 

@@ -29,7 +29,7 @@ def load_model(path, allow_pickle=False):
     return _dicestack.load_model(os.fspath(path), allow_pickle)
 
 
-def expert(name, demos=None, *, world=None, seed=0, retry=False):
+def expert(name, demos=None, *, world=None, seed=0, retry=False, preset="plain", settings=None):
     """An automatic expert, "scripted", "mpc" or "tracker": `expert(env)` (or `.act(env)`) gives
     the action for a DiceStackEnv's current state. It restarts by itself at each new episode; use
     one expert per world.
@@ -41,13 +41,18 @@ def expert(name, demos=None, *, world=None, seed=0, retry=False):
 
     retry=True ("mpc", "tracker"): once a failed attempt has come to rest (dice still, not
     stacked, the lowest on the table), start afresh from there, as the "+retry" feature maps
-    expect. The expert must then be asked at every step of an episode."""
+    expect. The expert must then be asked at every step of an episode.
+
+    preset and settings ("tracker"): its named settings, "plain" or "distill" (the learners'
+    default), and a dict of settings on top, by the names of the learners' tracker_* options
+    without "tracker_" (e.g. {"smooth": 4, "paths": 3}; docs/expert.md)."""
     if not isinstance(retry, bool):
         raise TypeError(f"retry must be True or False, got {type(retry).__name__}")
     if name == "tracker" and demos is None:
         raise ValueError('expert "tracker" follows recordings: give them with demos= ("builtin", "human", a folder '
                          "or a list of Episodes)")
-    return _dicestack.Expert(name, None if demos is None else _demos_argument(demos), resolve_world(world), seed, retry)
+    return _dicestack.Expert(name, None if demos is None else _demos_argument(demos), resolve_world(world), seed, retry,
+                             preset, [] if settings is None else _assignments(settings, "settings"))
 
 
 def _assignments(values, what):

@@ -88,16 +88,21 @@ std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& worl
 class PyExpert {
  public:
   /// `demos` (None, or as demos_from takes them) are the recordings "tracker" follows, ranked in
-  /// `world` with `seed`; other experts read none. `retry`: ExpertConfig::retry.
-  PyExpert(const std::string& name, const py::handle& demos, const WorldConfig& world, std::uint64_t seed, bool retry) {
+  /// `world` with `seed`, with the tracker_config of `preset` and `settings` ("NAME=VALUE"); other
+  /// experts read none of them. `retry`: ExpertConfig::retry.
+  PyExpert(const std::string& name, const py::handle& demos, const WorldConfig& world, std::uint64_t seed, bool retry,
+           const std::string& preset, const std::vector<std::string>& settings) {
     ExpertConfig config;
     config.retry = retry;
+    if (name != "tracker" && (preset != "plain" || !settings.empty()))
+      throw py::value_error("expert \"" + name + "\" has no tracker settings (preset= and settings= set \"tracker\")");
+    const TrackerConfig tracker = tracker_config(preset, settings);  // a bad one is refused before any work
     if (!demos.is_none()) {
       if (name != "tracker")
         throw py::value_error("expert \"" + name + "\" reads no demonstrations (demos= is the recordings of \"tracker\")");
       const std::vector<Episode> episodes = demos_from(demos, world, nullptr);
       py::gil_scoped_release nogil;
-      config.recordings = make_recordings(episodes, world, {}, seed);
+      config.recordings = make_recordings(episodes, world, tracker, seed);
     }
     expert_ = make_expert(name, config);
   }
@@ -306,8 +311,10 @@ void bind_models(py::module_& m) {
         }, py::arg("path"), py::arg("allow_pickle"));
 
   py::class_<PyExpert>(m, "Expert", "An automatic expert (\"scripted\", \"mpc\" or \"tracker\") acting on an environment")
-      .def(py::init<const std::string&, const py::handle&, const WorldConfig&, std::uint64_t, bool>(), py::arg("name"),
-           py::arg("demos"), py::arg("world"), py::arg("seed"), py::arg("retry"))
+      .def(py::init<const std::string&, const py::handle&, const WorldConfig&, std::uint64_t, bool, const std::string&,
+                    const std::vector<std::string>&>(),
+           py::arg("name"), py::arg("demos"), py::arg("world"), py::arg("seed"), py::arg("retry"), py::arg("preset") = "plain",
+           py::arg("settings") = std::vector<std::string>{})
       .def("act", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def("__call__", [](PyExpert& e, const py::handle& env) { return to_array(e.act(env_core(env))); }, py::arg("env"))
       .def_property_readonly("name", &PyExpert::name);

@@ -615,6 +615,37 @@ TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
   EXPECT_FALSE(std::filesystem::exists(dir));
 }
 
+// The tracker's settings go by one set of names: a preset, then NAME=VALUE on top, as the
+// learners' tracker_* options and the bench name them; the set says how it was recorded.
+TEST(CliLearning, RecordThroughATrackerPresetWithSettingsSaysSoAndABadSettingIsRefusedAtOnce) {
+  const auto dir = test::scratch_path("dicestack_cli_tracker_preset");
+  std::filesystem::remove_all(dir);
+  const Process p = run("record --expert tracker --demos " + kTinyDemos +
+                            " --tracker-preset distill --tracker smooth=2 --tracker probes=2 --episodes 1 --out " + dir.string(),
+                        false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  std::ifstream meta(dir / "meta.json");
+  const auto j = nlohmann::json::parse(meta);
+  EXPECT_THAT(j["provenance"].get<std::string>(), HasSubstr("--tracker-preset distill --tracker smooth=2 --tracker probes=2"));
+  EXPECT_THAT(j["description"].get<std::string>(), HasSubstr("--tracker-preset distill"));
+  std::filesystem::remove_all(dir);
+  const std::vector<std::pair<std::string, std::string>> refused{
+      {"record --expert tracker --demos " + kTinyDemos + " --tracker smoth=2 --episodes 1 --out " + dir.string(),
+       "tracker setting \"smoth\": unknown; settings: probes, optimise, paths"},
+      {"record --expert tracker --demos " + kTinyDemos + " --tracker robust=many --episodes 1 --out " + dir.string(),
+       "tracker setting robust: takes a whole number, got \"many\""},
+      {"record --expert tracker --demos " + kTinyDemos + " --tracker-preset tuned --episodes 1 --out " + dir.string(),
+       "--tracker-preset"},
+      {"record --expert mpc --tracker smooth=2 --episodes 1 --out " + dir.string(), "expert mpc has neither"},
+      {"robustness --expert scripted --tracker-preset distill --episodes 1", "--tracker-preset and --tracker set --expert tracker"}};
+  for (const auto& [args, message] : refused) {
+    const Process bad = run_within(5, args);
+    EXPECT_NE(bad.status, 0) << args;
+    EXPECT_THAT(bad.output, HasSubstr(message)) << args;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
 TEST(CliLearning, LeaderboardRowsCanBeLearnersWithOptions) {
   const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr "
                         "--learners bc,dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1 "

@@ -106,11 +106,11 @@ TEST(Recordings, RankingDoesNotDependOnThreads) {
   EXPECT_EQ(one.order(), two.order());
   EXPECT_EQ(one.probe_successes(), two.probe_successes());
   // keep: only the best-ranked recordings are ever tried, in the same order.
-  c.keep = 2;
+  c.paths = 2;
   const Recordings kept(paths, w, c, 7, 2);
   EXPECT_EQ(kept.order(), std::vector<std::size_t>(one.order().begin(), one.order().begin() + 2));
-  c.keep = -1;
-  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"keep\""), std::string::npos);
+  c.paths = -1;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"paths\""), std::string::npos);
 }
 
 TEST(ChoosePath, FindsARecordingThatSucceedsAndIsDeterministic) {
@@ -142,7 +142,7 @@ TEST(ChoosePath, RobustTrialsKeepTheChoiceWhenTheyAreNoiselessAndPickTheMostRobu
   ASSERT_TRUE(plain.success);
   // Trials without noise or warp replay the same episode: they all succeed, the choice stays,
   // and each costs one simulation.
-  c.robust_trials = 4;
+  c.robust = 4;
   c.robust_noise = 0.0;
   const TrackerChoice noiseless = choose_path(Recordings(paths, w, c, 0), env, sim, 3);
   EXPECT_EQ(noiseless.path, plain.path);
@@ -158,9 +158,9 @@ TEST(ChoosePath, RobustTrialsKeepTheChoiceWhenTheyAreNoiselessAndPickTheMostRobu
   EXPECT_GT(a.simulations, noiseless.simulations);
   EXPECT_EQ(a.path, plain.path);
   // Out of range: named.
-  c.robust_trials = -1;
-  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust_trials\""), std::string::npos);
-  c.robust_trials = 1;
+  c.robust = -1;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust\""), std::string::npos);
+  c.robust = 1;
   c.robust_warp = 2.0;
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"robust_warp\""), std::string::npos);
 }
@@ -172,7 +172,7 @@ TEST(ChoosePath, WhenNoRecordingSucceedsAsRecordedTheLeastNarrowingComesBeforeCm
   const std::vector<CupPath> paths = successful_scripted_paths(2);
   TrackerConfig c;
   c.probes = 0;
-  c.shrink_steps = 4;
+  c.shrink = 4;
   TrackerConfig as_recorded = c;
   as_recorded.optimise = false;
   const Recordings r(paths, w, c, 0), plain(paths, w, as_recorded, 0);
@@ -187,14 +187,14 @@ TEST(ChoosePath, WhenNoRecordingSucceedsAsRecordedTheLeastNarrowingComesBeforeCm
     const TrackerChoice a = choose_path(r, env, sim, 1);
     if (!a.success || a.warp.offset != 0.0) continue;  // CMA-ES's, after the grid failed
     EXPECT_EQ(a.warp.time_scale, 1.0);
-    const double k = (1.0 - a.warp.amplitude) / c.amplitude_range * c.shrink_steps;
+    const double k = (1.0 - a.warp.amplitude) / c.amplitude_range * c.shrink;
     EXPECT_NEAR(k, std::round(k), 1e-9) << shift;
     EXPECT_GE(std::round(k), 1.0);
     ++narrowed;
   }
   EXPECT_GE(narrowed, 1) << "no start needed (and found) a narrowing";
-  c.shrink_steps = 101;
-  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"shrink_steps\""), std::string::npos);
+  c.shrink = 101;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"shrink\""), std::string::npos);
 }
 
 TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
@@ -204,7 +204,7 @@ TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
   c.probes = 4;
   const Recordings plain(paths, w, c, 7, 1);
   // Noiseless trials: each success scores 1 + 3, the order stays.
-  c.robust_trials = 3;
+  c.robust = 3;
   c.robust_noise = 0.0;
   const Recordings noiseless(paths, w, c, 7, 1);
   EXPECT_EQ(noiseless.order(), plain.order());
@@ -222,7 +222,7 @@ TEST(Recordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainF
   c.probes = 4;
   c.smooth = 2.0;
   const Recordings plain(paths, w, c, 7, 1);
-  c.smooth_variants = {0.0, 2.0, 5.0};  // 2 is `smooth`'s: the recordings themselves
+  c.variants = {0.0, 2.0, 5.0};  // 2 is `smooth`'s: the recordings themselves
   c.variant_recordings = 2;
   c.finalists = 2;
   c.finalist_probes = 3;
@@ -254,8 +254,8 @@ TEST(Recordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainF
   const Recordings two(paths, w, c, 7, 2);
   EXPECT_EQ(two.order(), r.order());
   EXPECT_EQ(two.probe_successes(), r.probe_successes());
-  c.smooth_variants = {-1.0};
-  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"smooth_variants\""), std::string::npos);
+  c.variants = {-1.0};
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"variants\""), std::string::npos);
 }
 
 TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
@@ -360,8 +360,8 @@ TEST(Recordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
   c.smooth = -1.0;
   EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"smooth\""), std::string::npos);
   c.smooth = 0.0;
-  c.rescue_interval = -1;
-  EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"rescue_interval\""), std::string::npos);
+  c.rescue = -1;
+  EXPECT_NE(test::error_of([&] { Recordings({path}, w, c, 0); }).find("\"rescue\""), std::string::npos);
 }
 
 TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
@@ -394,11 +394,11 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
 }
 
 // The tracker's episode from paths[0]'s start, knocked at step 20 (dvx 0.6).
-test::KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue_interval, bool retry) {
+test::KnockedEpisode knocked_episode(const std::vector<CupPath>& paths, int rescue, bool retry) {
   const WorldConfig w;
   TrackerConfig c;
   c.probes = 0;
-  c.rescue_interval = rescue_interval;
+  c.rescue = rescue;
   ExpertConfig config;
   config.retry = retry;
   config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
@@ -437,5 +437,49 @@ TEST(TrackerExpert, TriesAgainFromWhereAFailedAttemptCameToRestWhenAskedTo) {
   EXPECT_NE(again.actions[restart], once.actions[restart]) << "a new choice at the restart";
   EXPECT_EQ(knocked_episode(paths, 0, true).actions, again.actions);
 }
+}  // namespace
+}  // namespace dicestack
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(TrackerPresets, PlainIsTheBareTrackerAndDistillTheLearnersTuning) {
+  const TrackerConfig plain = tracker_preset("plain"), bare{};
+  EXPECT_EQ(plain.paths, bare.paths);
+  EXPECT_EQ(plain.smooth, bare.smooth);
+  EXPECT_TRUE(plain.variants.empty());
+  const TrackerConfig distill = tracker_preset("distill");
+  EXPECT_EQ(distill.paths, 3);
+  EXPECT_EQ(distill.smooth, 4.0);
+  EXPECT_EQ(distill.robust, 5);
+  EXPECT_EQ(distill.robust_warp, 0.02);
+  EXPECT_EQ(distill.shrink, 5);
+  EXPECT_EQ(distill.variants.size(), kTrackerVariantWidths.size());
+  EXPECT_NO_THROW(validate(distill));
+  EXPECT_THAT(test::error_of([] { tracker_preset("tuned"); }),
+              HasSubstr("tracker preset \"tuned\": unknown; presets: plain, distill"));
+}
+
+TEST(TrackerPresets, SettingsGoOnTopByTheirFieldsNamesAndABadOneIsNamed) {
+  const TrackerConfig c = tracker_config("distill", {"smooth=2", "variants=false", "probes=8", "paths=1"});
+  EXPECT_EQ(c.smooth, 2.0);
+  EXPECT_TRUE(c.variants.empty());
+  EXPECT_EQ(c.probes, 8);
+  EXPECT_EQ(c.finalist_probes, 32) << "finalists are scored from four times the ranking's starts";
+  EXPECT_EQ(c.paths, 1);
+  EXPECT_EQ(c.robust, 5) << "the preset's, not given";
+  for (const auto& name : tracker_setting_names()) {
+    TrackerConfig t;
+    EXPECT_THAT(test::error_of([&] { set_tracker_setting(t, name, "x"); }), HasSubstr("tracker setting " + name + ": takes"))
+        << name;
+  }
+  EXPECT_THAT(test::error_of([] { tracker_config("plain", {"smoth=2"}); }),
+              HasSubstr("tracker setting \"smoth\": unknown; settings: probes, optimise, paths"));
+  EXPECT_THAT(test::error_of([] { tracker_config("plain", {"smooth"}); }), HasSubstr("give NAME=VALUE"));
+  EXPECT_THAT(test::error_of([] { tracker_config("plain", {"robust=-2"}); }), HasSubstr("robust"));
+}
+
 }  // namespace
 }  // namespace dicestack

@@ -231,5 +231,39 @@ TEST(LearnerSpec, TheExpertTriesAgainWithARetryMapUnlessToldOtherwise) {
   EXPECT_NO_THROW(parse_learner_spec("dagger:expert=mpc:retry=true"));
 }
 
+TEST(LearnerSpec, TheLearnersTrackerIsThePresetWithTheOptionsGivenOnTop) {
+  // One set of defaults: every tracker_* option's default is the distill preset's setting.
+  const TrackerConfig distill = tracker_preset("distill");
+  const auto learner = LearnerRegistry::global().create("dart", {"expert=tracker"});
+  const TrackerConfig by_default = learner_tracker_config(*learner, "state+clock+start_state@dice+retry/position");
+  EXPECT_EQ(by_default.smooth, distill.smooth);
+  EXPECT_EQ(by_default.robust, distill.robust);
+  EXPECT_EQ(by_default.shrink, distill.shrink);
+  EXPECT_EQ(by_default.variants, distill.variants);
+  EXPECT_EQ(by_default.paths, 1) << "one recording for a /position map";
+  const auto settings_equal = [](const TrackerConfig& x, const TrackerConfig& y) {
+    return x.probes == y.probes && x.optimise == y.optimise && x.smooth == y.smooth && x.rescue == y.rescue &&
+           x.robust == y.robust && x.robust_noise == y.robust_noise && x.robust_warp == y.robust_warp &&
+           x.keep_extremes == y.keep_extremes && x.shrink == y.shrink && x.variants == y.variants &&
+           x.finalist_probes == y.finalist_probes;
+  };
+  for (const auto& spec : LearnerRegistry::global().info("dart").params) {
+    const std::string setting = spec.name.starts_with("tracker_") ? spec.name.substr(8) : "";
+    const auto& names = tracker_setting_names();
+    if (setting.empty() || setting == "paths" || std::find(names.begin(), names.end(), setting) == names.end()) continue;
+    TrackerConfig with_default = distill;
+    set_tracker_setting(with_default, setting, spec.default_value);
+    EXPECT_TRUE(settings_equal(with_default, distill)) << spec.name << "'s default is not the preset's";
+  }
+  // Another preset: its settings, the options given on top, the others not the distill defaults.
+  const auto plain = LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_preset=plain", "tracker_smooth=2"});
+  const TrackerConfig p = learner_tracker_config(*plain, "state+clock+start_state@dice+retry/position");
+  EXPECT_EQ(p.smooth, 2.0);
+  EXPECT_EQ(p.robust, 0);
+  EXPECT_TRUE(p.variants.empty());
+  EXPECT_EQ(p.paths, 0) << "plain follows all its recordings";
+  EXPECT_THAT(test::error_of([] { parse_learner_spec("dart:tracker_preset=tuned"); }), HasSubstr("plain, distill"));
+}
+
 }  // namespace
 }  // namespace dicestack

@@ -143,3 +143,18 @@ def test_tracker_needs_recordings_and_the_others_read_none():
         dicestack.expert("tracker")
     with pytest.raises(ValueError, match="reads no demonstrations|no recordings|demos"):
         dicestack.expert("mpc", demos="builtin")
+
+
+def test_the_trackers_preset_and_settings_go_by_the_learners_names(builtin_episodes):
+    # The tracker of record and robustness is "plain"; the learners' is "distill"; settings on top.
+    few = builtin_episodes[:3]
+    expert = dicestack.expert("tracker", demos=few, preset="distill", settings={"smooth": 2, "probes": 2, "variants": False})
+    env = dicestack.DiceStackEnv()
+    env.reset(seed=3)
+    assert len(expert(env)) == 3
+    with pytest.raises(ValueError, match='tracker setting "smoth": unknown; settings: probes'):
+        dicestack.expert("tracker", demos=few, settings={"smoth": 2})
+    with pytest.raises(ValueError, match='tracker preset "tuned": unknown; presets: plain, distill'):
+        dicestack.expert("tracker", demos=few, preset="tuned")
+    with pytest.raises(ValueError, match="has no tracker settings"):
+        dicestack.expert("mpc", settings={"smooth": 2})

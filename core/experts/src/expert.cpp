@@ -294,7 +294,7 @@ class TrackerExpert final : public Expert {
       choice_ = choose_path(*recordings_, env, planning_sim(sim_, env), seed_);
       first_step_ = last_check_ = t;
       follow(t);
-    } else if (c.rescue_interval > 0 && t - last_check_ >= c.rescue_interval && t - start_step_ < follower_.length()) {
+    } else if (c.rescue > 0 && t - last_check_ >= c.rescue && t - start_step_ < follower_.length()) {
       last_check_ = t;
       if (!still_succeeds(follower_, env, planning_sim(sim_, env), c.hold_steps)) {
         choice_ = rescue_path(*recordings_, env, *sim_, frame_, choice_, follower_.phase(t), seed_);

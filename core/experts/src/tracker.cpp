@@ -137,8 +137,8 @@ struct Candidate {
 };
 
 // Simulates `candidates` in turn from env's state (each moved into the frame of `frame`); the
-// first success wins (with robust_trials, the first whose noisy trials all succeed too, else the
-// success with most). Failing that, the `optimise_paths` closest narrowed in shrink_steps even
+// first success wins (with robust, the first whose noisy trials all succeed too, else the
+// success with most). Failing that, the `optimise_paths` closest narrowed in shrink even
 // steps, then CMA-ES over their warps, `evaluations` each; failing all, the closest.
 TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
                      const std::vector<Candidate>& candidates, int evaluations, std::uint64_t seed) {
@@ -157,15 +157,15 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
     const PathFollower follower(paths[p], w, frame, t, c.gain, c.keep_extremes);
     Trial trial = simulate(follower, sim, start, c.hold_steps);
     ++simulations;
-    if (trial.success && c.robust_trials > 0) {
+    if (trial.success && c.robust > 0) {
       int wins = 0;
-      for (int k = 0; k < c.robust_trials; ++k, ++simulations)
+      for (int k = 0; k < c.robust; ++k, ++simulations)
         wins += robust_trial(paths[p], w, frame, t, c, sim, start, derive_seed(seed, static_cast<std::uint64_t>(simulations)));
       if (wins > best_robust) {
         best_robust = wins;
         robust_best = TrackerChoice{p, w, true, 0};
       }
-      if (wins < c.robust_trials) trial.success = false;  // keep looking
+      if (wins < c.robust) trial.success = false;  // keep looking
       else trial.score = 2.0;
     }
     if (trial.score > best) {  // a success outscores every failure
@@ -195,10 +195,10 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
   near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
   // First the least narrowing of the swing that succeeds, in even steps, the closest paths at
   // each step: alike for neighbouring starts, where CMA-ES's warps scatter.
-  for (int step = 1; step <= c.shrink_steps; ++step) {
+  for (int step = 1; step <= c.shrink; ++step) {
     for (const auto& [score, k] : near) {
       PathWarp w = candidates[k].warp;
-      w.amplitude *= 1.0 - c.amplitude_range * static_cast<double>(step) / static_cast<double>(c.shrink_steps);
+      w.amplitude *= 1.0 - c.amplitude_range * static_cast<double>(step) / static_cast<double>(c.shrink);
       if (consider(candidates[k].path, w).success) return choice;
     }
     if (robust_best) return finish();
@@ -248,7 +248,7 @@ void validate(const TrackerConfig& c) {
   };
   require(c.gain > 0.0 && c.gain < 1e6, "gain", "in (0, 1e6)", c.gain);
   require(c.probes >= 0 && c.probes <= 100000, "probes", "in [0, 100000]", c.probes);
-  require(c.keep >= 0 && c.keep <= 1000000, "keep", "in [0, 1000000]", c.keep);
+  require(c.paths >= 0 && c.paths <= 1000000, "paths", "in [0, 1000000]", c.paths);
   require(c.optimise_paths >= 1 && c.optimise_paths <= 100000, "optimise_paths", "in [1, 100000]", c.optimise_paths);
   require(c.optimise_evaluations >= 1 && c.optimise_evaluations <= 100000, "optimise_evaluations", "in [1, 100000]",
           c.optimise_evaluations);
@@ -257,16 +257,16 @@ void validate(const TrackerConfig& c) {
   require(c.amplitude_range >= 0.0 && c.amplitude_range < 1.0, "amplitude_range", "in [0, 1)", c.amplitude_range);
   require(c.hold_steps >= 0 && c.hold_steps <= 100000, "hold_steps", "in [0, 100000]", c.hold_steps);
   require(c.smooth >= 0.0 && c.smooth <= 1000.0, "smooth", "in [0, 1000]", c.smooth);
-  require(c.rescue_interval >= 0 && c.rescue_interval <= 100000, "rescue_interval", "in [0, 100000]",
-          c.rescue_interval);
-  require(c.robust_trials >= 0 && c.robust_trials <= 1000, "robust_trials", "in [0, 1000]", c.robust_trials);
+  require(c.rescue >= 0 && c.rescue <= 100000, "rescue", "in [0, 100000]",
+          c.rescue);
+  require(c.robust >= 0 && c.robust <= 1000, "robust", "in [0, 1000]", c.robust);
   require(c.robust_noise >= 0.0 && c.robust_noise <= 10.0, "robust_noise", "in [0, 10]", c.robust_noise);
   require(c.robust_warp >= 0.0 && c.robust_warp <= 1.0, "robust_warp", "in [0, 1]", c.robust_warp);
-  require(c.shrink_steps >= 0 && c.shrink_steps <= 100, "shrink_steps", "in [0, 100]", c.shrink_steps);
+  require(c.shrink >= 0 && c.shrink <= 100, "shrink", "in [0, 100]", c.shrink);
   require(c.rescue_evaluations >= 1 && c.rescue_evaluations <= 100000, "rescue_evaluations", "in [1, 100000]",
           c.rescue_evaluations);
-  require(c.smooth_variants.size() <= 100, "smooth_variants", "at most 100 widths long", static_cast<double>(c.smooth_variants.size()));
-  for (const double w : c.smooth_variants) require(w >= 0.0 && w <= 1000.0, "smooth_variants", "widths in [0, 1000]", w);
+  require(c.variants.size() <= 100, "variants", "at most 100 widths long", static_cast<double>(c.variants.size()));
+  for (const double w : c.variants) require(w >= 0.0 && w <= 1000.0, "variants", "widths in [0, 1000]", w);
   require(c.variant_recordings >= 1 && c.variant_recordings <= 1000000, "variant_recordings", "in [1, 1000000]",
           c.variant_recordings);
   require(c.finalists >= 1 && c.finalists <= 100000, "finalists", "in [1, 100000]", c.finalists);
@@ -331,10 +331,10 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
   validate(config_);
   if (paths_.empty()) throw InputError("tracker: no recordings to follow");
   for (const auto& p : paths_) check_path(p);
-  const std::vector<CupPath> recorded = config_.smooth_variants.empty() ? std::vector<CupPath>{} : paths_;
+  const std::vector<CupPath> recorded = config_.variants.empty() ? std::vector<CupPath>{} : paths_;
   if (config_.smooth > 0.0)
     for (auto& p : paths_) p = smoothed(p, config_.smooth);
-  const int per_probe = 1 + config_.robust_trials;
+  const int per_probe = 1 + config_.robust;
   probe_successes_ = probe_scores(world, threads, cluster, 0, paths_.size(), 0, config_.probes, false);
   probe_trials_.assign(paths_.size(), config_.probes * per_probe);
   std::vector<std::size_t> finalists;
@@ -342,7 +342,7 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
     // The best-ranked recordings, each also smoothed by every other width, scored alike.
     const std::size_t n = recorded.size();
     for (const std::size_t r : ranked(std::min(n, static_cast<std::size_t>(config_.variant_recordings))))
-      for (const double width : config_.smooth_variants) {
+      for (const double width : config_.variants) {
         if (width == config_.smooth) continue;
         CupPath v = width > 0.0 ? smoothed(recorded[r], width) : recorded[r];
         std::ostringstream name;
@@ -369,8 +369,8 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
     std::erase_if(order_, [&](std::size_t p) { return std::find(finalists.begin(), finalists.end(), p) != finalists.end(); });
     order_.insert(order_.begin(), finalists.begin(), finalists.end());
   }
-  if (config_.keep > 0 && static_cast<std::size_t>(config_.keep) < order_.size())
-    order_.resize(static_cast<std::size_t>(config_.keep));
+  if (config_.paths > 0 && static_cast<std::size_t>(config_.paths) < order_.size())
+    order_.resize(static_cast<std::size_t>(config_.paths));
 }
 
 std::vector<std::size_t> Recordings::ranked(std::size_t count) const {
@@ -406,7 +406,7 @@ std::vector<int> Recordings::probe_scores(const WorldConfig& world, int threads,
                                              : derive_seed(seed_, kProbeNoiseStream);
         const std::size_t key = variants ? 0 : item;
         int won = 1;
-        for (int k = 0; k < config_.robust_trials; ++k)
+        for (int k = 0; k < config_.robust; ++k)
           won += robust_trial(paths_[path], {}, start, 0, config_, sims.at(w), snap,
                               derive_seed(noise, key * 1000 + static_cast<std::size_t>(k)));
         return won;

@@ -52,15 +52,22 @@ ParamSpec retry_param_spec();
 /// default for the feature map `features` (1 for a "/position" map, else 3); others as given.
 int tracker_paths_for(int paths, const std::string& features);
 
-/// The options of a learner whose expert may be the tracker (DART, DAgger): tracker_probes,
-/// tracker_optimise (the TrackerConfig fields a user may want to change, for ablations) and
-/// tracker_recordings (follow only that many of the demonstrations, drawn with the run's seed).
+/// The options of a learner whose expert may be the tracker (DART, DAgger, DaD): tracker_preset,
+/// then "tracker_" + each tracker setting (tracker_setting_names: the TrackerConfig fields of that
+/// name, their defaults the preset's), tracker_demos and tracker_recordings (follow only that
+/// many of the demonstrations, drawn with the run's seed).
 std::vector<ParamSpec> tracker_param_specs();
 
-/// The ExpertConfig of a learner's expert `name` (DART, DAgger): for "tracker", its recordings
-/// made from the context's training demonstrations with the learner's tracker_* options (ranked
-/// with the context's seed, over its cluster); for the others, the defaults. Throws InputError
-/// for "tracker" without demonstrations.
-ExpertConfig learner_expert_config(const std::string& name, const Params& params, const LearnContext& context);
+/// The tracker a learner's options ask for: the preset `tracker_preset`, each tracker_* option
+/// given set on top (by the setting of its name, tracker_setting_names), and `tracker_paths` -1
+/// resolved for the feature map `features` (with the learners' preset or when given).
+/// Throws ConfigError as tracker_config.
+TrackerConfig learner_tracker_config(const Learner& learner, const std::string& features);
+
+/// The ExpertConfig of a learner's expert `name` (DART, DAgger, DaD): for "tracker", its
+/// recordings made from the context's training demonstrations with learner_tracker_config
+/// (ranked with the context's seed, over its cluster); for the others, the defaults. Throws
+/// InputError for "tracker" without demonstrations.
+ExpertConfig learner_expert_config(const std::string& name, const Learner& learner, const LearnContext& context);
 
 }  // namespace dicestack

@@ -75,6 +75,11 @@ class Learner {
   virtual ~Learner() = default;
   const std::string& name() const { return name_; }
   const Params& params() const { return params_; }
+  /// Whether the option `key` was given (not left at its default): settings given on top of a
+  /// preset override it, the others follow it (tracker_preset).
+  bool given(std::string_view key) const;
+  /// The keys given, as LearnerRegistry::create sets them from its assignments.
+  void set_given(std::vector<std::string> keys) { given_ = std::move(keys); }
   /// Throws InputError if there are no demonstrations, ConfigError for a bad regressor.
   virtual LearnResult learn(const LearnContext& context) const = 0;
   /// The feature map this learner, with its options, reads when none is named; empty: its
@@ -84,6 +89,7 @@ class Learner {
  private:
   std::string name_;
   Params params_;
+  std::vector<std::string> given_;
 };
 
 struct LearnerInfo {

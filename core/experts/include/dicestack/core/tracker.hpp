@@ -6,9 +6,11 @@
 // Why the cup's path and not the actions: the task is open-loop in the cup's path, not in the
 // actions. A recording's actions replayed in another world (or from a start 1 cm away) lose the
 // dice at the first contact; its cup path, tracked, scoops them again (docs/learners.md).
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <dicestack/core/cluster.hpp>
@@ -37,7 +39,7 @@ struct PathWarp {
 struct TrackerConfig {
   double gain = 10.0;        ///< feedback gain on the cup's pose, 1/s (the issue's k)
   int probes = 16;           ///< training starts that rank the recordings (most successes first), >= 0
-  int keep = 0;              ///< follow only the first `keep` recordings of the ranking (0: all), >= 0
+  int paths = 0;              ///< follow only the first `paths` recordings of the ranking (0: all), >= 0
   bool optimise = true;      ///< when no recording succeeds as recorded, search warps
   int optimise_paths = 4;    ///< the warp search tries the recordings that came closest, >= 1
   int optimise_evaluations = 60;   ///< simulated warps per recording (CMA-ES), >= 1
@@ -48,7 +50,7 @@ struct TrackerConfig {
   /// Closed loop on the dice: every this many steps the rest of the followed path is simulated
   /// from the state reached; when it no longer ends in a success, a rescue joins a recording
   /// midway (rescue_path). 0: the path is chosen once per episode. >= 0.
-  int rescue_interval = 0;
+  int rescue = 0;
   int rescue_evaluations = 30;  ///< simulated warps per recording in a rescue's search (CMA-ES), >= 1
   /// Each path's pose and velocity are smoothed by a Gaussian of this std, in steps, before it
   /// is followed (0: as recorded). A person's per-step jitter is no part of the motion a learner
@@ -59,7 +61,7 @@ struct TrackerConfig {
   /// action.scale, and the whole path off by a random warp of std robust_warp), and the first
   /// whose trials all succeed is chosen; failing that, the success with most. The ranking's
   /// probes count those trials too. 0: off. In [0, 1000].
-  int robust_trials = 0;
+  int robust = 0;
   double robust_noise = 0.1;  ///< in [0, 10]
   double robust_warp = 0.0;   ///< std of each noisy trial's random warp (time scale, offset in m, amplitude), in [0, 1]
   /// A path moved to a start away from the recording's own swings that far nearer one wall: the
@@ -67,17 +69,17 @@ struct TrackerConfig {
   /// is narrowed (about the dice) to reach no further than the recording's did.
   bool keep_extremes = false;
   /// When no recording succeeds as recorded, before CMA-ES: the swing narrowed about the dice in
-  /// even steps (amplitude 1 - k amplitude_range / shrink_steps, k = 1..shrink_steps), the
+  /// even steps (amplitude 1 - k amplitude_range / shrink, k = 1..shrink), the
   /// closest recordings at each step: the least change that succeeds, alike for neighbouring
   /// starts. 0: straight to CMA-ES. In [0, 100].
-  int shrink_steps = 0;
+  int shrink = 0;
   /// Variants of the recordings: besides `smooth`, each of the `variant_recordings` best-ranked
   /// recordings is also ranked smoothed by each of these widths (steps, each in [0, 1000]); the
   /// `finalists` best-scoring paths are then scored again from `finalist_probes` further probe
   /// starts, and lead the order by their score over all their trials. Whether a path plays is a
   /// chaotic function of such details (one recording, smoothed by 1 step, plays from 59 of 100
   /// starts; by 4, from 27): the ranking picks the width. Empty: off.
-  std::vector<double> smooth_variants;
+  std::vector<double> variants;
   int variant_recordings = 8;  ///< >= 1
   int finalists = 4;           ///< >= 1
   int finalist_probes = 64;    ///< >= 0
@@ -85,6 +87,30 @@ struct TrackerConfig {
 
 /// Throws ConfigError naming the first field of `config` out of its range.
 void validate(const TrackerConfig& config);
+
+/// The smoothing widths, in steps, that `variants=true` ranks each recording at.
+inline constexpr std::array<double, 7> kTrackerVariantWidths{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0};
+
+/// Named tracker settings, as Hydra's config groups: a preset, then settings on top.
+///  - "plain": TrackerConfig{}, the tracker as it follows recordings (record, robustness, Python);
+///  - "distill": tuned for a learner distilling it (the learners' default): the 3 best-ranked
+///    recordings, smoothed by 4 steps, chosen robust to a learner's errors (5 noisy trials,
+///    warps of std 0.02), narrowed in 5 steps before warped, each recording's smoothing chosen
+///    among kTrackerVariantWidths. Measured in docs/learners.md.
+/// Throws ConfigError for another name, listing the presets.
+TrackerConfig tracker_preset(std::string_view name);
+/// The presets' names, in listing order.
+std::vector<std::string> tracker_preset_names();
+
+/// The settings a user may give by name ("NAME=VALUE"), each a TrackerConfig field: probes,
+/// optimise, paths, smooth, rescue, robust, robust_noise, robust_warp, keep_extremes, shrink and
+/// variants (true: kTrackerVariantWidths, false: none). `probes` also sets finalist_probes to 4
+/// times it (finalists are scored from four times the ranking's starts).
+std::vector<std::string> tracker_setting_names();
+/// Sets one of them from text. Throws ConfigError naming the setting and what it takes.
+void set_tracker_setting(TrackerConfig& config, std::string_view name, std::string_view value);
+/// tracker_preset(preset) with each "NAME=VALUE" of `settings` on top, validated.
+TrackerConfig tracker_config(std::string_view preset, const std::vector<std::string>& settings);
 
 /// Follows one recorded path moved into a start's frame (x shifted by the difference of the
 /// dice' mean x in `start` and in the recording's first state), then warped: dv = v_ref +
@@ -114,7 +140,7 @@ class PathFollower {
   double centre_ = 0.0, shift_ = 0.0, gain_ = 10.0;
 };
 
-/// Recordings prepared for the tracker: each path (with TrackerConfig::smooth_variants, the
+/// Recordings prepared for the tracker: each path (with TrackerConfig::variants, the
 /// recordings' variants after them, named "NAME (smoothed W)"), and their order of trial. Built
 /// once (the ranking simulates every path from `config.probes` training starts) and shared,
 /// read-only, by every tracker expert on every thread. The order is a deterministic function of the paths,
@@ -129,12 +155,12 @@ class Recordings {
 
   const std::vector<CupPath>& paths() const { return paths_; }
   /// Path indices in the order the tracker tries them: highest probe score first, then by index;
-  /// only the first config.keep of them when keep > 0 (the others are never followed).
+  /// only the first config.paths of them when paths > 0 (the others are never followed).
   const std::vector<std::size_t>& order() const { return order_; }
   /// Probe score per path (index as in paths()): its successes from the probe starts, and with
-  /// robust_trials, 1 more for each noisy trial of such a success that also succeeds.
+  /// robust, 1 more for each noisy trial of such a success that also succeeds.
   const std::vector<int>& probe_successes() const { return probe_successes_; }
-  /// The trials each probe score counts: probes x (1 + robust_trials), more for a finalist.
+  /// The trials each probe score counts: probes x (1 + robust), more for a finalist.
   const std::vector<int>& probe_trials() const { return probe_trials_; }
   const TrackerConfig& config() const { return config_; }
   std::uint64_t seed() const { return seed_; }
@@ -163,8 +189,8 @@ struct TrackerChoice {
 
 /// Searches `recordings` from env's current state, simulating in `sim` (an environment of the
 /// same world): the first path in order() whose simulated episode is a realistic success (with
-/// robust_trials: whose noisy trials succeed too, else the success with most); if none and
-/// config.optimise, the paths that came closest narrowed (shrink_steps), then warped (CMA-ES,
+/// robust: whose noisy trials succeed too, else the success with most); if none and
+/// config.optimise, the paths that came closest narrowed (shrink), then warped (CMA-ES,
 /// seeded by `seed`); failing all, the closest (fewest judge tolerances from a stack, no wall).
 /// Deterministic in the state, the recordings and `seed`.
 TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, std::uint64_t seed);
