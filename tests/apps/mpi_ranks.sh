@@ -147,8 +147,11 @@ case "$mode" in
       ranks "$n" leaderboard --demos "$work/demos" --regressors knn --learners bc,dagger --option expert=scripted \
         --episodes 4 --seeds 2 --threads 1 --format html --out "$work/page-$n/board.html" "${world[@]}" > /dev/null
     done
-    ls "$work/page-1/board_files/previews/"*.gif > /dev/null || fail "no previews"
-    [ "$(ls "$work/page-1/board_files/eval_info" | wc -l)" = 2 ] || fail "expected the per-episode results of 2 rows"
+    # The media sit in one generation folder, named by their digest: the same media, the same name.
+    media=("$work/page-1/board_files/"m-*)
+    [ "${#media[@]}" = 1 ] && [ -d "${media[0]}" ] || fail "expected one generation of media"
+    ls "${media[0]}/previews/"*.gif > /dev/null || fail "no previews"
+    [ "$(ls "${media[0]}/eval_info" | wc -l)" = 2 ] || fail "expected the per-episode results of 2 rows"
     same "$work/page-1/board_files" "$work/page-3/board_files"
     # Resume: a progress file with one finished row is reused under mpirun, not recomputed.
     python3 - "$work/lb-1.json" "$work/lb-r.json.partial.json" <<'PY'
