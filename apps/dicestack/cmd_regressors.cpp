@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <optional>
+#include <iostream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -18,12 +19,14 @@
 
 #include "cli.hpp"
 #include "options.hpp"
+#include "reference_md.hpp"
 
 namespace dicestack::cli {
 namespace {
 
 struct ListOptions {
   bool json = false;
+  bool markdown = false;
 };
 
 // Prints "--set name= type default range help" lines of a schema.
@@ -44,7 +47,11 @@ void print_params(const std::vector<ParamSpec>& params, const char* flag) {
   }
 }
 
-int run_learners() {
+int run_learners(bool markdown) {
+  if (markdown) {
+    std::cout << learners_reference_markdown();
+    return 0;
+  }
   const auto& reg = LearnerRegistry::global();
   for (const auto& name : reg.names()) {
     const auto& i = reg.info(name);
@@ -71,6 +78,10 @@ int run_learners() {
 }
 
 int run_list(const ListOptions& opt) {
+  if (opt.markdown) {
+    std::cout << regressors_reference_markdown();
+    return 0;
+  }
   const auto& reg = RegressorRegistry::global();
   if (opt.json) {
     nlohmann::json out = nlohmann::json::array();
@@ -210,12 +221,15 @@ void add_regressors_command(CLI::App& app) {
   auto list = std::make_shared<ListOptions>();
   CLI::App* cmd = app.add_subcommand("regressors", "List the registered regressors and their parameters");
   cmd->add_flag("--json", list->json, "Print JSON");
+  cmd->add_flag("--markdown", list->markdown, "Print the reference page of the built-in ones (docs/reference/regressors.md)");
   cmd->callback([list] { run_list(*list); });
 }
 
 void add_learners_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("learners", "List the learners and their options");
-  cmd->callback([] { run_learners(); });
+  auto markdown = std::make_shared<bool>(false);
+  cmd->add_flag("--markdown", *markdown, "Print the reference page (docs/reference/learners.md)");
+  cmd->callback([markdown] { run_learners(*markdown); });
 }
 
 void add_bench_regressors_command(CLI::App& bench) {

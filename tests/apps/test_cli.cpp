@@ -233,6 +233,18 @@ TEST(CliInput, AnOverlongValueInAnyOptionIsCutInTheMessage) {
   }
 }
 
+// The reference pages are generated from the schemas: the committed pages are what the
+// commands print today (regenerate them with the commands when a schema changes).
+TEST(Cli, TheReferencePagesAreWhatTheCommandsPrint) {
+  for (const std::string what : {"learners", "regressors"}) {
+    const Process p = run(what + " --markdown", false);
+    ASSERT_EQ(p.status, 0) << what;
+    const std::string page = std::string(DICESTACK_SOURCE_DIR) + "/docs/reference/" + what + ".md";
+    EXPECT_TRUE(p.output == read_text(page))
+        << page << " differs from `dicestack " << what << " --markdown`: regenerate it with that command";
+  }
+}
+
 TEST(Cli, RolloutWritesAPng) {
   const auto png = test::scratch_path("dicestack_cli_rollout.png");
   std::filesystem::remove(png);
