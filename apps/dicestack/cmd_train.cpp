@@ -94,8 +94,9 @@ void add_train_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--learner", opt->learner, "Learner: bc, dagger, dad, dart (see `dicestack learners`)")->capture_default_str();
   cmd->add_option("--option", opt->options, "key=value option of the learner; repeatable");
   cmd->add_option("--features", opt->features,
-                  "Feature map the policy reads: state, state+clock, state+clock+start, state+history, "
-                  "state+clock+start_state (default: the learner's, see `dicestack learners`)");
+                  "Feature map the policy reads, a name of parts such as state+clock+start_state or "
+                  "state+clock+start_state@dice+retry/position (default: the learner's; the grammar: `dicestack "
+                  "learners`, docs/reference/learners.md)");
   cmd->add_option("--split", opt->split,
                   "episodes: train on episodes i % 5 != 4, report test error and give the rest to learners as "
                   "held-out demonstrations; none: all")
