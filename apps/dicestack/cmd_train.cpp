@@ -26,11 +26,8 @@ struct TrainOptions {
 int run_train(const TrainOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   check_replaceable(opt.out, model_ownership());  // refuse a user's file before any work
-  const auto dir = opt.demos.resolve(world, cluster);
   TrainRequest request;
   request.world = world;
-  request.demos = read_demo_set(dir).episodes;
-  request.demos_name = dir.string();
   request.regressor = opt.regressor;
   request.regressor_sets = opt.sets;
   request.learner = opt.learner;
@@ -42,6 +39,10 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   request.checkpoint_dir = opt.checkpoint.empty() ? std::filesystem::path(opt.out.string() + ".checkpoint") : opt.checkpoint;
   request.resume = opt.resume;
   request.cluster = &cluster;
+  check_train_settings(request);  // every name and option, before the demonstrations are read
+  const auto dir = opt.demos.resolve(world, cluster);
+  request.demos = read_demo_set(dir).episodes;
+  request.demos_name = dir.string();
   ProgressBar bar;
   request.progress = [&](const Progress& p) {
     std::string text = opt.learner + " " + opt.regressor + ": iteration " + std::to_string(p.iteration) + "/" +

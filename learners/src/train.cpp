@@ -15,16 +15,24 @@ std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const 
   return spec;
 }
 
-TrainReport train_model(const TrainRequest& request) {
+std::string check_train_settings(const TrainRequest& request) {
   const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
-  // An unknown regressor or a bad --set value (it used to surface only at the first fit,
-  // after DART had recorded its episodes) fails here, before any work.
+  for (const auto& [key, value] : learner->params().as_text())
+    if (key == "perturb") learner_perturbation(learner->params(), request.world, request.learner);
+  // An unknown regressor or a bad --set value would otherwise surface only at the first fit,
+  // after DART had recorded its episodes.
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(
       request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
   check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
+  return features.name();
+}
+
+TrainReport train_model(const TrainRequest& request) {
+  const FeatureMap& features = feature_map(check_train_settings(request));
+  const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
   if (request.demos.empty())
     throw InputError((request.demos_name.empty() ? std::string("the demonstrations") : request.demos_name) +
                      ": no episode to train on");

@@ -245,6 +245,25 @@ TEST(Cli, TheReferencePagesAreWhatTheCommandsPrint) {
   }
 }
 
+// Every name and option of a training run is checked before its demonstrations are read: a
+// bad one is named even when the demonstrations do not exist (and so before any episode).
+TEST(CliInput, ABadNameOrOptionIsRefusedBeforeTheDemonstrationsAreRead) {
+  const std::string base = "train --demos /nonexistent/set --out " + test::scratch_path("dicestack_cli_edge.dsm").string();
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {" --regressor knn --learner dart --option perturb=nosuch", "option perturb: nosuch: not a perturbation level"},
+      {" --regressor knn --learner dart --features state+x", "unknown part \"x\""},
+      {" --regressor knn --learner dart --option tracker_preset=x", "\"tracker_preset\" must be one of plain, distill"},
+      {" --regressor knn --set k=-1", "\"k\" must be in [1, 64]"},
+      {" --regressor knn --learner dagger --option expert=oracle", "\"expert\" must be one of"},
+      {" --regressor nosuch", "nosuch"}};
+  for (const auto& [args, message] : cases) {
+    const Process p = run_within(5, base + args);
+    EXPECT_EQ(p.status, 1) << args << "\n" << p.output;
+    EXPECT_THAT(p.output, HasSubstr(message)) << args;
+    EXPECT_THAT(p.output, Not(HasSubstr("/nonexistent/set"))) << args << ": the demonstrations were read first";
+  }
+}
+
 TEST(Cli, RolloutWritesAPng) {
   const auto png = test::scratch_path("dicestack_cli_rollout.png");
   std::filesystem::remove(png);

@@ -49,9 +49,15 @@ struct TrainReport {
   Score score;                       ///< eq. 9 on the training and held-out episodes
 };
 
-/// Checks the learner, its options, the regressor and the feature map before any work
-/// (ConfigError), splits, runs the learner and records learner, options, demonstrations, split
-/// and seed in the model. Throws InputError when the split leaves nothing to train on.
+/// Checks what a request names, without its demonstrations: the learner and its options (a
+/// `perturb` level or file against the world), the regressor and its settings, the feature map
+/// (and an "/ahead" map's world) and the split. Throws ConfigError naming the first bad one;
+/// returns the feature map's name. Callers run it before reading any demonstration.
+std::string check_train_settings(const TrainRequest& request);
+
+/// check_train_settings, then splits, runs the learner and records learner, options,
+/// demonstrations, split and seed in the model. Throws InputError when the split leaves nothing
+/// to train on.
 TrainReport train_model(const TrainRequest& request);
 
 }  // namespace dicestack
