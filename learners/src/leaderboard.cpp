@@ -27,6 +27,7 @@
 
 #include <dicestack/learners/results_page.hpp>
 
+#include "leaderboard_json.hpp"
 #include "leaderboard_rows.hpp"
 
 namespace dicestack {
@@ -34,7 +35,15 @@ namespace {
 
 using nlohmann::json;
 
-json row_json(const LeaderboardRow& r) {
+constexpr const char* kPartialFormat = "dicestack-leaderboard-partial";
+
+Ownership partial_ownership() {
+  return Ownership::json_object("dicestack leaderboard progress file", kPartialFormat, {"meta", "rows"});
+}
+
+}  // namespace
+
+json leaderboard_row_object(const LeaderboardRow& r) {
   const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
   return {{"regressor", r.regressor},     {"learner", r.learner},          {"features", r.features},
           {"train_error", r.train_error},
@@ -46,10 +55,12 @@ json row_json(const LeaderboardRow& r) {
           {"fit_s", r.fit_s},             {"us_per_step", r.us_per_step}};
 }
 
+namespace {
+
 // A row as the progress file keeps it: the table's row, its rollouts' results, and its
 // previews when the run keeps them (html).
-json partial_row_json(const LeaderboardRow& r) {
-  json j = row_json(r);
+json partial_leaderboard_row_object(const LeaderboardRow& r) {
+  json j = leaderboard_row_object(r);
   json rollouts = json::array();
   for (const RowRollout& o : r.rollouts) {
     const EpisodeResult& e = o.result;
@@ -142,107 +153,8 @@ double estimated_row_cost(const std::string& learner, const std::string& regress
   return fit_cost + own + rollout_steps * (step_us + 25.0) * 1e-6;
 }
 
+
 namespace {
-
-std::string pct(int k, int n) {
-  const Rate r = wilson(k, n);
-  char s[64];
-  std::snprintf(s, sizeof s, "%.0f%% [%.0f-%.0f]", 100 * r.value, 100 * r.low, 100 * r.high);
-  return s;
-}
-
-std::string fixed(double v, int digits) {
-  if (v < 0) return "-";
-  char s[32];
-  std::snprintf(s, sizeof s, "%.*f", digits, v);
-  return s;
-}
-
-constexpr const char* kLeaderboardFormat = "dicestack-leaderboard";
-constexpr const char* kPartialFormat = "dicestack-leaderboard-partial";
-constexpr const char* kCsvHeader =
-    "regressor,learner,features,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
-    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
-// The header before feature maps had a column (still ours to replace).
-constexpr const char* kCsvHeaderV1 =
-    "regressor,learner,train_error,test_error,dice_in_cup_mean,stacked_rate,stacked_low,stacked_high,"
-    "wall_contact_rate,realistic_success_rate,realistic_success_low,realistic_success_high,episodes,fit_s,us_per_step";
-
-Ownership md_ownership(const std::string& format, const std::string& marker) {
-  // Our marker line, or the header line tables had before the marker.
-  return {"dicestack leaderboard (" + format + ")", [marker, format](const std::filesystem::path& p) {
-            std::ifstream in(p, std::ios::binary);
-            std::string first;
-            std::getline(in, first);
-            const std::string old = format == "latex" ? "% dicestack " : "dicestack ";
-            return first == marker || (first.rfind(old, 0) == 0 && first.find(" leaderboard: ") != std::string::npos);
-          }};
-}
-
-Ownership partial_ownership() {
-  return Ownership::json_object("dicestack leaderboard progress file", kPartialFormat, {"meta", "rows"});
-}
-
-const std::vector<std::string> kColumns{"regressor", "learner", "features", "train error", "test error", "dice in cup",
-                                        "stacked", "wall contact", "realistic success", "fit s", "us/step"};
-
-std::vector<std::string> cells(const LeaderboardRow& r) {
-  return {r.regressor, r.learner, r.features, fixed(r.train_error, 3), fixed(r.test_error, 3),
-          fixed(r.dice_in_cup, 2), pct(r.stacked, r.episodes), pct(r.walls, r.episodes),
-          pct(r.success, r.episodes), fixed(r.fit_s, 2), fixed(r.us_per_step, 1)};
-}
-
-std::string render_json(const Leaderboard& board) {
-  json j = json::parse(board.meta_json);
-  j["format"] = kLeaderboardFormat;
-  j["version"] = 1;
-  j["rows"] = json::array();
-  for (const auto& r : board.rows) j["rows"].push_back(row_json(r));
-  return j.dump(2) + '\n';
-}
-
-std::string render_csv(const Leaderboard& board) {
-  std::ostringstream os;
-  os << kCsvHeader << '\n';
-  for (const auto& r : board.rows) {
-    const Rate st = wilson(r.stacked, r.episodes), wc = wilson(r.walls, r.episodes), rs = wilson(r.success, r.episodes);
-    os << r.regressor << ',' << r.learner << ',' << r.features << ',' << r.train_error << ',' << r.test_error << ',' << r.dice_in_cup << ','
-       << st.value << ',' << st.low << ',' << st.high << ',' << wc.value << ',' << rs.value << ',' << rs.low << ','
-       << rs.high << ',' << r.episodes << ',' << r.fit_s << ',' << r.us_per_step << '\n';
-  }
-  return os.str();
-}
-
-std::string render_latex(const Leaderboard& board) {
-  std::ostringstream os;
-  os << "% " << board.header << "\n\\begin{tabular}{lllrrrrrrrr}\n\\hline\n";
-  for (std::size_t c = 0; c < kColumns.size(); ++c) os << kColumns[c] << (c + 1 < kColumns.size() ? " & " : " \\\\\n\\hline\n");
-  for (const auto& r : board.rows) {
-    const auto v = cells(r);
-    for (std::size_t c = 0; c < v.size(); ++c) {
-      std::string cell = v[c];
-      for (std::size_t p = 0; (p = cell.find_first_of("%_", p)) != std::string::npos; p += 2) cell.insert(p, "\\");
-      os << cell << (c + 1 < v.size() ? " & " : " \\\\\n");
-    }
-  }
-  os << "\\hline\n\\end{tabular}\n";
-  return os.str();
-}
-
-std::string render_md(const Leaderboard& board) {
-  std::ostringstream os;
-  os << board.header << "\n\n|";
-  for (const auto& c : kColumns) os << ' ' << c << " |";
-  os << "\n|";
-  for (std::size_t c = 0; c < kColumns.size(); ++c) os << (c < 3 ? "---|" : "---:|");
-  os << '\n';
-  for (const auto& r : board.rows) {
-    os << '|';
-    for (const auto& v : cells(r)) os << ' ' << v << " |";
-    os << '\n';
-  }
-  return os.str();
-}
 
 void check_one_of(const std::string& what, const std::string& value, const std::vector<std::string>& allowed) {
   if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return;
@@ -250,47 +162,6 @@ void check_one_of(const std::string& what, const std::string& value, const std::
   for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
   throw ConfigError("leaderboard: " + what + " \"" + value + "\" is not one of " + list);
 }
-
-}  // namespace
-
-const std::vector<LeaderboardFormat>& leaderboard_formats() {
-  static const std::vector<LeaderboardFormat> formats = [] {
-    using Path = const std::filesystem::path&;
-    auto text = [](std::string (*render)(const Leaderboard&)) { return [render](const Leaderboard& b, Path) { return render(b); }; };
-    std::vector<LeaderboardFormat> f;
-    f.push_back({"md", ".md", "the header line, then a Markdown table", text(render_md),
-                 [] { return md_ownership("md", "<!-- dicestack leaderboard -->"); }, "<!-- dicestack leaderboard -->\n"});
-    f.push_back({"csv", ".csv", "a row per line, rates with their intervals", text(render_csv),
-                 [] { return Ownership::first_line("dicestack leaderboard (csv)", {kCsvHeader, kCsvHeaderV1}); }, ""});
-    f.push_back({"latex", ".tex", "a tabular, the header line as a comment", text(render_latex),
-                 [] { return md_ownership("latex", "% dicestack leaderboard"); }, "% dicestack leaderboard\n"});
-    f.push_back({"json", ".json", "the settings and a \"rows\" array", text(render_json),
-                 [] { return Ownership::json_object("dicestack leaderboard (json)", kLeaderboardFormat, {"rows", "dicestack_version"}); },
-                 ""});
-    LeaderboardFormat html{"html", ".html",
-                           "a page for a browser: sortable table, previews, per-episode results in <page>_files/ (docs/results-pages.md)",
-                           [](const Leaderboard& b, Path) { return results_page_html(b, ""); },
-                           [] { return results_page_ownership(); }, std::string(kResultsPageMarker) + "\n"};
-    html.write = [](const Leaderboard& b, Path out) { write_results_page(b, out); };
-    html.check_beside = [](Path out) { check_page_media_replaceable(page_media_folder(out)); };
-    html.echo = "md";
-    f.push_back(std::move(html));
-    return f;
-  }();
-  return formats;
-}
-
-const LeaderboardFormat& leaderboard_format(const std::string& name) {
-  std::vector<std::string> names;
-  for (const LeaderboardFormat& f : leaderboard_formats()) {
-    if (f.name == name) return f;
-    names.push_back(f.name);
-  }
-  check_one_of("format", name, names);
-  throw std::logic_error("unreachable");
-}
-
-namespace {
 
 using Say = std::function<void(const std::string& text, double fraction)>;
 
@@ -526,7 +397,7 @@ std::vector<std::optional<LeaderboardRow>> measure_jobs(const RunPlan& plan, con
   std::size_t finished = 0;
   auto keep_row = [&](std::size_t j, LeaderboardRow row) {
     if (!jobs[j].key.empty() && !partial.empty() && cluster.is_root()) {
-      done[jobs[j].key] = partial_row_json(row);
+      done[jobs[j].key] = partial_leaderboard_row_object(row);
       AtomicFile f(partial, partial_ownership());
       f.stream() << json{{"format", kPartialFormat}, {"version", 1}, {"meta", plan.meta}, {"rows", done}}.dump();
       f.commit();
@@ -704,7 +575,7 @@ std::string render_leaderboard(const Leaderboard& board, const std::string& form
   return leaderboard_format(format).render(board, {});
 }
 
-std::string leaderboard_row_json(const LeaderboardRow& row) { return row_json(row).dump(); }
+std::string leaderboard_row_json(const LeaderboardRow& row) { return leaderboard_row_object(row).dump(); }
 
 void write_leaderboard(const Leaderboard& board, const std::string& format_name, const std::filesystem::path& out) {
   const LeaderboardFormat& format = leaderboard_format(format_name);
