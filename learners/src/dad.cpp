@@ -116,6 +116,36 @@ int made_at(const Episode& e) {
   }
 }
 
+// Where a DaD run stands between iterations: its data, its curve, the policy now and the best
+// so far, and its corrections' counts. What a checkpoint saves.
+struct DadRun {
+  std::vector<Episode> data;  // the demonstrations, then each correction once
+  LearnResult result;
+  std::shared_ptr<Model> model, best;
+  double best_deviation = 0.0;
+  int best_iteration = 0, first = 1;
+  std::size_t corrections = 0, filtered = 0;
+  bool from_training = false;
+
+  // The iteration's policy is better: from training starts, it stacks from more of them (then
+  // follows its targets closer); else it follows the held-out demonstrations closer.
+  bool better(const CurvePoint& p) const {
+    if (!from_training) return p.deviation < best_deviation;
+    const CurvePoint& b = result.curve[static_cast<std::size_t>(best_iteration)];
+    return p.realistic_success_rate > b.realistic_success_rate ||
+           (p.realistic_success_rate == b.realistic_success_rate && p.deviation < b.deviation);
+  }
+  // Adds iteration k's point to the curve, keeping its policy when it is the best so far.
+  void add(const CurvePoint& point, int k) {
+    const bool improved = better(point);
+    result.curve.push_back(point);
+    if (!improved) return;
+    best = model;
+    best_deviation = point.deviation;
+    best_iteration = k;
+  }
+};
+
 // DaD with windowed annealing (paper VI-E, DESIGN "Learners"): roll the policy out from each
 // demonstration's first state; at every w-th step, from the policy's own drifted world, find
 // the next w actions that bring the simulated cup back onto the demonstration's cup path (or,
@@ -133,9 +163,6 @@ class Dad final : public Learner {
   LearnResult learn(const LearnContext& c) const override {
     const DadPlan plan = make_plan();
     const bool from_training = params().choice("starts") == "training";
-    // A window cut from the middle of a rollout carries the rollout before it, as history, for a
-    // map that reads more than the current state (the step index, the start, the frame).
-    const bool with_history = c.features != "state";
     std::string followed;  // from training starts: the recordings the tracker followed
     const int total = plan.windows * plan.per_window;
     const std::vector<Episode> targets =
@@ -148,41 +175,11 @@ class Dad final : public Learner {
     WorldConfig world = c.world;
     for (const auto& d : targets) world.episode.max_steps = std::max(world.episode.max_steps, static_cast<int>(d.size()) + 1);
 
-    std::vector<Episode> data = targets;  // the demonstrations, then each correction once
-    LearnResult result;
-    std::shared_ptr<Model> best;
-    double best_deviation = 0.0;
-    int best_iteration = 0, first = 1;
-    // The iteration's policy is better: from training starts, it stacks from more of them (then
-    // follows its targets closer); else it follows the held-out demonstrations closer.
-    auto better = [&](const CurvePoint& p) {
-      if (!from_training) return p.deviation < best_deviation;
-      const CurvePoint& b = result.curve[static_cast<std::size_t>(best_iteration)];
-      return p.realistic_success_rate > b.realistic_success_rate ||
-             (p.realistic_success_rate == b.realistic_success_rate && p.deviation < b.deviation);
-    };
-    std::size_t corrections = 0, filtered = 0;
-    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params()))) {
-      first = state->iteration() + 1;
-      data = state->data();
-      result.curve = state->curve();
-      best_iteration = static_cast<int>(state->integer("best_iteration", 0, state->iteration()));
-      best_deviation = state->number("best_deviation");
-      best = std::make_shared<Model>(load_model(c.checkpoint_dir / state->file("best_model"), *c.registry));
-      corrections = static_cast<std::size_t>(state->integer("corrections_kept", 0, INT64_MAX));
-      filtered = static_cast<std::size_t>(state->integer("corrections_filtered", 0, INT64_MAX));
-    }
-    std::shared_ptr<Model> model =
-        fit_model(c, fit_data(data, plan, first - 1), derive_seed(c.seed, static_cast<std::uint64_t>(first - 1)), is_row);
-    if (first == 1) {
-      result.curve.push_back(measure_policy(model, measured, targets, 0, rows_of(data)));
-      best = model;
-      best_deviation = result.curve.back().deviation;
-    }
-
+    DadRun run = start_run(c, plan, targets, measured);
+    run.from_training = from_training;
     EnvPool envs(world, c.threads);
     const auto corrector = make_corrector(plan.corrector, plan.search);
-    for (int k = first; k <= total; ++k) {
+    for (int k = run.first; k <= total; ++k) {
       const int window = (k - 1) / plan.per_window + 1;
       auto report = [&](const char* phase, int done, int of) {
         if (c.progress)
@@ -190,74 +187,20 @@ class Dad final : public Learner {
       };
       report("rollouts", 0, 0);
       std::vector<Episode> rollouts;
-      const std::vector<Task> tasks = policy_tasks(*model, targets, plan, window, fixed_start, envs, c.threads, rollouts);
-
-      // Every rank cut the same windows (the rollouts are deterministic); the corrections, the
-      // heavy part, are dealt among the ranks by window length and gathered in index order.
-      std::atomic<int> finished{0};
-      const int ranks = c.cluster->size();
-      const std::uint64_t round_seed = derive_seed(c.seed, 1000003u + static_cast<std::uint64_t>(k));
-      std::vector<double> cost(tasks.size());
-      for (std::size_t i = 0; i < tasks.size(); ++i) cost[i] = static_cast<double>(tasks[i].problem.target.size());
-      const std::vector<Correction> fixes = distributed_map<Correction>(
-          *c.cluster, tasks.size(), c.threads,
-          [&](std::size_t i, int w) {
-            Correction fix = corrector->correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
-            const int done = std::min(static_cast<int>(tasks.size()), ++finished * ranks);
-            if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
-            return fix;
-          },
-          pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
-
-      std::vector<Episode> made;
-      if (plan.code.label) {
-        made = step_corrections(tasks, fixes, targets, k);
-        corrections += tasks.size();
-      } else {
-        for (std::size_t i = 0; i < tasks.size(); ++i) {
-          if (plan.filter && !(fixes[i].cost < fixes[i].warm_cost)) {
-            ++filtered;
-            continue;
-          }
-          made.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
-                                    with_history ? &rollouts[tasks[i].demo] : nullptr));
-          ++corrections;
-        }
-      }
-      for (auto& e : made) {
-        if (plan.code.units)
-          for (std::size_t t = 0; t < e.size(); ++t)
-            if (e.sources[t] == StepSource::correction) e.actions[t] = scaled(e.actions[t], kCodeLabelUnits);
-        data.push_back(std::move(e));
-      }
+      const std::vector<Task> tasks = policy_tasks(*run.model, targets, plan, window, fixed_start, envs, c.threads, rollouts);
+      const std::vector<Correction> fixes = correct_windows(c, *corrector, envs, tasks, k, report);
+      keep_corrections(plan, tasks, fixes, targets, rollouts, k, c.features != "state", run);
       report("fit", 0, 1);
-      const std::vector<Episode> fitted = fit_data(data, plan, k);
-      model = fit_model(c, fitted, derive_seed(c.seed, static_cast<std::uint64_t>(k)), is_row);
-      CurvePoint point = measure_policy(model, measured, targets, k, rows_of(fitted));
+      const std::vector<Episode> fitted = fit_data(run.data, plan, k);
+      run.model = fit_model(c, fitted, derive_seed(c.seed, static_cast<std::uint64_t>(k)), is_row);
+      CurvePoint point = measure_policy(run.model, measured, targets, k, rows_of(fitted));
       point.window = window;
-      const bool improved = better(point);
-      result.curve.push_back(point);
-      if (improved) {
-        best = model;
-        best_deviation = point.deviation;
-        best_iteration = k;
-      }
-      if (!c.checkpoint_dir.empty() && c.cluster->is_root()) {
-        // The best model is named by its iteration and written before the state that names it.
-        const std::string best_file = "best-" + std::to_string(best_iteration) + ".model";
-        fs::create_directories(c.checkpoint_dir);
-        if (!model_ownership().recognises(c.checkpoint_dir / best_file)) save_model(*best, c.checkpoint_dir / best_file);
-        save_checkpoint(c.checkpoint_dir, k,
-                        {{"run", run_settings(c, params())}, {"seed", c.seed}, {"regressor", c.regressor}, {"best_iteration", best_iteration},
-                         {"best_model", best_file}, {"best_deviation", best_deviation}, {"corrections_kept", corrections},
-                         {"corrections_filtered", filtered}, {"curve", curve_to_json(result.curve)}},
-                        "dad.json", c, data, "DaD data after iteration " + std::to_string(k));
-        remove_old_best_models(c.checkpoint_dir, best_file);
-      }
+      run.add(point, k);
+      if (!c.checkpoint_dir.empty() && c.cluster->is_root()) save_state(c, k, run);
     }
-    const std::shared_ptr<Model> chosen = plan.keep_best ? best : model;
+    const std::shared_ptr<Model> chosen = plan.keep_best ? run.best : run.model;
     chosen->record["learner"] = "dad";
-    chosen->record["dad_iteration"] = std::to_string(plan.keep_best ? best_iteration : total);
+    chosen->record["dad_iteration"] = std::to_string(plan.keep_best ? run.best_iteration : total);
     chosen->record["dad_targets"] = std::to_string(targets.size());
     chosen->record["dad_scored_on"] = from_training ? std::to_string(targets.size()) + " training starts (realistic success)"
                                       : c.held_out.empty() ? "targets"
@@ -266,11 +209,11 @@ class Dad final : public Learner {
       chosen->record["dad_starts"] = "training";
       chosen->record["tracker_followed"] = followed;
     }
-    chosen->record["dad_corrections_kept"] = std::to_string(corrections);
-    chosen->record["dad_corrections_filtered"] = std::to_string(filtered);
+    chosen->record["dad_corrections_kept"] = std::to_string(run.corrections);
+    chosen->record["dad_corrections_filtered"] = std::to_string(run.filtered);
     if (plan.code.any()) chosen->record["dad_faithful"] = params().choice("faithful");
-    result.model = chosen;
-    return result;
+    run.result.model = chosen;
+    return run.result;
   }
 
   static std::vector<ParamSpec> schema() {
@@ -313,6 +256,97 @@ class Dad final : public Learner {
   }
 
  private:
+  // A fresh run (the demonstrations, the first fit, its point), or the checkpoint's.
+  DadRun start_run(const LearnContext& c, const DadPlan& plan, const std::vector<Episode>& targets,
+                   const LearnContext& measured) const {
+    DadRun run;
+    run.data = targets;
+    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params()))) {
+      run.first = state->iteration() + 1;
+      run.data = state->data();
+      run.result.curve = state->curve();
+      run.best_iteration = static_cast<int>(state->integer("best_iteration", 0, state->iteration()));
+      run.best_deviation = state->number("best_deviation");
+      run.best = std::make_shared<Model>(load_model(c.checkpoint_dir / state->file("best_model"), *c.registry));
+      run.corrections = static_cast<std::size_t>(state->integer("corrections_kept", 0, INT64_MAX));
+      run.filtered = static_cast<std::size_t>(state->integer("corrections_filtered", 0, INT64_MAX));
+    }
+    run.model = fit_model(c, fit_data(run.data, plan, run.first - 1), derive_seed(c.seed, static_cast<std::uint64_t>(run.first - 1)),
+                          is_row);
+    if (run.first == 1) {
+      run.result.curve.push_back(measure_policy(run.model, measured, targets, 0, rows_of(run.data)));
+      run.best = run.model;
+      run.best_deviation = run.result.curve.back().deviation;
+    }
+    return run;
+  }
+
+  // Iteration k's corrections of its windows. Every rank cut the same windows (the rollouts are
+  // deterministic); the corrections, the heavy part, are dealt among the ranks by window length
+  // and gathered in index order.
+  template <class Report>
+  std::vector<Correction> correct_windows(const LearnContext& c, const Corrector& corrector, EnvPool& envs,
+                                          const std::vector<Task>& tasks, int k, const Report& report) const {
+    std::atomic<int> finished{0};
+    const int ranks = c.cluster->size();
+    const std::uint64_t round_seed = derive_seed(c.seed, 1000003u + static_cast<std::uint64_t>(k));
+    std::vector<double> cost(tasks.size());
+    for (std::size_t i = 0; i < tasks.size(); ++i) cost[i] = static_cast<double>(tasks[i].problem.target.size());
+    return distributed_map<Correction>(
+        *c.cluster, tasks.size(), c.threads,
+        [&](std::size_t i, int w) {
+          Correction fix = corrector.correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
+          const int done = std::min(static_cast<int>(tasks.size()), ++finished * ranks);
+          if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
+          return fix;
+        },
+        pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
+  }
+
+  // Adds iteration k's corrections to the data, once each (or, as the paper's code labels,
+  // every step of each window), and counts them. `with_history`: a window cut from the middle
+  // of a rollout carries the rollout before it, for a map that reads more than the current state.
+  static void keep_corrections(const DadPlan& plan, const std::vector<Task>& tasks, const std::vector<Correction>& fixes,
+                               const std::vector<Episode>& targets, const std::vector<Episode>& rollouts, int k,
+                               bool with_history, DadRun& run) {
+    std::vector<Episode> made;
+    if (plan.code.label) {
+      made = step_corrections(tasks, fixes, targets, k);
+      run.corrections += tasks.size();
+    } else {
+      for (std::size_t i = 0; i < tasks.size(); ++i) {
+        if (plan.filter && !(fixes[i].cost < fixes[i].warm_cost)) {
+          ++run.filtered;
+          continue;
+        }
+        made.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
+                                  with_history ? &rollouts[tasks[i].demo] : nullptr));
+        ++run.corrections;
+      }
+    }
+    for (auto& e : made) {
+      if (plan.code.units)
+        for (std::size_t t = 0; t < e.size(); ++t)
+          if (e.sources[t] == StepSource::correction) e.actions[t] = scaled(e.actions[t], kCodeLabelUnits);
+      run.data.push_back(std::move(e));
+    }
+  }
+
+  // The checkpoint after iteration k: the best model, named by its iteration and written before
+  // the state that names it, then the state.
+  void save_state(const LearnContext& c, int k, const DadRun& run) const {
+    const std::string best_file = "best-" + std::to_string(run.best_iteration) + ".model";
+    fs::create_directories(c.checkpoint_dir);
+    if (!model_ownership().recognises(c.checkpoint_dir / best_file)) save_model(*run.best, c.checkpoint_dir / best_file);
+    save_checkpoint(c.checkpoint_dir, k,
+                    {{"run", run_settings(c, params())}, {"seed", c.seed}, {"regressor", c.regressor},
+                     {"best_iteration", run.best_iteration}, {"best_model", best_file}, {"best_deviation", run.best_deviation},
+                     {"corrections_kept", run.corrections}, {"corrections_filtered", run.filtered},
+                     {"curve", curve_to_json(run.result.curve)}},
+                    "dad.json", c, run.data, "DaD data after iteration " + std::to_string(k));
+    remove_old_best_models(c.checkpoint_dir, best_file);
+  }
+
   DadPlan make_plan() const {
     DadPlan p;
     p.code = code_parts(params().choice("faithful"));
