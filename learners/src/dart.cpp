@@ -1,3 +1,5 @@
+#include <cstdio>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/datasets/features.hpp>
@@ -8,6 +10,55 @@
 namespace dicestack {
 namespace {
 
+// DART's options as one run uses them, every default that depends on the expert or the feature
+// map resolved in one place (dart_settings); the model records them as "dart_settings".
+struct DartSettings {
+  std::string expert;
+  int episodes = 0;
+  Action noise{};  // per action dimension, as fractions of action.scale
+  bool replan = false, retry = false, successes_only = true, include_demos = false;
+  int mpc_robust = 0;
+
+  std::string summary() const {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "expert=%s, episodes=%d, noise=%g/%g/%g, replan=%s, retry=%s, mpc_robust=%d, successes_only=%s, "
+                  "include_demos=%s",
+                  expert.c_str(), episodes, noise[0], noise[1], noise[2], replan ? "true" : "false", retry ? "true" : "false",
+                  mpc_robust, successes_only ? "true" : "false", include_demos ? "true" : "false");
+    return text;
+  }
+};
+
+// DART's noise in dvy and dw when the tracker demonstrates (fractions of action.scale).
+constexpr double kDartTrackerNoiseDvy = 0.5, kDartTrackerNoiseDw = 0.2;
+// Noisy demonstrations by default, and with the tracker for a "/position" map.
+constexpr int kDartEpisodes = 300, kDartServoEpisodes = 1200;
+
+DartSettings dart_settings(const Params& params, const std::string& features) {
+  DartSettings d;
+  d.expert = params.choice("expert");
+  d.episodes = static_cast<int>(params.integer("episodes"));
+  // A servo policy's labels do not change with the noise, so it learns the reference from
+  // how many starts it saw (docs/learners.md: 300 -> 600 episodes 60.2 -> 70.3 %; in the dice
+  // frame, 600 -> 1200 on the tuning seeds 83.0 -> 84.8 %).
+  if (d.episodes == 0) d.episodes = d.expert == "tracker" && servo_targets(features) ? kDartServoEpisodes : kDartEpisodes;
+  const double noise = params.real("noise");
+  d.noise = {noise, noise, noise};
+  // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
+  // that (docs/learners.md: 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
+  if (d.expert == "tracker") d.noise = {noise, kDartTrackerNoiseDvy, kDartTrackerNoiseDw};
+  const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
+  for (std::size_t k = 0; k < kActionDim; ++k)
+    if (params.real(per_dim[k]) >= 0.0) d.noise[k] = params.real(per_dim[k]);
+  d.replan = params.boolean("replan");
+  d.retry = expert_retries(params.choice("retry"), features);
+  d.mpc_robust = static_cast<int>(params.integer("mpc_robust"));
+  d.successes_only = params.boolean("successes_only");
+  d.include_demos = params.boolean("include_demos");
+  return d;
+}
+
 // DART (Laskey et al., CoRL 2017): the expert demonstrates from random training starts while
 // Gaussian noise perturbs what it executes, so the demonstrations visit the states a learner's
 // own errors lead to; the expert's clean actions are the labels; the regressor is fitted once.
@@ -15,46 +66,29 @@ class Dart final : public Learner {
  public:
   using Learner::Learner;
 
-  // DART's noise in dvy and dw when the tracker demonstrates (fractions of action.scale).
-  static constexpr double kTrackerNoiseDvy = 0.5, kTrackerNoiseDw = 0.2;
-  // Noisy demonstrations by default, and with the tracker for a "/position" map.
-  static constexpr int kEpisodes = 300, kServoEpisodes = 1200;
-
   LearnResult learn(const LearnContext& c) const override {
     const Perturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
-    int episodes = static_cast<int>(params().integer("episodes"));
-    // A servo policy's labels do not change with the noise, so it learns the reference from
-    // how many starts it saw (docs/learners.md: 300 -> 600 episodes 60.2 -> 70.3 %; in the dice
-    // frame, 600 -> 1200 on the tuning seeds 83.0 -> 84.8 %).
-    if (episodes == 0) episodes = params().choice("expert") == "tracker" && servo_targets(c.features) ? kServoEpisodes : kEpisodes;
-    const double noise = params().real("noise");
-    Action fraction{noise, noise, noise};
-    // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
-    // that (docs/learners.md: 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
-    if (params().choice("expert") == "tracker") fraction = {noise, kTrackerNoiseDvy, kTrackerNoiseDw};
-    const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
-    for (std::size_t k = 0; k < kActionDim; ++k)
-      if (params().real(per_dim[k]) >= 0.0) fraction[k] = params().real(per_dim[k]);
+    const DartSettings d = dart_settings(params(), c.features);
+    const int episodes = d.episodes;
     if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
-    std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
-    ExpertConfig expert = learner_expert_config(params().choice("expert"), *this, c);
+    std::vector<Episode> data = d.include_demos ? c.demos : std::vector<Episode>{};
+    ExpertConfig expert = learner_expert_config(d.expert, *this, c);
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
-    expert.replan = params().boolean("replan");
-    expert.robust_trials = static_cast<int>(params().integer("mpc_robust"));
-    expert.retry = expert_retries(params().choice("retry"), c.features);
+    expert.replan = d.replan;
+    expert.robust_trials = d.mpc_robust;
+    expert.retry = d.retry;
     RecordRequest request;
     request.episodes = episodes;
     request.seed = c.seed;
     request.threads = c.threads;
-    request.noise = fraction;
+    request.noise = d.noise;
     request.perturbation = perturbation;
-    auto recorded = record_expert(params().choice("expert"), expert, c.world, request, *c.cluster);
+    auto recorded = record_expert(d.expert, expert, c.world, request, *c.cluster);
     int successes = 0;
-    const bool successes_only = params().boolean("successes_only");
     for (auto& e : recorded) {
       successes += e.outcome.realistic_success();
-      if (successes_only && !e.outcome.realistic_success()) continue;
+      if (d.successes_only && !e.outcome.realistic_success()) continue;
       e.origin = "dart";
       data.push_back(std::move(e));
     }
@@ -64,9 +98,10 @@ class Dart final : public Learner {
     LearnResult r;
     r.model = fit_model(c, data, c.seed);
     r.model->record["learner"] = "dart";
-    r.model->record["expert"] = params().choice("expert");
+    r.model->record["expert"] = d.expert;
     r.model->record["dart_episodes"] = std::to_string(episodes);
-    if (params().choice("expert") == "tracker") {  // the option may say -1: the map's default
+    r.model->record["dart_settings"] = d.summary();  // the options as this run used them
+    if (d.expert == "tracker") {  // the option may say -1: the map's default
       r.model->record["tracker_paths"] = std::to_string(expert.recordings->config().paths);
       r.model->record["tracker_followed"] = followed_recordings(*expert.recordings);
     }

@@ -77,6 +77,10 @@ TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
   EXPECT_EQ(learned.model->record.at("learner"), "dart");
   EXPECT_EQ(learned.model->record.at("tracker_paths"), "3") << "the default resolved for a map answering impulses";
+  // The options as the run used them, each default that depends on the expert or the map resolved.
+  EXPECT_EQ(learned.model->record.at("dart_settings"),
+            "expert=tracker, episodes=3, noise=0.1/0.5/0.2, replan=false, retry=false, mpc_robust=0, successes_only=false, "
+            "include_demos=false");
   // The three best-ranked paths (a recording, or a recording smoothed otherwise), each with its
   // score out of 1 probe x (1 + 5 noisy trials), or, a finalist, 1 + 4 probes.
   const std::string followed = learned.model->record.at("tracker_followed");
