@@ -29,9 +29,18 @@ std::string values_of(const ParamSpec& p) {
   }
   if (p.type == ParamType::boolean) return "`true`, `false`";
   if (p.type == ParamType::text) return "text";
-  std::ostringstream os;
-  os << p.min << " to " << p.max;
-  return os.str();
+  // A bound as a user types it: whole numbers in digits, none past +-1e300 (unbounded).
+  const auto bound = [&p](double v) {
+    if (p.type == ParamType::integer) return std::to_string(static_cast<long long>(v));
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  const bool low = p.min > -1e299, high = p.max < 1e299;
+  if (low && high) return bound(p.min) + " to " + bound(p.max);
+  if (low) return "at least " + bound(p.min);
+  if (high) return "at most " + bound(p.max);
+  return "any number";
 }
 
 // One schema as a table: option, type, default, values, what.

@@ -196,9 +196,10 @@ void remove_old_best_models(const fs::path& dir, const std::string& keep) {
   }
 }
 
-json run_settings(const LearnContext& c, const Params& learner_params, const std::vector<std::string>& extendable) {
+json run_settings(const LearnContext& c, const std::vector<std::pair<std::string, std::string>>& learner_options,
+                  const std::vector<std::string>& extendable) {
   json options = json::object();
-  for (const auto& [key, value] : learner_params.as_text())
+  for (const auto& [key, value] : learner_options)
     if (std::find(extendable.begin(), extendable.end(), key) == extendable.end()) options[key] = value;
   const auto& schema = c.registry->info(c.regressor).params;
   return {{"regressor", c.regressor},

@@ -27,11 +27,11 @@ void save_checkpoint(const std::filesystem::path& dir, int iteration, nlohmann::
 void remove_old_best_models(const std::filesystem::path& dir, const std::string& keep);
 
 /// What a run was started with: regressor and its settings (every schema parameter's parsed value,
-/// so "max_depth=08" and "max_depth=8" are one setting), feature map, seed, learner options but
+/// so "max_depth=08" and "max_depth=8" are one setting), feature map, seed, learner options (effective_options: as the run uses them) but
 /// `extendable` (options a resumed run may change, e.g. DAgger's round count: more rounds continue
 /// the same run). Saved in every checkpoint state under "run"; a resumed run must match it.
 /// Throws ConfigError for an unknown regressor or a bad setting.
-nlohmann::json run_settings(const LearnContext& context, const Params& learner_params,
+nlohmann::json run_settings(const LearnContext& context, const std::vector<std::pair<std::string, std::string>>& learner_options,
                             const std::vector<std::string>& extendable = {});
 
 /// A checkpoint state as read back: the common fields checked, the learner's own fields read

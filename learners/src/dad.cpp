@@ -261,7 +261,7 @@ class Dad final : public Learner {
                    const LearnContext& measured) const {
     DadRun run;
     run.data = targets;
-    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, params()))) {
+    if (const auto state = load_checkpoint_state(c, "dad.json", run_settings(c, effective_options(*this)))) {
       run.first = state->iteration() + 1;
       run.data = state->data();
       run.result.curve = state->curve();
@@ -339,7 +339,7 @@ class Dad final : public Learner {
     fs::create_directories(c.checkpoint_dir);
     if (!model_ownership().recognises(c.checkpoint_dir / best_file)) save_model(*run.best, c.checkpoint_dir / best_file);
     save_checkpoint(c.checkpoint_dir, k,
-                    {{"run", run_settings(c, params())}, {"seed", c.seed}, {"regressor", c.regressor},
+                    {{"run", run_settings(c, effective_options(*this))}, {"seed", c.seed}, {"regressor", c.regressor},
                      {"best_iteration", run.best_iteration}, {"best_model", best_file}, {"best_deviation", run.best_deviation},
                      {"corrections_kept", run.corrections}, {"corrections_filtered", run.filtered},
                      {"curve", curve_to_json(run.result.curve)}},

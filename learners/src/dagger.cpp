@@ -38,7 +38,7 @@ class Dagger final : public Learner {
     std::shared_ptr<Model> model;
     LearnResult result;
     int first = 1;
-    if (const auto state = load_checkpoint_state(c, "dagger.json", run_settings(c, params(), extendable()))) {
+    if (const auto state = load_checkpoint_state(c, "dagger.json", run_settings(c, effective_options(*this), extendable()))) {
       first = state->iteration() + 1;
       data = state->data();
       result.curve = state->curve();
@@ -75,7 +75,7 @@ class Dagger final : public Learner {
       result.curve.push_back(measure_policy(model, c, c.demos, i, rows));
       if (!c.checkpoint_dir.empty() && c.cluster->is_root())
         save_checkpoint(c.checkpoint_dir, i,
-                        {{"run", run_settings(c, params(), extendable())}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
+                        {{"run", run_settings(c, effective_options(*this), extendable())}, {"seed", c.seed}, {"regressor", c.regressor}, {"beta", beta}, {"curve", curve_to_json(result.curve)}},
                         "dagger.json", c, data, "DAgger aggregate after round " + std::to_string(i));
     }
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");

@@ -104,6 +104,7 @@ class Dart final : public Learner {
     if (d.expert == "tracker") {  // the option may say -1: the map's default
       r.model->record["tracker_paths"] = std::to_string(expert.recordings->config().paths);
       r.model->record["tracker_followed"] = followed_recordings(*expert.recordings);
+      r.model->record["tracker_settings"] = tracker_summary(expert.recordings->config());
     }
     r.model->record["dart_expert_successes"] = std::to_string(successes);
     if (!perturbation.nominal()) r.model->record["perturb"] = params().choice("perturb");

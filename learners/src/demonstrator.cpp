@@ -2,6 +2,7 @@
 
 #include <dicestack/datasets/features.hpp>
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <sstream>
@@ -146,6 +147,22 @@ TrackerConfig learner_tracker_config(const Learner& learner, const std::string& 
   if (learner.given("tracker_paths") || preset == kLearnerPreset) tracker.paths = tracker_paths_for(paths, features);
   validate(tracker);
   return tracker;
+}
+
+std::vector<std::pair<std::string, std::string>> effective_options(const Learner& learner) {
+  std::vector<std::pair<std::string, std::string>> out = learner.params().as_text();
+  std::string preset;
+  for (const auto& [key, value] : out)
+    if (key == "tracker_preset") preset = value;
+  if (preset.empty() || preset == kLearnerPreset) return out;  // no tracker options, or their defaults are the preset's
+  const TrackerConfig c = tracker_preset(preset);
+  for (auto& [key, value] : out) {
+    if (!key.starts_with("tracker_") || learner.given(key)) continue;
+    const std::string setting = key.substr(8);
+    const auto& names = tracker_setting_names();
+    if (std::find(names.begin(), names.end(), setting) != names.end()) value = tracker_setting_text(c, setting);
+  }
+  return out;
 }
 
 ExpertConfig learner_expert_config(const std::string& name, const Learner& learner, const LearnContext& c) {

@@ -69,23 +69,35 @@ int marker_version(const fs::path& marker) {
 }
 
 // Creates the media folder with its marker, whole (a folder of ours appears or nothing does).
+// First removes what runs killed while creating it left beside it.
 void create_media_folder(const MediaFolder& media) {
   std::error_code ec;
+  for (const auto& dead : dead_leftovers(media.folder, "tmp"))
+    if (fs::is_directory(fs::symlink_status(dead, ec))) fs::remove_all(dead, ec);  // named as only our scratch is
   const fs::path tmp = temporary_sibling(media.folder, "tmp");
-  fs::create_directories(tmp);
-  write_marker(tmp / media.marker, media.format, kMediaGenerationsVersion);
-  fs::rename(tmp, media.folder, ec);
-  if (ec) {  // another run made it first: theirs is as good, if it is ours
+  try {
+    fs::create_directories(tmp);
+    write_marker(tmp / media.marker, media.format, kMediaGenerationsVersion);
+  } catch (...) {
     fs::remove_all(tmp, ec);
-    check_marked_folder(media.folder, media.marker, media.format, media.what);
+    throw;
   }
+  fs::rename(tmp, media.folder, ec);
+  if (!ec) return;
+  const std::error_code failed = ec;
+  fs::remove_all(tmp, ec);
+  // Another run made it first: theirs is as good, if it is ours. Any other failure is this one's.
+  if (!fs::exists(fs::symlink_status(media.folder, ec)))
+    throw InputError(media.folder.string() + ": cannot write: " + failed.message());
+  check_marked_folder(media.folder, media.marker, media.format, media.what);
 }
 
 // Removes what no page links: other generations, an older layout's files and dead runs' scratch.
 void prune(const MediaFolder& media, const std::set<std::string>& keep) {
   std::error_code ec;
-  std::set<fs::path> dead;
+  std::set<fs::path> dead;  // killed runs' scratch generations, and their half-written markers
   for (const auto& p : dead_leftovers(scratch_anchor(media.folder), kScratchTag)) dead.insert(p);
+  for (const auto& p : dead_leftovers(media.folder / media.marker, "tmp")) dead.insert(p);
   std::vector<fs::path> gone;
   for (fs::directory_iterator it(media.folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();

@@ -145,7 +145,12 @@ const rate = (key) => ({
 // spec's long name).
 function breakable(text) {
   const f = document.createDocumentFragment();
-  text.split(/(?<=[+\/:])/).forEach((part, i) => { if (i > 0) f.append(el("wbr")); f.append(part); });
+  let part = "";
+  for (const ch of text) {
+    part += ch;
+    if (ch === "+" || ch === "/" || ch === ":") { f.append(part, el("wbr")); part = ""; }
+  }
+  f.append(part);
   return f;
 }
 function el(tag, attrs, ...children) {
@@ -156,9 +161,15 @@ function el(tag, attrs, ...children) {
 }
 document.title = data.title;
 document.getElementById("title").textContent = data.title;
-// The header line says what the facts say: shown only on a page without facts.
-if (data.facts.length === 0) document.getElementById("header").textContent = data.header;
-else document.getElementById("header").remove();
+// The header line says in one sentence what the facts list (and a few notes besides): on a page
+// with facts it is folded under them, not printed twice.
+const header = document.getElementById("header");
+header.textContent = data.header;
+if (data.facts.length > 0) {
+  const folded = el("details", { id: "header-line" }, el("summary", {}, "the run in one line"));
+  header.replaceWith(folded);
+  folded.append(header);
+}
 const facts = document.getElementById("facts");
 for (const [k, v] of data.facts) facts.append(el("dt", {}, k), el("dd", {}, typeof v === "string" ? v : JSON.stringify(v)));
 // columns: {key, label, value(row), text(row), className}: value (a number, kept in data-value)
@@ -210,6 +221,7 @@ constexpr const char* kTableStyle = R"CSS(
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; color: #222; }
 h1 { font-size: 1.4em; margin: 0 0 .3em; }
 #header { color: #555; font-size: .9em; max-width: 80em; }
+details#header-line { font-size: .9em; color: #555; margin: .3em 0; } details#header-line summary { cursor: pointer; }
 dl#facts { display: grid; grid-template-columns: max-content 1fr; gap: .1em 1em; font-size: .9em; }
 dl#facts dt { font-weight: 600; }
 dl#facts dd { margin: 0; word-break: break-word; }

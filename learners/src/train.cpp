@@ -5,6 +5,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/record.hpp>
 
 namespace dicestack {
@@ -58,7 +59,9 @@ TrainReport train_model(const TrainRequest& request) {
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Model& model = *report.result.model;
   model.record["learner"] = request.learner;
-  model.record["learner_options"] = learner->params().summary();
+  std::string options;  // as the run used them: a tracker option not given shows its preset's value
+  for (const auto& [key, value] : effective_options(*learner)) options += (options.empty() ? "" : ", ") + key + "=" + value;
+  model.record["learner_options"] = options;
   model.record["demos"] = request.demos_name;
   std::string names;  // the recordings it learned from, by name
   for (const auto& e : c.demos) names += (names.empty() ? "" : ", ") + e.name;

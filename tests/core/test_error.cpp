@@ -30,6 +30,7 @@ TEST(ReadableMessage, CutsOnlyBetweenCharacters) {
   const std::size_t tail = shown.find("]...") + 4;
   EXPECT_EQ((shown.size() - tail) % 2, 0u) << "the tail starts on a character boundary";
   EXPECT_EQ(static_cast<unsigned char>(shown[tail]), 0xc3);
+  EXPECT_NE(shown.find("...[220 characters cut]..."), std::string::npos) << "characters, not bytes: " << shown.substr(cut, 40);
 }
 
 }  // namespace

@@ -142,7 +142,10 @@ TEST(ResultsPage, APageAndItsMediaAreOneUnitAndOnlyTheLinkedMediaStay) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path page = dir / "board.html";
+  // A run killed while it created the media folder left its scratch beside it: the next one removes it.
+  fs::create_directories(dir / ".board_files.tmp-999999999-x");
   write_leaderboard(small_board(), "html", page);
+  EXPECT_FALSE(fs::exists(dir / ".board_files.tmp-999999999-x"));
   const std::string first_page = read(page);
   const fs::path first = linked_media(page);
   // The same board again: the same media, the same generation, the same page.

@@ -177,7 +177,9 @@ def test_the_leaderboard_page_fits_a_laptops_width_and_says_its_facts_once(brows
         widths = browser.execute_script(
             "return [document.documentElement.scrollWidth, document.documentElement.clientWidth]")
         assert widths[0] <= widths[1], widths
-        assert browser.find_elements(By.ID, "header") == []
+        folded = browser.find_element(By.ID, "header-line")  # the one-line header, folded under the facts
+        assert folded.tag_name == "details" and folded.get_attribute("open") is None
+        assert not browser.find_element(By.ID, "header").is_displayed()
         assert "state+clock+start_state@dice+retry/position" in browser.find_element(By.ID, "facts").text
         assert no_console_errors(browser) == []
     finally:

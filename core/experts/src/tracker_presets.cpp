@@ -2,6 +2,7 @@
 // config's field names, for record, robustness, Python, the bench and the learners.
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <dicestack/core/error.hpp>
@@ -93,6 +94,33 @@ void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_vi
   } else {
     throw ConfigError("tracker setting \"" + std::string(name) + "\": unknown; settings: " + joined(tracker_setting_names()));
   }
+}
+
+std::string tracker_setting_text(const TrackerConfig& c, std::string_view name) {
+  const auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return std::string(text);
+  };
+  const auto flag = [](bool v) { return std::string(v ? "true" : "false"); };
+  if (name == "probes") return std::to_string(c.probes);
+  if (name == "optimise") return flag(c.optimise);
+  if (name == "paths") return std::to_string(c.paths);
+  if (name == "smooth") return number(c.smooth);
+  if (name == "rescue") return std::to_string(c.rescue);
+  if (name == "robust") return std::to_string(c.robust);
+  if (name == "robust_noise") return number(c.robust_noise);
+  if (name == "robust_warp") return number(c.robust_warp);
+  if (name == "keep_extremes") return flag(c.keep_extremes);
+  if (name == "shrink") return std::to_string(c.shrink);
+  if (name == "variants") return flag(!c.variants.empty());
+  throw ConfigError("tracker setting \"" + std::string(name) + "\": unknown; settings: " + joined(tracker_setting_names()));
+}
+
+std::string tracker_summary(const TrackerConfig& c) {
+  std::string out;
+  for (const auto& name : tracker_setting_names()) out += (out.empty() ? "" : ", ") + name + "=" + tracker_setting_text(c, name);
+  return out;
 }
 
 TrackerConfig tracker_config(std::string_view preset, const std::vector<std::string>& settings) {

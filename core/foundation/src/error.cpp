@@ -17,7 +17,9 @@ std::string cut_word(const std::string& word) {
   while (head > 0 && is_continuation(word[head])) --head;
   std::size_t tail = word.size() - kWordTail;
   while (tail < word.size() && is_continuation(word[tail])) ++tail;
-  return word.substr(0, head) + "...[" + std::to_string(tail - head) + " characters cut]..." + word.substr(tail);
+  std::size_t cut = 0;  // characters, not bytes: each starts with a byte that does not continue one
+  for (std::size_t i = head; i < tail; ++i) cut += is_continuation(word[i]) ? 0 : 1;
+  return word.substr(0, head) + "...[" + std::to_string(cut) + " characters cut]..." + word.substr(tail);
 }
 
 }  // namespace

@@ -64,6 +64,11 @@ std::vector<ParamSpec> tracker_param_specs();
 /// Throws ConfigError as tracker_config.
 TrackerConfig learner_tracker_config(const Learner& learner, const std::string& features);
 
+/// The learner's options as text, each tracker_* option not given shown as its preset's value
+/// (under tracker_preset=distill, the defaults themselves): what checkpoints compare and models
+/// record, so that two runs with the same text ran the same tracker.
+std::vector<std::pair<std::string, std::string>> effective_options(const Learner& learner);
+
 /// The ExpertConfig of a learner's expert `name` (DART, DAgger, DaD): for "tracker", its
 /// recordings made from the context's training demonstrations with learner_tracker_config
 /// (ranked with the context's seed, over its cluster); for the others, the defaults. Throws

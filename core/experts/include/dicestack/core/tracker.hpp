@@ -109,6 +109,11 @@ std::vector<std::string> tracker_preset_names();
 std::vector<std::string> tracker_setting_names();
 /// Sets one of them from text. Throws ConfigError naming the setting and what it takes.
 void set_tracker_setting(TrackerConfig& config, std::string_view name, std::string_view value);
+/// The value of one of them in `config`, as text set_tracker_setting reads back the same.
+std::string tracker_setting_text(const TrackerConfig& config, std::string_view name);
+/// Every setting of `config`, "NAME=VALUE, ...", in tracker_setting_names' order: what a
+/// model records of the tracker that taught it.
+std::string tracker_summary(const TrackerConfig& config);
 /// tracker_preset(preset) with each "NAME=VALUE" of `settings` on top, validated.
 TrackerConfig tracker_config(std::string_view preset, const std::vector<std::string>& settings);
 

@@ -35,9 +35,10 @@ class PluginError : public Error {
 /// user gave (a 1 MB option, a pasted file) and would bury the message.
 inline constexpr std::size_t kLongestWordShown = 200;
 
-/// `message` with every word longer than `longest` cut to its start and end around
-/// "...[N characters cut]...", at UTF-8 character boundaries: how the tool and the Python module
-/// show any error, whichever library or parser wrote it.
+/// `message` with every word longer than `longest` bytes (at least 160: a cut word keeps its
+/// first 120 and last 40 bytes) cut to its start and end around "...[N characters cut]...", at
+/// UTF-8 character boundaries: how the tool and the Python module show any error, whichever
+/// library or parser wrote it.
 std::string readable_message(const std::string& message, std::size_t longest = kLongestWordShown);
 
 }  // namespace dicestack
