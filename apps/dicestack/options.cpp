@@ -28,10 +28,12 @@ WorldConfig WorldOption::load() const {
 }
 
 void TrackerOption::add_to(CLI::App& app) {
-  std::string presets;
-  for (const auto& n : tracker_preset_names()) presets += (presets.empty() ? "" : ", ") + n;
-  std::string names;
-  for (const auto& n : tracker_setting_names()) names += (names.empty() ? "" : ", ") + n;
+  const auto listed = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+  };
+  const std::string presets = listed(tracker_preset_names()), names = listed(tracker_setting_names());
   app.add_option("--tracker-preset", preset,
                  "tracker: its named settings (" + presets + "; distill is the learners' default, docs/expert.md)")
       ->check(CLI::IsMember(tracker_preset_names()))

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <filesystem>
 #include <set>
 #include <unistd.h>
@@ -267,6 +268,25 @@ TEST(LearnerSpec, TheLearnersTrackerIsThePresetWithTheOptionsGivenOnTop) {
   EXPECT_TRUE(p.variants.empty());
   EXPECT_EQ(p.paths, 0) << "plain follows all its recordings";
   EXPECT_THAT(test::error_of([] { parse_learner_spec("dart:tracker_preset=tuned"); }), HasSubstr("plain, distill"));
+  // What checkpoints compare and models record: an option not given shows the preset's value, so
+  // two runs with the same text ran the same tracker.
+  const auto options = [](const Learner& l) {
+    std::map<std::string, std::string> out;
+    for (const auto& [k, v] : effective_options(l)) out[k] = v;
+    return out;
+  };
+  const auto shown = options(*plain);
+  EXPECT_EQ(shown.at("tracker_smooth"), "2") << "given";
+  EXPECT_EQ(shown.at("tracker_robust"), "0") << "plain's, not distill's default 5";
+  EXPECT_EQ(shown.at("tracker_variants"), "false");
+  const auto plain_smooth_4 =
+      LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_preset=plain", "tracker_smooth=4"});
+  const auto plain_alone = LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_preset=plain"});
+  EXPECT_NE(options(*plain_smooth_4).at("tracker_smooth"), options(*plain_alone).at("tracker_smooth"));
+  const auto distill_default = LearnerRegistry::global().create("dart", {"expert=tracker"});
+  std::map<std::string, std::string> as_text;
+  for (const auto& [k, v] : distill_default->params().as_text()) as_text[k] = v;
+  EXPECT_EQ(options(*distill_default), as_text) << "the learners' preset: its options' text as before";
 }
 
 }  // namespace

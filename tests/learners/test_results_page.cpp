@@ -155,6 +155,7 @@ TEST(ResultsPage, APageAndItsMediaAreOneUnitAndOnlyTheLinkedMediaStay) {
   // Another board: a new generation, linked; the old one is gone; a dead run's scratch too.
   const fs::path dead_scratch = dir / "board_files" / ".generation.tmp-999999999-x";
   fs::create_directories(dead_scratch);
+  std::ofstream(dir / "board_files" / ".dicestack-page.json.tmp-999999999-x") << "{";  // a killed marker write
   write_leaderboard(small_board("another"), "html", page);
   const fs::path second = linked_media(page);
   ASSERT_FALSE(second.empty());
