@@ -241,6 +241,83 @@ std::vector<std::string> episode_csv_columns(int version) {
 
 namespace {
 
+// Checks a CSV header row (either layout version's columns, in order); sets `columns` to its
+// column names and returns the version.
+int check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
+  if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2)
+    throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
+                     std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1) or " +
+                     std::to_string(kColumnsV2) + " (the same and reward: version 2)");
+  const std::size_t width = fields.size();
+  const int version = width == kColumnsV1 ? 1 : 2;
+  columns = episode_csv_columns(version);
+  for (std::size_t c = 0; c < width; ++c)
+    if (trim(fields[c]) != columns[c])
+      throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
+                       "\", expected \"" + columns[c] + "\"");
+  return version;
+}
+
+// The numeric columns of a row (t, state, action), each a finite number.
+std::array<double, kNumbers> parse_csv_numbers(const std::vector<std::string_view>& fields, const std::string& prefix,
+                                               const std::vector<std::string>& columns) {
+  std::array<double, kNumbers> values{};
+  for (std::size_t c = 0; c < kNumbers; ++c) {
+    const std::string_view f = trim(fields[c]);
+    double v = 0.0;
+    const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+    if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
+      throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
+                       (f.size() > 40 ? "...\"" : "\"") + " is not a number");
+    if (!std::isfinite(v))
+      throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
+                       "; demonstrations must be finite");
+    values[c] = v;
+  }
+  return values;
+}
+
+// The reward cell `f` of the row just appended to `e`: empty in every row (unknown, as in the
+// first row, which sets `reward_empty`) or a finite number in every row.
+void parse_csv_reward(std::string_view f, const std::string& prefix, bool& reward_empty, Episode& e) {
+  if (e.states.size() == 1) reward_empty = f.empty();
+  if (f.empty() != reward_empty)
+    throw InputError(prefix + "column \"reward\" is " + (f.empty() ? "empty" : "a number") + " but line 2's is " +
+                     (reward_empty ? "empty" : "a number") + "; an episode's rewards are all known or all empty");
+  if (f.empty()) return;
+  double v = 0.0;
+  const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+  if (r.ec != std::errc() || r.ptr != f.data() + f.size())
+    throw InputError(prefix + "column \"reward\": \"" + std::string(f.substr(0, 40)) + (f.size() > 40 ? "...\"" : "\"") +
+                     " is not a number");
+  if (!std::isfinite(v))
+    throw InputError(prefix + "column \"reward\" is " + (std::isnan(v) ? "NaN" : "infinite") + "; demonstrations must be finite");
+  e.rewards.push_back(v);
+}
+
+// Appends one data row (its width already checked) to `e`: the next step's state, action,
+// source and, in version 2, reward.
+void append_csv_row(const std::vector<std::string_view>& fields, const std::string& prefix,
+                    const std::vector<std::string>& columns, int version, bool& reward_empty, Episode& e) {
+  const std::array<double, kNumbers> values = parse_csv_numbers(fields, prefix, columns);
+  const double expected_t = static_cast<double>(e.states.size());
+  if (values[0] != expected_t)
+    throw InputError(prefix + "column \"t\" is " + number_text(values[0]) + ", expected " + number_text(expected_t) +
+                     " (rows are consecutive steps from 0)");
+  State s;
+  std::copy(values.begin() + 1, values.begin() + 1 + kStateDim, s.begin());
+  Action a;
+  std::copy(values.begin() + 1 + kStateDim, values.end(), a.begin());
+  e.states.push_back(s);
+  e.actions.push_back(a);
+  try {
+    e.sources.push_back(step_source_from(trim(fields[kNumbers])));
+  } catch (const InputError& err) {
+    throw InputError(prefix + "column \"source\": " + err.what());
+  }
+  if (version >= 2) parse_csv_reward(trim(fields[kNumbers + 1]), prefix, reward_empty, e);
+}
+
 // parse_episode_csv, also telling the file's layout version (by its header).
 Episode parse_csv(std::string_view text, const std::string& where, std::string name, int& version) {
   std::vector<std::string> columns;
@@ -262,68 +339,14 @@ Episode parse_csv(std::string_view text, const std::string& where, std::string n
     }
     split_fields(line, fields);
     if (line_no == 1) {
-      if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2)
-        throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
-                         std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1) or " +
-                         std::to_string(kColumnsV2) + " (the same and reward: version 2)");
+      version = check_csv_header(fields, prefix, columns);
       width = fields.size();
-      version = width == kColumnsV1 ? 1 : 2;
-      columns = episode_csv_columns(version);
-      for (std::size_t c = 0; c < width; ++c)
-        if (trim(fields[c]) != columns[c])
-          throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
-                           "\", expected \"" + columns[c] + "\"");
       continue;
     }
     if (fields.size() != width)
       throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
                        std::to_string(width) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
-    std::array<double, kNumbers> values{};
-    for (std::size_t c = 0; c < kNumbers; ++c) {
-      const std::string_view f = trim(fields[c]);
-      double v = 0.0;
-      const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
-      if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
-        throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
-                         (f.size() > 40 ? "...\"" : "\"") + " is not a number");
-      if (!std::isfinite(v))
-        throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
-                         "; demonstrations must be finite");
-      values[c] = v;
-    }
-    const double expected_t = static_cast<double>(e.states.size());
-    if (values[0] != expected_t)
-      throw InputError(prefix + "column \"t\" is " + number_text(values[0]) + ", expected " + number_text(expected_t) +
-                       " (rows are consecutive steps from 0)");
-    State s;
-    std::copy(values.begin() + 1, values.begin() + 1 + kStateDim, s.begin());
-    Action a;
-    std::copy(values.begin() + 1 + kStateDim, values.end(), a.begin());
-    e.states.push_back(s);
-    e.actions.push_back(a);
-    try {
-      e.sources.push_back(step_source_from(trim(fields[kNumbers])));
-    } catch (const InputError& err) {
-      throw InputError(prefix + "column \"source\": " + err.what());
-    }
-    if (version >= 2) {
-      const std::string_view f = trim(fields[kNumbers + 1]);
-      if (e.states.size() == 1) reward_empty = f.empty();
-      if (f.empty() != reward_empty)
-        throw InputError(prefix + "column \"reward\" is " + (f.empty() ? "empty" : "a number") + " but line 2's is " +
-                         (reward_empty ? "empty" : "a number") + "; an episode's rewards are all known or all empty");
-      if (!f.empty()) {
-        double v = 0.0;
-        const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
-        if (r.ec != std::errc() || r.ptr != f.data() + f.size())
-          throw InputError(prefix + "column \"reward\": \"" + std::string(f.substr(0, 40)) + (f.size() > 40 ? "...\"" : "\"") +
-                           " is not a number");
-        if (!std::isfinite(v))
-          throw InputError(prefix + "column \"reward\" is " + (std::isnan(v) ? "NaN" : "infinite") +
-                           "; demonstrations must be finite");
-        e.rewards.push_back(v);
-      }
-    }
+    append_csv_row(fields, prefix, columns, version, reward_empty, e);
   }
   if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
   if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");

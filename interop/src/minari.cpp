@@ -130,6 +130,100 @@ json env_spec(const WorldConfig& world) {
           {"vector_entry_point", "dicestack.vector_env:DiceStackVectorEnv"}};
 }
 
+// Reads data/metadata.json: it must exist, be a JSON object, and name HDF5 storage.
+json read_minari_metadata(const fs::path& meta_path) {
+  const std::string M = meta_path.string();
+  std::error_code ec;
+  if (fs::status(meta_path, ec).type() == fs::file_type::not_found) throw InputError(M + ": missing; not a Minari dataset");
+  json meta = parse_json_text(read_file(meta_path), M);
+  if (!meta.is_object()) throw InputError(M + ": must be a JSON object");
+  if (!meta.contains("data_format") || meta["data_format"] != "hdf5")
+    throw InputError(M + ": \"data_format\" must be \"hdf5\" (the only storage dicestack reads)");
+  return meta;
+}
+
+// The world, description and provenance from metadata.json's "dicestack" object (our marker), if it has one.
+void read_minari_set_record(const json& meta, const std::string& M, DemoSet& set) {
+  if (!meta.contains("dicestack")) return;
+  const json& r = meta["dicestack"];
+  if (!r.is_object() || r.value("format", "") != kMinariFormat)
+    throw InputError(M + ": \"dicestack\" must be an object with \"format\": \"" + kMinariFormat + "\"");
+  if (!r.contains("version") || !r["version"].is_number_integer())
+    throw InputError(M + ": \"dicestack\".\"version\" must be an integer");
+  if (r["version"].get<std::int64_t>() > kInteropFormatVersion)
+    throw InputError(M + ": format version " + std::to_string(r["version"].get<std::int64_t>()) +
+                     " is newer than this dicestack reads (" + std::to_string(kInteropFormatVersion) + "); upgrade dicestack");
+  if (!r.contains("world")) throw InputError(M + ": \"dicestack\" has no \"world\"");
+  set.world = world_config_from_json(r["world"].dump(), M + " \"dicestack\".\"world\"");
+  set.description = r.value("description", set.description);
+  set.provenance = r.value("provenance", "");
+}
+
+// The episode_<n> groups of the main file, sorted; exactly metadata.json's total_episodes of
+// them, numbered from 0 without gaps.
+std::vector<std::string> list_minari_episodes(const h5::ReadFile& f, const std::string& M, std::int64_t total_episodes) {
+  const std::string& F = f.name();
+  std::vector<std::pair<long, std::string>> episodes;
+  for (const auto& name : h5::members(f.root(), F)) {
+    const long n = episode_number(name);
+    if (n < 0) throw InputError(F + ": " + name.substr(0, 60) + ": not an episode_<n> group");
+    episodes.emplace_back(n, name);
+  }
+  std::sort(episodes.begin(), episodes.end());
+  if (static_cast<std::int64_t>(episodes.size()) != total_episodes)
+    throw InputError(M + ": \"total_episodes\" is " + std::to_string(total_episodes) + ", but " + F + " holds " +
+                     std::to_string(episodes.size()) + " episodes");
+  if (episodes.empty()) throw InputError(F + ": holds no episode");
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    if (episodes[i].first != static_cast<long>(i))
+      throw InputError(F + ": episode_" + std::to_string(i) + ": missing (episodes are numbered from 0 without gaps)");
+    names.push_back(episodes[i].second);
+  }
+  return names;
+}
+
+// Reads and checks the main file's group `name`, the episode at `index` of the dataset in `dir`.
+Episode read_minari_episode(const h5::ReadFile& f, const std::string& name, std::size_t index, const fs::path& dir,
+                            const WorldConfig& world) {
+  const auto& limit = world.action.limit;
+  const std::string where = f.name() + ": " + name;
+  const h5::Id g = h5::open_group(f.root(), name, where);
+  const h5::Array actions = read_rows(g.get(), "actions", where + "/actions", kActionDim);
+  const std::size_t steps = actions.dims[0];
+  const h5::Array obs = read_shaped(g.get(), "observations", where + "/observations", steps + 1, kStateDim);
+  const h5::Array rewards = read_shaped(g.get(), "rewards", where + "/rewards", steps, 0);
+  const auto terminations = end_flags(g.get(), "terminations", where + "/terminations", steps);
+  const auto truncations = end_flags(g.get(), "truncations", where + "/truncations", steps);
+  if (const auto n = h5::read_attr_int(g.get(), "total_steps", where); n && *n != static_cast<std::int64_t>(steps))
+    throw InputError(where + ": attribute total_steps is " + std::to_string(*n) + ", but actions has " +
+                     std::to_string(steps) + " rows");
+
+  Episode e;
+  e.states.resize(steps);
+  State final_state{};
+  for (std::size_t t = 0; t <= steps; ++t) {
+    State& s = t < steps ? e.states[t] : final_state;
+    std::copy_n(obs.values.begin() + static_cast<std::ptrdiff_t>(t * kStateDim), kStateDim, s.begin());
+  }
+  e.final_state = final_state;
+  e.actions.resize(steps);
+  for (std::size_t t = 0; t < steps; ++t)
+    for (std::size_t k = 0; k < kActionDim; ++k) {
+      const double a = actions.values[t * kActionDim + k];
+      if (std::abs(a) > limit[k])
+        throw InputError(where + "/actions: row " + std::to_string(t) + " column " + std::to_string(k) +
+                         " is outside the world's action.limit (" + py_number(limit[k]) + ")");
+      e.actions[t][k] = a;
+    }
+  e.rewards = rewards.values;
+  e.terminated = terminations.back() != 0.0;
+  e.truncated = truncations.back() != 0.0;
+  read_episode_record(g.get(), where, index, "seed", "minari " + dir.string() + " " + name, world, e);
+  check_read_episode(e, where);
+  return e;
+}
+
 }  // namespace
 
 std::string default_minari_dataset_id(const fs::path& set_dir) {
@@ -212,89 +306,22 @@ DemoSet import_minari(const fs::path& dir, const WorldConfig& fallback_world) {
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a folder (a Minari dataset is a folder holding data/)");
   const fs::path meta_path = dir / "data" / kMetadataFile;
   const std::string M = meta_path.string();
-  std::error_code ec;
-  if (fs::status(meta_path, ec).type() == fs::file_type::not_found) throw InputError(M + ": missing; not a Minari dataset");
-  const json meta = parse_json_text(read_file(meta_path), M);
-  if (!meta.is_object()) throw InputError(M + ": must be a JSON object");
-  if (!meta.contains("data_format") || meta["data_format"] != "hdf5")
-    throw InputError(M + ": \"data_format\" must be \"hdf5\" (the only storage dicestack reads)");
+  const json meta = read_minari_metadata(meta_path);
   const auto total_episodes = meta_integer(meta, "total_episodes", M);
   const auto total_steps = meta_integer(meta, "total_steps", M);
   DemoSet set;
   set.world = fallback_world;
   set.description = meta.contains("description") && meta["description"].is_string() ? meta["description"].get<std::string>()
                                                                                      : "imported from Minari dataset " + dir.string();
-  if (meta.contains("dicestack")) {
-    const json& r = meta["dicestack"];
-    if (!r.is_object() || r.value("format", "") != kMinariFormat)
-      throw InputError(M + ": \"dicestack\" must be an object with \"format\": \"" + kMinariFormat + "\"");
-    if (!r.contains("version") || !r["version"].is_number_integer())
-      throw InputError(M + ": \"dicestack\".\"version\" must be an integer");
-    if (r["version"].get<std::int64_t>() > kInteropFormatVersion)
-      throw InputError(M + ": format version " + std::to_string(r["version"].get<std::int64_t>()) +
-                       " is newer than this dicestack reads (" + std::to_string(kInteropFormatVersion) + "); upgrade dicestack");
-    if (!r.contains("world")) throw InputError(M + ": \"dicestack\" has no \"world\"");
-    set.world = world_config_from_json(r["world"].dump(), M + " \"dicestack\".\"world\"");
-    set.description = r.value("description", set.description);
-    set.provenance = r.value("provenance", "");
-  }
-  const auto& limit = set.world.action.limit;
+  read_minari_set_record(meta, M, set);
 
   const fs::path main_path = dir / "data" / kMainFile;
   h5::ReadFile f(main_path);
-  const std::string F = f.name();
-  std::vector<std::pair<long, std::string>> episodes;
-  for (const auto& name : h5::members(f.root(), F)) {
-    const long n = episode_number(name);
-    if (n < 0) throw InputError(F + ": " + name.substr(0, 60) + ": not an episode_<n> group");
-    episodes.emplace_back(n, name);
-  }
-  std::sort(episodes.begin(), episodes.end());
-  if (static_cast<std::int64_t>(episodes.size()) != total_episodes)
-    throw InputError(M + ": \"total_episodes\" is " + std::to_string(total_episodes) + ", but " + F + " holds " +
-                     std::to_string(episodes.size()) + " episodes");
-  if (episodes.empty()) throw InputError(F + ": holds no episode");
-  for (std::size_t i = 0; i < episodes.size(); ++i)
-    if (episodes[i].first != static_cast<long>(i))
-      throw InputError(F + ": episode_" + std::to_string(i) + ": missing (episodes are numbered from 0 without gaps)");
-
+  const std::vector<std::string> episodes = list_minari_episodes(f, M, total_episodes);
   std::int64_t steps_seen = 0;
   for (std::size_t i = 0; i < episodes.size(); ++i) {
-    const std::string& name = episodes[i].second;
-    const std::string where = F + ": " + name;
-    const h5::Id g = h5::open_group(f.root(), name, where);
-    const h5::Array actions = read_rows(g.get(), "actions", where + "/actions", kActionDim);
-    const std::size_t steps = actions.dims[0];
-    steps_seen += static_cast<std::int64_t>(steps);
-    const h5::Array obs = read_shaped(g.get(), "observations", where + "/observations", steps + 1, kStateDim);
-    const h5::Array rewards = read_shaped(g.get(), "rewards", where + "/rewards", steps, 0);
-    const auto terminations = end_flags(g.get(), "terminations", where + "/terminations", steps);
-    const auto truncations = end_flags(g.get(), "truncations", where + "/truncations", steps);
-    if (const auto n = h5::read_attr_int(g.get(), "total_steps", where); n && *n != static_cast<std::int64_t>(steps))
-      throw InputError(where + ": attribute total_steps is " + std::to_string(*n) + ", but actions has " + std::to_string(steps) + " rows");
-
-    Episode e;
-    e.states.resize(steps);
-    State final_state{};
-    for (std::size_t t = 0; t <= steps; ++t) {
-      State& s = t < steps ? e.states[t] : final_state;
-      std::copy_n(obs.values.begin() + static_cast<std::ptrdiff_t>(t * kStateDim), kStateDim, s.begin());
-    }
-    e.final_state = final_state;
-    e.actions.resize(steps);
-    for (std::size_t t = 0; t < steps; ++t)
-      for (std::size_t k = 0; k < kActionDim; ++k) {
-        const double a = actions.values[t * kActionDim + k];
-        if (std::abs(a) > limit[k])
-          throw InputError(where + "/actions: row " + std::to_string(t) + " column " + std::to_string(k) +
-                           " is outside the world's action.limit (" + py_number(limit[k]) + ")");
-        e.actions[t][k] = a;
-      }
-    e.rewards = rewards.values;
-    e.terminated = terminations.back() != 0.0;
-    e.truncated = truncations.back() != 0.0;
-    read_episode_record(g.get(), where, i, "seed", "minari " + dir.string() + " " + name, set.world, e);
-    check_read_episode(e, where);
+    Episode e = read_minari_episode(f, episodes[i], i, dir, set.world);
+    steps_seen += static_cast<std::int64_t>(e.actions.size());
     set.episodes.push_back(std::move(e));
   }
   if (steps_seen != total_steps)

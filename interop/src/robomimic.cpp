@@ -52,6 +52,146 @@ long demo_number(const std::string& name) {
 
 std::string row_col(std::size_t r, std::size_t c) { return "row " + std::to_string(r) + " column " + std::to_string(c); }
 
+// Checks /data's env_args attribute (our gym id, robomimic's gym type, the action limits) and
+// takes the world from its env_kwargs.
+void read_robomimic_env_args(hid_t data, const std::string& F, WorldConfig& world) {
+  const auto env_text = h5::read_attr_string(data, "env_args", F + ": data");
+  if (!env_text) throw InputError(F + ": data: attribute env_args is missing");
+  const std::string env_where = F + ": data attribute env_args";
+  const json env = parse_json_text(*env_text, env_where);
+  if (!env.is_object() || !env.contains("env_name") || !env["env_name"].is_string())
+    throw InputError(env_where + ": \"env_name\" must be a string");
+  if (env["env_name"] != kGymEnvId)
+    throw InputError(env_where + ": env_name \"" + env["env_name"].get<std::string>().substr(0, 60) + "\" is not " + kGymEnvId);
+  if (!env.contains("type") || env["type"] != kRobomimicGymType)
+    throw InputError(env_where + ": \"type\" must be " + std::to_string(kRobomimicGymType) + " (robomimic's gym type)");
+  if (env.contains("env_kwargs") && env["env_kwargs"].is_object() && env["env_kwargs"].contains("world"))
+    world = world_config_from_json(env["env_kwargs"]["world"].dump(), env_where + " env_kwargs.world");
+  const auto& limit = world.action.limit;
+  if (env.contains("action_limits")) {
+    const json& l = env["action_limits"];
+    bool same = l.is_array() && l.size() == kActionDim;
+    for (std::size_t k = 0; same && k < kActionDim; ++k) same = l[k].is_number() && l[k].get<double>() == limit[k];
+    if (!same) throw InputError(env_where + ": \"action_limits\" must be the world's action.limit, " + json(limit).dump());
+  }
+}
+
+// The description and provenance from /data's dicestack attribute (our marker), if it has one.
+void read_robomimic_set_record(hid_t data, const std::string& F, DemoSet& set) {
+  if (const auto record = h5::read_attr_string(data, "dicestack", F + ": data")) {
+    const json r = parse_json_text(*record, F + ": data attribute dicestack");
+    if (r.value("format", "") != kRobomimicFormat)
+      throw InputError(F + ": data attribute dicestack: \"format\" is not " + kRobomimicFormat);
+    if (!r.contains("version") || !r["version"].is_number_integer())
+      throw InputError(F + ": data attribute dicestack: \"version\" must be an integer");
+    if (r["version"].get<std::int64_t>() > kInteropFormatVersion)
+      throw InputError(F + ": format version " + std::to_string(r["version"].get<std::int64_t>()) +
+                       " is newer than this dicestack reads (" + std::to_string(kInteropFormatVersion) + "); upgrade dicestack");
+    set.description = r.value("description", "");
+    set.provenance = r.value("provenance", "");
+  } else {
+    set.description = "imported from robomimic file " + F;
+  }
+}
+
+// The demo_<n> groups under /data as (n, name), sorted by n; any other member is an error.
+std::vector<std::pair<long, std::string>> list_robomimic_demos(hid_t data, const std::string& F) {
+  std::vector<std::pair<long, std::string>> demos;
+  for (const auto& name : h5::members(data, F + ": data")) {
+    const long n = demo_number(name);
+    if (n < 0) throw InputError(F + ": data/" + name.substr(0, 60) + ": not a demo_<n> group");
+    demos.emplace_back(n, name);
+  }
+  if (demos.empty()) throw InputError(F + ": data: holds no demo_<n> group");
+  std::sort(demos.begin(), demos.end());
+  return demos;
+}
+
+// Checks a demo's obs/ and next_obs/ against its states; returns the final state next_obs ends with.
+State check_robomimic_observations(hid_t demo, const std::string& where, const std::string& path,
+                                   const std::vector<State>& states) {
+  const std::size_t steps = states.size();
+  State final_state{};
+  for (const auto& key : observation_keys()) {
+    const h5::Array o = read_shaped(demo, std::string("obs/") + key.name, where + "/obs/" + key.name, steps, 3);
+    const h5::Array n = read_shaped(demo, std::string("next_obs/") + key.name, where + "/next_obs/" + key.name, steps, 3);
+    for (std::size_t t = 0; t < steps; ++t)
+      for (std::size_t c = 0; c < 3; ++c) {
+        if (o.values[t * 3 + c] != states[t][key.index[c]])
+          throw InputError(where + "/obs/" + key.name + ": " + row_col(t, c) + " disagrees with " + path + "/states");
+        if (t + 1 < steps && n.values[t * 3 + c] != states[t + 1][key.index[c]])
+          throw InputError(where + "/next_obs/" + key.name + ": " + row_col(t, c) + " disagrees with " + path +
+                           "/states row " + std::to_string(t + 1));
+      }
+    for (std::size_t c = 0; c < 3; ++c) final_state[key.index[c]] = n.values[(steps - 1) * 3 + c];
+  }
+  return final_state;
+}
+
+// A demo's actions in world units: the scaled actions times the limits, or our exact
+// dicestack/actions where present (checked against the scaled ones).
+std::vector<Action> read_robomimic_actions(hid_t demo, const std::string& where, const std::string& path,
+                                           const h5::Array& actions, const std::array<double, kActionDim>& limit) {
+  const std::size_t steps = actions.dims[0];
+  std::vector<Action> out(steps);
+  const bool has_raw = h5::exists(demo, "dicestack/actions");
+  const h5::Array raw =
+      has_raw ? read_shaped(demo, "dicestack/actions", where + "/dicestack/actions", steps, kActionDim) : h5::Array{};
+  for (std::size_t t = 0; t < steps; ++t)
+    for (std::size_t k = 0; k < kActionDim; ++k) {
+      const double v = actions.values[t * kActionDim + k];
+      if (v < -1.0 || v > 1.0)
+        throw InputError(where + "/actions: " + row_col(t, k) + " is outside [-1, 1] (actions are divided by the action limits)");
+      double a = v * limit[k];
+      if (has_raw) {
+        const double r = raw.values[t * kActionDim + k];
+        if (!(std::abs(r / limit[k] - v) <= 1e-12))
+          throw InputError(where + "/dicestack/actions: " + row_col(t, k) + " disagrees with " + path + "/actions");
+        a = r;
+      }
+      if (std::abs(a) > limit[k])
+        throw InputError(where + "/dicestack/actions: " + row_col(t, k) + " is outside the world's action.limit");
+      out[t][k] = a;
+    }
+  return out;
+}
+
+// Reads and checks the group data/<name>, the episode at `index`.
+Episode read_robomimic_demo(const h5::ReadFile& f, const std::string& name, std::size_t index, const WorldConfig& world) {
+  const std::string& F = f.name();
+  const std::string path = "data/" + name;
+  const std::string where = F + ": " + path;
+  const h5::Id demo = h5::open_group(f.root(), path, where);
+  const auto samples = h5::read_attr_int(demo.get(), "num_samples", where);
+  if (!samples) throw InputError(where + ": attribute num_samples is missing");
+  const h5::Array actions = read_rows(demo.get(), "actions", where + "/actions", kActionDim);
+  const std::size_t steps = actions.dims[0];
+  if (*samples != static_cast<std::int64_t>(steps))
+    throw InputError(where + ": attribute num_samples is " + std::to_string(*samples) + ", but actions has " +
+                     std::to_string(steps) + " rows");
+  const h5::Array states = read_shaped(demo.get(), "states", where + "/states", steps, kStateDim);
+  const h5::Array rewards = read_shaped(demo.get(), "rewards", where + "/rewards", steps, 0);
+  const h5::Array dones = read_shaped(demo.get(), "dones", where + "/dones", steps, 0, true);
+  for (std::size_t t = 0; t < steps; ++t)
+    if (dones.values[t] != 0.0 && dones.values[t] != 1.0)
+      throw InputError(where + "/dones: item " + std::to_string(t) + " is neither 0 nor 1");
+
+  Episode e;
+  e.states.resize(steps);
+  for (std::size_t t = 0; t < steps; ++t)
+    std::copy_n(states.values.begin() + static_cast<std::ptrdiff_t>(t * kStateDim), kStateDim, e.states[t].begin());
+  e.final_state = check_robomimic_observations(demo.get(), where, path, e.states);
+  e.rewards = rewards.values;
+  e.actions = read_robomimic_actions(demo.get(), where, path, actions, world.action.limit);
+
+  read_episode_record(demo.get(), where, index, "dicestack_seed", "robomimic " + F + " " + name, world, e);
+  const auto terminated = h5::read_attr_int(demo.get(), "dicestack_terminated", where);
+  const auto truncated = h5::read_attr_int(demo.get(), "dicestack_truncated", where);
+  e.terminated = terminated ? *terminated != 0 : e.outcome.realistic_success();
+  e.truncated = truncated ? *truncated != 0 : !e.terminated;
+  check_read_episode(e, where);
+  return e;
+}
 
 }  // namespace
 
@@ -130,117 +270,14 @@ DemoSet import_robomimic(const fs::path& file) {
   h5::ReadFile f(file);
   const std::string F = f.name();
   const h5::Id data = h5::open_group(f.root(), "data", F + ": data");
-  const auto env_text = h5::read_attr_string(data.get(), "env_args", F + ": data");
-  if (!env_text) throw InputError(F + ": data: attribute env_args is missing");
-  const std::string env_where = F + ": data attribute env_args";
-  const json env = parse_json_text(*env_text, env_where);
-  if (!env.is_object() || !env.contains("env_name") || !env["env_name"].is_string())
-    throw InputError(env_where + ": \"env_name\" must be a string");
-  if (env["env_name"] != kGymEnvId)
-    throw InputError(env_where + ": env_name \"" + env["env_name"].get<std::string>().substr(0, 60) + "\" is not " + kGymEnvId);
-  if (!env.contains("type") || env["type"] != kRobomimicGymType)
-    throw InputError(env_where + ": \"type\" must be " + std::to_string(kRobomimicGymType) + " (robomimic's gym type)");
   DemoSet set;
-  if (env.contains("env_kwargs") && env["env_kwargs"].is_object() && env["env_kwargs"].contains("world"))
-    set.world = world_config_from_json(env["env_kwargs"]["world"].dump(), env_where + " env_kwargs.world");
-  const auto& limit = set.world.action.limit;
-  if (env.contains("action_limits")) {
-    const json& l = env["action_limits"];
-    bool same = l.is_array() && l.size() == kActionDim;
-    for (std::size_t k = 0; same && k < kActionDim; ++k) same = l[k].is_number() && l[k].get<double>() == limit[k];
-    if (!same) throw InputError(env_where + ": \"action_limits\" must be the world's action.limit, " + json(limit).dump());
-  }
-  if (const auto record = h5::read_attr_string(data.get(), "dicestack", F + ": data")) {
-    const json r = parse_json_text(*record, F + ": data attribute dicestack");
-    if (r.value("format", "") != kRobomimicFormat)
-      throw InputError(F + ": data attribute dicestack: \"format\" is not " + kRobomimicFormat);
-    if (!r.contains("version") || !r["version"].is_number_integer())
-      throw InputError(F + ": data attribute dicestack: \"version\" must be an integer");
-    if (r["version"].get<std::int64_t>() > kInteropFormatVersion)
-      throw InputError(F + ": format version " + std::to_string(r["version"].get<std::int64_t>()) +
-                       " is newer than this dicestack reads (" + std::to_string(kInteropFormatVersion) + "); upgrade dicestack");
-    set.description = r.value("description", "");
-    set.provenance = r.value("provenance", "");
-  } else {
-    set.description = "imported from robomimic file " + F;
-  }
-
-  std::vector<std::pair<long, std::string>> demos;
-  for (const auto& name : h5::members(data.get(), F + ": data")) {
-    const long n = demo_number(name);
-    if (n < 0) throw InputError(F + ": data/" + name.substr(0, 60) + ": not a demo_<n> group");
-    demos.emplace_back(n, name);
-  }
-  if (demos.empty()) throw InputError(F + ": data: holds no demo_<n> group");
-  std::sort(demos.begin(), demos.end());
+  read_robomimic_env_args(data.get(), F, set.world);
+  read_robomimic_set_record(data.get(), F, set);
+  const auto demos = list_robomimic_demos(data.get(), F);
   std::int64_t total = 0;
   for (std::size_t i = 0; i < demos.size(); ++i) {
-    const std::string path = "data/" + demos[i].second;
-    const std::string where = F + ": " + path;
-    const h5::Id demo = h5::open_group(f.root(), path, where);
-    const auto samples = h5::read_attr_int(demo.get(), "num_samples", where);
-    if (!samples) throw InputError(where + ": attribute num_samples is missing");
-    const h5::Array actions = read_rows(demo.get(), "actions", where + "/actions", kActionDim);
-    const std::size_t steps = actions.dims[0];
-    if (*samples != static_cast<std::int64_t>(steps))
-      throw InputError(where + ": attribute num_samples is " + std::to_string(*samples) + ", but actions has " +
-                       std::to_string(steps) + " rows");
-    total += *samples;
-    const h5::Array states = read_shaped(demo.get(), "states", where + "/states", steps, kStateDim);
-    const h5::Array rewards = read_shaped(demo.get(), "rewards", where + "/rewards", steps, 0);
-    const h5::Array dones = read_shaped(demo.get(), "dones", where + "/dones", steps, 0, true);
-    for (std::size_t t = 0; t < steps; ++t)
-      if (dones.values[t] != 0.0 && dones.values[t] != 1.0)
-        throw InputError(where + "/dones: item " + std::to_string(t) + " is neither 0 nor 1");
-
-    Episode e;
-    e.states.resize(steps);
-    for (std::size_t t = 0; t < steps; ++t)
-      std::copy_n(states.values.begin() + static_cast<std::ptrdiff_t>(t * kStateDim), kStateDim, e.states[t].begin());
-    State final_state{};
-    for (const auto& key : observation_keys()) {
-      const h5::Array o = read_shaped(demo.get(), std::string("obs/") + key.name, where + "/obs/" + key.name, steps, 3);
-      const h5::Array n = read_shaped(demo.get(), std::string("next_obs/") + key.name, where + "/next_obs/" + key.name, steps, 3);
-      for (std::size_t t = 0; t < steps; ++t)
-        for (std::size_t c = 0; c < 3; ++c) {
-          if (o.values[t * 3 + c] != e.states[t][key.index[c]])
-            throw InputError(where + "/obs/" + key.name + ": " + row_col(t, c) + " disagrees with " + path + "/states");
-          if (t + 1 < steps && n.values[t * 3 + c] != e.states[t + 1][key.index[c]])
-            throw InputError(where + "/next_obs/" + key.name + ": " + row_col(t, c) + " disagrees with " + path +
-                             "/states row " + std::to_string(t + 1));
-        }
-      for (std::size_t c = 0; c < 3; ++c) final_state[key.index[c]] = n.values[(steps - 1) * 3 + c];
-    }
-    e.final_state = final_state;
-    e.rewards = rewards.values;
-
-    e.actions.resize(steps);
-    const bool has_raw = h5::exists(demo.get(), "dicestack/actions");
-    const h5::Array raw =
-        has_raw ? read_shaped(demo.get(), "dicestack/actions", where + "/dicestack/actions", steps, kActionDim) : h5::Array{};
-    for (std::size_t t = 0; t < steps; ++t)
-      for (std::size_t k = 0; k < kActionDim; ++k) {
-        const double v = actions.values[t * kActionDim + k];
-        if (v < -1.0 || v > 1.0)
-          throw InputError(where + "/actions: " + row_col(t, k) + " is outside [-1, 1] (actions are divided by the action limits)");
-        double a = v * limit[k];
-        if (has_raw) {
-          const double r = raw.values[t * kActionDim + k];
-          if (!(std::abs(r / limit[k] - v) <= 1e-12))
-            throw InputError(where + "/dicestack/actions: " + row_col(t, k) + " disagrees with " + path + "/actions");
-          a = r;
-        }
-        if (std::abs(a) > limit[k])
-          throw InputError(where + "/dicestack/actions: " + row_col(t, k) + " is outside the world's action.limit");
-        e.actions[t][k] = a;
-      }
-
-    read_episode_record(demo.get(), where, i, "dicestack_seed", "robomimic " + F + " " + demos[i].second, set.world, e);
-    const auto terminated = h5::read_attr_int(demo.get(), "dicestack_terminated", where);
-    const auto truncated = h5::read_attr_int(demo.get(), "dicestack_truncated", where);
-    e.terminated = terminated ? *terminated != 0 : e.outcome.realistic_success();
-    e.truncated = truncated ? *truncated != 0 : !e.terminated;
-    check_read_episode(e, where);
+    Episode e = read_robomimic_demo(f, demos[i].second, i, set.world);
+    total += static_cast<std::int64_t>(e.actions.size());  // num_samples, checked equal to the rows
     set.episodes.push_back(std::move(e));
   }
   if (const auto t = h5::read_attr_int(data.get(), "total", F + ": data"); t && *t != total)

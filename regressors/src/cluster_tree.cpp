@@ -9,6 +9,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 // The 8-lane helpers below pass vectors by value; they are internal and inlined, so no ABI is
 // crossed and GCC's note that AVX changes it does not apply. Not popped: GCC reports the note
@@ -188,48 +189,66 @@ ClusterTree::ClusterTree(Rows rows, Metric metric, std::size_t leaf_size)
     std::copy_n(rows.row(static_cast<Eigen::Index>(order_[i])).data(), cols_, rows_.get() + i * stride_);
 }
 
-std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits,
-                                 std::vector<float>& boxes) {
-  const std::size_t d = cols_;
-  const auto row = [&](std::uint32_t i) { return rows.row(static_cast<Eigen::Index>(order_[i])).data(); };
+namespace {
+
+// Row i of the rows a split divides: the input row order[i].
+struct ClusterRows {
+  const ClusterTree::Rows& rows;
+  const std::vector<std::size_t>& order;
+  const float* operator()(std::uint32_t i) const { return rows.row(static_cast<Eigen::Index>(order[i])).data(); }
+};
+
+// The mean of rows [begin, end), in double.
+std::vector<double> cluster_mean(const ClusterRows& row, std::uint32_t begin, std::uint32_t end, std::size_t d) {
   std::vector<double> mean(d, 0.0);
   for (std::uint32_t i = begin; i < end; ++i)
     for (std::size_t j = 0; j < d; ++j) mean[j] += row(i)[j];
   for (double& m : mean) m /= static_cast<double>(end - begin);
+  return mean;
+}
 
-  const auto id = static_cast<std::uint32_t>(splits.size());
-  splits.push_back({begin, end});
-  boxes.resize(boxes.size() + 2 * d);
-  float* lo = boxes.data() + 2 * static_cast<std::size_t>(id) * d;
-  float* hi = lo + d;
+// The bounding box of rows [begin, end): per column its least value in lo, its greatest in hi.
+void cluster_box(const ClusterRows& row, std::uint32_t begin, std::uint32_t end, std::size_t d, float* lo, float* hi) {
   std::copy_n(row(begin), d, lo);
   std::copy_n(row(begin), d, hi);
   for (std::uint32_t i = begin + 1; i < end; ++i)
     for (std::size_t j = 0; j < d; ++j) lo[j] = std::min(lo[j], row(i)[j]), hi[j] = std::max(hi[j], row(i)[j]);
-  double radius = 0.0;  // the farthest row from the mean (metric distance)
+}
+
+// The row of [begin, end) farthest from the mean (the first of equals; `begin` if all lie on
+// it) and that metric distance (squared under l2).
+std::pair<double, std::uint32_t> farthest_from_mean(const ClusterRows& row, std::uint32_t begin, std::uint32_t end,
+                                                    const std::vector<double>& mean, bool l2) {
+  double radius = 0.0;
   std::uint32_t farthest = begin;
   for (std::uint32_t i = begin; i < end; ++i) {
     double t = 0.0;
-    for (std::size_t j = 0; j < d; ++j) {
+    for (std::size_t j = 0; j < mean.size(); ++j) {
       const double x = row(i)[j] - mean[j];
-      t += metric_ == Metric::l2 ? x * x : std::abs(x);
+      t += l2 ? x * x : std::abs(x);
     }
     if (t > radius) radius = t, farthest = i;
   }
-  if (end - begin <= leaf_size_ || radius == 0.0) return id;
+  return {radius, farthest};
+}
 
-  // The principal direction by a few power iterations, from the farthest row's direction.
+// Row i's offset from the mean, projected on `dir`.
+double cluster_along(const ClusterRows& row, std::uint32_t i, const std::vector<double>& mean, const std::vector<double>& dir) {
+  double s = 0.0;
+  for (std::size_t j = 0; j < mean.size(); ++j) s += (row(i)[j] - mean[j]) * dir[j];
+  return s;
+}
+
+// The principal direction of rows [begin, end) by a few power iterations, from the farthest row's direction.
+std::vector<double> principal_direction(const ClusterRows& row, std::uint32_t begin, std::uint32_t end,
+                                        const std::vector<double>& mean, std::uint32_t farthest) {
+  const std::size_t d = mean.size();
   std::vector<double> v(d), w(d);
   for (std::size_t j = 0; j < d; ++j) v[j] = row(farthest)[j] - mean[j];
-  const auto along = [&](std::uint32_t i, const std::vector<double>& dir) {
-    double s = 0.0;
-    for (std::size_t j = 0; j < d; ++j) s += (row(i)[j] - mean[j]) * dir[j];
-    return s;
-  };
   for (int it = 0; it < 3; ++it) {
     std::fill(w.begin(), w.end(), 0.0);
     for (std::uint32_t i = begin; i < end; ++i) {
-      const double s = along(i, v);
+      const double s = cluster_along(row, i, mean, v);
       for (std::size_t j = 0; j < d; ++j) w[j] += (row(i)[j] - mean[j]) * s;
     }
     double n = 0.0;
@@ -238,18 +257,31 @@ std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t 
     n = std::sqrt(n);
     for (std::size_t j = 0; j < d; ++j) v[j] = w[j] / n;
   }
-  // Start from the median along it, then move the plane as 2-means would (the bisector of the
-  // two sides' means), which fits the clusters a trajectory set has better than the median.
+  return v;
+}
+
+// Which side of the median along `dir` each row of [begin, end) lies on (1: right). The median
+// by rank (ties by position), so both sides hold rows even when many keys are equal.
+std::vector<char> median_sides(const ClusterRows& row, std::uint32_t begin, std::uint32_t end, const std::vector<double>& mean,
+                               const std::vector<double>& dir) {
   const std::uint32_t n = end - begin;
   std::vector<double> key(n);
-  for (std::uint32_t i = 0; i < n; ++i) key[i] = along(begin + i, v);
-  // The median by rank (ties by position), so both sides hold rows even when many keys are equal.
+  for (std::uint32_t i = 0; i < n; ++i) key[i] = cluster_along(row, begin + i, mean, dir);
   std::vector<std::uint32_t> rank(n);
   std::iota(rank.begin(), rank.end(), 0u);
   std::nth_element(rank.begin(), rank.begin() + n / 2, rank.end(),
                    [&](std::uint32_t x, std::uint32_t y) { return key[x] < key[y] || (key[x] == key[y] && x < y); });
-  std::vector<char> on_right(n, 0), next(n);
+  std::vector<char> on_right(n, 0);
   for (std::uint32_t i = n / 2; i < n; ++i) on_right[rank[i]] = 1;
+  return on_right;
+}
+
+// Moves the plane between the sides of the rows from `begin` as 2-means would (the bisector of
+// the two sides' means), which fits the clusters a trajectory set has better than the median.
+void refine_sides(const ClusterRows& row, std::uint32_t begin, const std::vector<double>& mean, std::vector<char>& on_right) {
+  const std::size_t d = mean.size();
+  const auto n = static_cast<std::uint32_t>(on_right.size());
+  std::vector<char> next(n);
   const std::uint32_t least = std::max<std::uint32_t>(1, n / 8);
   std::vector<double> a(d), b(d), u(d);
   for (int it = 0; it < kRefinements; ++it) {
@@ -276,18 +308,48 @@ std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t 
     for (double& x : u) x /= norm;
     const double s = (bb - aa) / (2.0 * norm);
     std::uint32_t moved_right = 0;
-    for (std::uint32_t i = 0; i < n; ++i) moved_right += (next[i] = along(begin + i, u) > s) != 0;
+    for (std::uint32_t i = 0; i < n; ++i) moved_right += (next[i] = cluster_along(row, begin + i, mean, u) > s) != 0;
     if (moved_right < least || n - moved_right < least) break;  // lopsided: keep the last balanced plane
     const bool same = next == on_right;
     on_right.swap(next);
     if (same) break;
   }
-  std::vector<std::size_t> sides(order_.begin() + begin, order_.begin() + end);
+}
+
+// Reorders order[begin, begin + n) stably into the left side's rows, then the right side's;
+// returns how many lie on the left.
+std::uint32_t partition_by_side(std::vector<std::size_t>& order, std::uint32_t begin, const std::vector<char>& on_right) {
+  const auto n = static_cast<std::uint32_t>(on_right.size());
+  std::vector<std::size_t> sides(order.begin() + begin, order.begin() + begin + n);
   std::uint32_t half = 0;
   for (std::uint32_t i = 0; i < n; ++i)
-    if (!on_right[i]) order_[begin + half++] = sides[i];
+    if (!on_right[i]) order[begin + half++] = sides[i];
   for (std::uint32_t i = 0, r = half; i < n; ++i)
-    if (on_right[i]) order_[begin + r++] = sides[i];
+    if (on_right[i]) order[begin + r++] = sides[i];
+  return half;
+}
+
+}  // namespace
+
+std::uint32_t ClusterTree::split(Rows& rows, std::uint32_t begin, std::uint32_t end, std::vector<Split>& splits,
+                                 std::vector<float>& boxes) {
+  const std::size_t d = cols_;
+  const ClusterRows row{rows, order_};
+  const std::vector<double> mean = cluster_mean(row, begin, end, d);
+
+  const auto id = static_cast<std::uint32_t>(splits.size());
+  splits.push_back({begin, end});
+  boxes.resize(boxes.size() + 2 * d);
+  float* lo = boxes.data() + 2 * static_cast<std::size_t>(id) * d;
+  cluster_box(row, begin, end, d, lo, lo + d);
+  const auto [radius, farthest] = farthest_from_mean(row, begin, end, mean, metric_ == Metric::l2);
+  if (end - begin <= leaf_size_ || radius == 0.0) return id;
+
+  const std::vector<double> direction = principal_direction(row, begin, end, mean, farthest);
+  // Start from the median along it, then move the plane as 2-means would.
+  std::vector<char> on_right = median_sides(row, begin, end, mean, direction);
+  refine_sides(row, begin, mean, on_right);
+  const std::uint32_t half = partition_by_side(order_, begin, on_right);
   const std::uint32_t left = split(rows, begin, begin + half, splits, boxes);
   const std::uint32_t right = split(rows, begin + half, end, splits, boxes);
   splits[id].left = left;

@@ -227,6 +227,129 @@ Model load_model(const std::filesystem::path& path, const RegressorRegistry& reg
   return parse_model_file(read_file(path), path.string(), registry, pickles);
 }
 
+namespace {
+
+// Checks the header's format and version and the payload's size and checksums; returns the version.
+int check_model_header(const json& h, std::string_view payload, const std::string& where) {
+  if (!h.is_object() || h.value("format", "") != kModelFormat) throw InputError(where + "format is not " + kModelFormat);
+  const auto version = static_cast<int>(header_count(h, "version", 1000, where));
+  if (version > kModelFormatVersion)
+    throw InputError(where + "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
+                     std::to_string(kModelFormatVersion) + "); upgrade dicestack");
+  // The payload's size against the bytes present; nothing is allocated for it.
+  const auto bytes_claimed = header_count(h, "payload_bytes", std::uint64_t{1} << 40, where);
+  const std::uint64_t present = payload.size();
+  if (present < bytes_claimed)
+    throw InputError(where + "truncated: the payload has " + std::to_string(present) + " of " +
+                     std::to_string(bytes_claimed) + " bytes");
+  if (present > bytes_claimed) throw InputError(where + "has bytes after the payload; corrupted");
+  if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
+    throw InputError(where + "corrupted: the payload's checksum does not match the header");
+  if (version >= 2 && h.at("checksum").get<std::string>() != whole_checksum(h, payload))
+    throw InputError(where + "corrupted: the header's checksum does not match (the header or payload was edited)");
+  return version;
+}
+
+// The model's feature map, of the version it was trained with.
+const FeatureMap& model_feature_map(const json& h, int version, const std::string& where) {
+  // Version 1 had no feature map: its regressors read the 24 state numbers.
+  const FeatureMap& features = [&]() -> const FeatureMap& {
+    try {
+      return feature_map(version >= 2 ? h.at("features").get<std::string>() : "state");
+    } catch (const ConfigError& e) {
+      throw InputError(where + e.what() + " (upgrade dicestack?)");
+    }
+  }();
+  if (version >= 2) {
+    const auto fv = static_cast<int>(header_count(h, "features_version", 1000, where));
+    if (fv != features.version())
+      throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
+                       " differs from this dicestack's (" + std::to_string(features.version()) + ")");
+  }
+  return features;
+}
+
+// What a model file maps: its feature map, input width and action width.
+struct ModelShape {
+  const FeatureMap* features;
+  std::size_t input_dim;
+  std::size_t action_dim;
+};
+
+// The header's dimensions, checked against the feature map and this world's state and action sizes.
+ModelShape read_model_shape(const json& h, int version, const std::string& where) {
+  const auto state_dim = static_cast<std::size_t>(header_count(h, "state_dim", 1024, where));
+  const auto action_dim = static_cast<std::size_t>(header_count(h, "action_dim", 1024, where));
+  const FeatureMap& features = model_feature_map(h, version, where);
+  const std::size_t input_dim =
+      version >= 2 ? static_cast<std::size_t>(header_count(h, "input_dim", 1024, where)) : state_dim;
+  if (input_dim != features.width())
+    throw InputError(where + "the regressor reads " + std::to_string(input_dim) + " inputs, but feature map \"" +
+                     features.name() + "\" produces " + std::to_string(features.width()));
+  if (state_dim != kStateDim)
+    throw InputError(where + "trained on " + std::to_string(state_dim) + "-d states, this world produces " +
+                     std::to_string(kStateDim) + "-d");
+  if (action_dim != kActionDim)
+    throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, this world takes " +
+                     std::to_string(kActionDim) + "-d");
+  return {&features, input_dim, action_dim};
+}
+
+// A Python regressor from the pickle beside the model file at `path`, which `record` describes.
+std::unique_ptr<Regressor> load_pickled_regressor(const json& record, const std::string& name,
+                                                  const std::vector<std::string>& sets, const std::string& path,
+                                                  const std::string& where, const PickleLoader& pickles) {
+  const std::filesystem::path pkl = pickle_path(std::filesystem::path(path));
+  const std::string type = record.value("object_type", std::string("?"));
+  if (!pickles)
+    throw InputError(where + "regressor \"" + cut(name) + "\" is a Python object (" + cut(type) + ") pickled in " +
+                     pkl.string() +
+                     "; unpickling runs code, so dicestack reads it only from Python, with "
+                     "dicestack.load_model(path, allow_pickle=True) (never from the command line), and only from "
+                     "a source you trust");
+  std::string pickle;
+  try {
+    pickle = read_file(pkl);
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + " (the pickle of the model " + path + ")");
+  }
+  if (!matches(pickle, record))
+    throw InputError(pkl.string() + ": does not match the model file " + path +
+                     " (its size or FNV-1a differs from the one recorded there): they were not saved together");
+  return pickles(name, sets, pickle);
+}
+
+// The header's regressor with its params, unfitted: unpickled, or made by the registry.
+std::unique_ptr<Regressor> make_model_regressor(const json& h, std::string_view payload, const std::string& path,
+                                                const std::string& where, const RegressorRegistry& registry,
+                                                const PickleLoader& pickles) {
+  const std::string name = h.at("regressor").get<std::string>();
+  std::vector<std::string> sets;
+  for (const auto& [k, v] : h.at("params").items()) sets.push_back(k + "=" + v.get<std::string>());
+  if (const auto record = pickled_record_of(payload)) return load_pickled_regressor(*record, name, sets, path, where, pickles);
+  if (!registry.contains(name))
+    throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
+  try {
+    return registry.create(name, sets);
+  } catch (const ConfigError& e) {
+    throw InputError(where + "\"params\": " + e.what());
+  }
+}
+
+// The header's standardiser under `key`: `dim` means and positive sigmas.
+Standardizer model_scaler(const json& h, const char* key, std::size_t dim, const std::string& where) {
+  Standardizer s;
+  s.mean = h.at(key).at("mean").get<std::vector<double>>();
+  s.sigma = h.at(key).at("sigma").get<std::vector<double>>();
+  if (s.mean.size() != dim || s.sigma.size() != dim)
+    throw InputError(where + key + " has " + std::to_string(s.mean.size()) + " columns, expected " + std::to_string(dim));
+  for (double v : s.sigma)
+    if (!(v > 0.0) || !std::isfinite(v)) throw InputError(where + key + " has a sigma that is not positive");
+  return s;
+}
+
+}  // namespace
+
 Model parse_model_file(std::string_view bytes, const std::string& path, const RegressorRegistry& registry,
                        const PickleLoader& pickles) {
   const std::string where = path + ": ";
@@ -240,100 +363,18 @@ Model parse_model_file(std::string_view bytes, const std::string& path, const Re
     throw InputError(where + "the first line is not a JSON header; not a dicestack model");
   }
   try {
-    if (!h.is_object() || h.value("format", "") != kModelFormat) throw InputError(where + "format is not " + kModelFormat);
-    const auto version = static_cast<int>(header_count(h, "version", 1000, where));
-    if (version > kModelFormatVersion)
-      throw InputError(where + "format version " + std::to_string(version) + " is newer than this dicestack reads (" +
-                       std::to_string(kModelFormatVersion) + "); upgrade dicestack");
-    // The payload's size against the bytes present; nothing is allocated for it.
-    const auto bytes_claimed = header_count(h, "payload_bytes", std::uint64_t{1} << 40, where);
     const std::string_view payload = newline == std::string_view::npos ? std::string_view() : bytes.substr(newline + 1);
-    const std::uint64_t present = payload.size();
-    if (present < bytes_claimed)
-      throw InputError(where + "truncated: the payload has " + std::to_string(present) + " of " +
-                       std::to_string(bytes_claimed) + " bytes");
-    if (present > bytes_claimed) throw InputError(where + "has bytes after the payload; corrupted");
-    if (fnv1a_hex(payload) != h.at("payload_fnv1a").get<std::string>())
-      throw InputError(where + "corrupted: the payload's checksum does not match the header");
-    if (version >= 2 && h.at("checksum").get<std::string>() != whole_checksum(h, payload))
-      throw InputError(where + "corrupted: the header's checksum does not match (the header or payload was edited)");
-    const auto state_dim = static_cast<std::size_t>(header_count(h, "state_dim", 1024, where));
-    const auto action_dim = static_cast<std::size_t>(header_count(h, "action_dim", 1024, where));
-    // Version 1 had no feature map: its regressors read the 24 state numbers.
-    const FeatureMap& features = [&]() -> const FeatureMap& {
-      try {
-        return feature_map(version >= 2 ? h.at("features").get<std::string>() : "state");
-      } catch (const ConfigError& e) {
-        throw InputError(where + e.what() + " (upgrade dicestack?)");
-      }
-    }();
-    if (version >= 2) {
-      const auto fv = static_cast<int>(header_count(h, "features_version", 1000, where));
-      if (fv != features.version())
-        throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
-                         " differs from this dicestack's (" + std::to_string(features.version()) + ")");
-    }
-    const std::size_t input_dim =
-        version >= 2 ? static_cast<std::size_t>(header_count(h, "input_dim", 1024, where)) : state_dim;
-    if (input_dim != features.width())
-      throw InputError(where + "the regressor reads " + std::to_string(input_dim) + " inputs, but feature map \"" +
-                       features.name() + "\" produces " + std::to_string(features.width()));
-    if (state_dim != kStateDim)
-      throw InputError(where + "trained on " + std::to_string(state_dim) + "-d states, this world produces " +
-                       std::to_string(kStateDim) + "-d");
-    if (action_dim != kActionDim)
-      throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, this world takes " +
-                       std::to_string(kActionDim) + "-d");
-    const std::string name = h.at("regressor").get<std::string>();
-    std::vector<std::string> sets;
-    for (const auto& [k, v] : h.at("params").items()) sets.push_back(k + "=" + v.get<std::string>());
-    std::unique_ptr<Regressor> regressor;
-    if (const auto record = pickled_record_of(payload)) {
-      const std::filesystem::path pkl = pickle_path(std::filesystem::path(path));
-      const std::string type = record->value("object_type", std::string("?"));
-      if (!pickles)
-        throw InputError(where + "regressor \"" + cut(name) + "\" is a Python object (" + cut(type) + ") pickled in " +
-                         pkl.string() +
-                         "; unpickling runs code, so dicestack reads it only from Python, with "
-                         "dicestack.load_model(path, allow_pickle=True) (never from the command line), and only from "
-                         "a source you trust");
-      std::string pickle;
-      try {
-        pickle = read_file(pkl);
-      } catch (const InputError& e) {
-        throw InputError(std::string(e.what()) + " (the pickle of the model " + path + ")");
-      }
-      if (!matches(pickle, *record))
-        throw InputError(pkl.string() + ": does not match the model file " + path +
-                         " (its size or FNV-1a differs from the one recorded there): they were not saved together");
-      regressor = pickles(name, sets, pickle);
-    } else {
-      if (!registry.contains(name))
-        throw ConfigError(where + "regressor \"" + name + "\" is not registered; load its plugin with --plugin");
-      try {
-        regressor = registry.create(name, sets);
-      } catch (const ConfigError& e) {
-        throw InputError(where + "\"params\": " + e.what());
-      }
-    }
-    auto scaler = [&](const char* key, std::size_t dim) {
-      Standardizer s;
-      s.mean = h.at(key).at("mean").get<std::vector<double>>();
-      s.sigma = h.at(key).at("sigma").get<std::vector<double>>();
-      if (s.mean.size() != dim || s.sigma.size() != dim)
-        throw InputError(where + key + " has " + std::to_string(s.mean.size()) + " columns, expected " +
-                         std::to_string(dim));
-      for (double v : s.sigma)
-        if (!(v > 0.0) || !std::isfinite(v)) throw InputError(where + key + " has a sigma that is not positive");
-      return s;
-    };
-    Standardizer xs = scaler("x_standardizer", input_dim), ys = scaler("y_standardizer", action_dim);
+    const int version = check_model_header(h, payload, where);
+    const ModelShape shape = read_model_shape(h, version, where);
+    std::unique_ptr<Regressor> regressor = make_model_regressor(h, payload, path, where, registry, pickles);
+    Standardizer xs = model_scaler(h, "x_standardizer", shape.input_dim, where),
+                 ys = model_scaler(h, "y_standardizer", shape.action_dim, where);
     try {
-      regressor->load_payload(payload, input_dim, action_dim);
+      regressor->load_payload(payload, shape.input_dim, shape.action_dim);
     } catch (const Error& e) {
       throw InputError(where + e.what());
     }
-    Model model(std::move(regressor), std::move(xs), std::move(ys), features);
+    Model model(std::move(regressor), std::move(xs), std::move(ys), *shape.features);
     if (h.contains("record"))
       for (const auto& [k, v] : h["record"].items()) model.record[k] = v.is_string() ? v.get<std::string>() : v.dump();
     return model;

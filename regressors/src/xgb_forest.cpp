@@ -36,17 +36,120 @@ std::uint64_t count_text(const FloatJson& v, const std::string& what) {
   return out;
 }
 
-}  // namespace
-
-XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_t outputs) {
-  FloatJson j;
+// The payload as JSON, floats read as floats.
+FloatJson parse_xgb_json(std::string_view text) {
   try {
-    j = parse_json_limited<FloatJson>(text, "gbt payload");
+    return parse_json_limited<FloatJson>(text, "gbt payload");
   } catch (const FloatJson::exception& e) {
     fail(std::string("the payload is not xgboost's JSON model: ") + e.what());
   } catch (const InputError& e) {
     fail(e.what());
   }
+}
+
+// Checks the learner's objective, target and feature counts, base score and booster, and that
+// tree_info and num_trees agree with the trees present; returns the booster's model.
+const FloatJson& read_xgb_model(const FloatJson& j, std::size_t inputs, std::size_t outputs, float& base_score) {
+  const auto& learner = j.at("learner");
+  if (learner.at("objective").at("name").get<std::string>() != "reg:squarederror")
+    fail("the model's objective is not reg:squarederror");
+  const auto& param = learner.at("learner_model_param");
+  const auto targets = count_text(param.at("num_target"), "num_target");
+  if (targets != outputs)
+    fail("the model has " + std::to_string(targets) + " targets, the header says " + std::to_string(outputs));
+  if (count_text(param.at("num_feature"), "num_feature") != inputs)
+    fail("the model reads " + param.at("num_feature").get<std::string>() + " features, the header says " +
+         std::to_string(inputs));
+  base_score = std::stof(param.at("base_score").get<std::string>());
+  if (!std::isfinite(base_score)) fail("base_score is not finite");
+  const auto& booster = learner.at("gradient_booster");
+  if (booster.at("name").get<std::string>() != "gbtree") fail("the booster is not gbtree");
+  const auto& model = booster.at("model");
+  const auto& trees = model.at("trees");
+  const auto& info = model.at("tree_info");
+  if (!trees.is_array() || !info.is_array() || trees.size() != info.size())
+    fail("tree_info lists " + std::to_string(info.size()) + " trees, the model holds " + std::to_string(trees.size()));
+  // xgboost reads this count when it loads the model; it must agree with the trees present.
+  if (count_text(model.at("gbtree_model_param").at("num_trees"), "num_trees") != trees.size())
+    fail("num_trees says " + model.at("gbtree_model_param").at("num_trees").dump().substr(0, 40) + ", the model holds " +
+         std::to_string(trees.size()) + " trees");
+  return model;
+}
+
+// Checks one tree's node arrays for a forest already holding `nodes_before` nodes, then walks
+// it from the root: each node reached once (a tree), every index checked before use.
+void check_xgb_tree(const FloatJson& tree, const std::string& where, std::size_t inputs, std::size_t nodes_before) {
+  const auto& left = tree.at("left_children");
+  const auto& right = tree.at("right_children");
+  const auto& feature = tree.at("split_indices");
+  const auto& value = tree.at("split_conditions");
+  const auto& dleft = tree.at("default_left");
+  const auto& type = tree.at("split_type");
+  const std::size_t n = left.size();
+  if (n == 0 || n > (1u << 24)) fail(where + "has " + std::to_string(n) + " nodes");
+  if (nodes_before + n > (1u << 30)) fail(where + "the forest has more than 2^30 nodes");
+  for (const auto* a : {&right, &feature, &value, &dleft, &type})
+    if (!a->is_array() || a->size() != n) fail(where + "its node arrays differ in length");
+  std::vector<char> seen(n, 0);
+  std::vector<std::pair<std::int64_t, int>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [i, depth] = stack.back();
+    stack.pop_back();
+    const std::string at = where + "node " + std::to_string(i) + ": ";
+    if (seen[static_cast<std::size_t>(i)]) fail(at + "reached twice; not a tree");
+    seen[static_cast<std::size_t>(i)] = 1;
+    if (depth > 64) fail(at + "deeper than 64");
+    const auto l = integer(left[static_cast<std::size_t>(i)], at + "left child");
+    const auto r = integer(right[static_cast<std::size_t>(i)], at + "right child");
+    integer(dleft[static_cast<std::size_t>(i)], at + "default_left");
+    const float v = value[static_cast<std::size_t>(i)].get<float>();
+    if (!std::isfinite(v)) fail(at + "value is not finite");
+    if (l == -1 && r == -1) continue;
+    for (const auto c : {l, r})
+      if (c <= 0 || c >= static_cast<std::int64_t>(n))
+        fail(at + "child " + std::to_string(c) + " is out of range (the tree has " + std::to_string(n) + " nodes)");
+    if (integer(type[static_cast<std::size_t>(i)], at + "split_type") != 0) fail(at + "categorical splits are not supported");
+    const auto k = integer(feature[static_cast<std::size_t>(i)], at + "split index");
+    if (k < 0 || static_cast<std::size_t>(k) >= inputs)
+      fail(at + "splits on feature " + std::to_string(k) + " of " + std::to_string(inputs));
+    stack.emplace_back(l, depth + 1);
+    stack.emplace_back(r, depth + 1);
+  }
+}
+
+// Appends a checked tree's nodes to `nodes`, laid out breadth first with each node's two children
+// side by side (right = left + 1): 12-byte nodes, the top levels of a tree in a few cache lines.
+// `Node` is XgbForest's node, deduced; `default_left` is its flag for a NaN going left.
+template <class Node>
+void lay_out_xgb_tree(const FloatJson& tree, std::vector<Node>& nodes, std::uint32_t default_left) {
+  const auto& left = tree.at("left_children");
+  const auto& right = tree.at("right_children");
+  const auto& feature = tree.at("split_indices");
+  const auto& value = tree.at("split_conditions");
+  const auto& dleft = tree.at("default_left");
+  const std::size_t base = nodes.size();
+  nodes.emplace_back();
+  std::vector<std::pair<std::size_t, std::size_t>> queue{{0, base}};  // (xgboost's, ours)
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const auto [i, slot] = queue[q];
+    Node& node = nodes[slot];
+    node.value = value[i].get<float>();
+    const auto l = left[i].get<std::int64_t>();  // checked by check_xgb_tree
+    if (l == -1) continue;
+    const auto children = nodes.size();
+    node.left = static_cast<std::int32_t>(children);
+    node.feature = static_cast<std::uint32_t>(feature[i].get<std::int64_t>()) | (dleft[i].get<int>() != 0 ? default_left : 0u);
+    nodes.emplace_back();
+    nodes.emplace_back();
+    queue.emplace_back(static_cast<std::size_t>(l), children);
+    queue.emplace_back(static_cast<std::size_t>(right[i].get<std::int64_t>()), children + 1);
+  }
+}
+
+}  // namespace
+
+XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_t outputs) {
+  const FloatJson j = parse_xgb_json(text);
   XgbForest f;
   if (outputs == 0 || outputs > kMaxOutputs)
     fail("a model predicts 1 to " + std::to_string(kMaxOutputs) + " outputs, not " + std::to_string(outputs));
@@ -54,93 +157,18 @@ XgbForest XgbForest::parse(std::string_view text, std::size_t inputs, std::size_
     fail("a model reads 1 to " + std::to_string(kMaxInputs) + " inputs, not " + std::to_string(inputs));
   f.outputs_ = outputs;
   try {
-    const auto& learner = j.at("learner");
-    if (learner.at("objective").at("name").get<std::string>() != "reg:squarederror")
-      fail("the model's objective is not reg:squarederror");
-    const auto& param = learner.at("learner_model_param");
-    const auto targets = count_text(param.at("num_target"), "num_target");
-    if (targets != outputs)
-      fail("the model has " + std::to_string(targets) + " targets, the header says " + std::to_string(outputs));
-    if (count_text(param.at("num_feature"), "num_feature") != inputs)
-      fail("the model reads " + param.at("num_feature").get<std::string>() + " features, the header says " +
-           std::to_string(inputs));
-    f.base_score_ = std::stof(param.at("base_score").get<std::string>());
-    if (!std::isfinite(f.base_score_)) fail("base_score is not finite");
-    const auto& booster = learner.at("gradient_booster");
-    if (booster.at("name").get<std::string>() != "gbtree") fail("the booster is not gbtree");
-    const auto& model = booster.at("model");
+    const FloatJson& model = read_xgb_model(j, inputs, outputs, f.base_score_);
     const auto& trees = model.at("trees");
     const auto& info = model.at("tree_info");
-    if (!trees.is_array() || !info.is_array() || trees.size() != info.size())
-      fail("tree_info lists " + std::to_string(info.size()) + " trees, the model holds " + std::to_string(trees.size()));
-    // xgboost reads this count when it loads the model; it must agree with the trees present.
-    if (count_text(model.at("gbtree_model_param").at("num_trees"), "num_trees") != trees.size())
-      fail("num_trees says " + model.at("gbtree_model_param").at("num_trees").dump().substr(0, 40) + ", the model holds " +
-           std::to_string(trees.size()) + " trees");
     for (std::size_t t = 0; t < trees.size(); ++t) {
       const std::string where = "tree " + std::to_string(t) + ": ";
       const auto target = integer(info[t], where + "tree_info");
       if (target < 0 || static_cast<std::size_t>(target) >= outputs)
         fail(where + "target " + std::to_string(target) + " is not below " + std::to_string(outputs));
-      const auto& tree = trees[t];
-      const auto& left = tree.at("left_children");
-      const auto& right = tree.at("right_children");
-      const auto& feature = tree.at("split_indices");
-      const auto& value = tree.at("split_conditions");
-      const auto& dleft = tree.at("default_left");
-      const auto& type = tree.at("split_type");
-      const std::size_t n = left.size();
-      if (n == 0 || n > (1u << 24)) fail(where + "has " + std::to_string(n) + " nodes");
-      if (f.nodes_.size() + n > (1u << 30)) fail(where + "the forest has more than 2^30 nodes");
-      for (const auto* a : {&right, &feature, &value, &dleft, &type})
-        if (!a->is_array() || a->size() != n) fail(where + "its node arrays differ in length");
-      const auto base = static_cast<std::int64_t>(f.nodes_.size());
-      std::vector<char> seen(n, 0);
-      // Walk from the root: each node reached once (a tree), every index checked before use.
-      std::vector<std::pair<std::int64_t, int>> stack{{0, 0}};
-      while (!stack.empty()) {
-        const auto [i, depth] = stack.back();
-        stack.pop_back();
-        const std::string at = where + "node " + std::to_string(i) + ": ";
-        if (seen[static_cast<std::size_t>(i)]) fail(at + "reached twice; not a tree");
-        seen[static_cast<std::size_t>(i)] = 1;
-        if (depth > 64) fail(at + "deeper than 64");
-        const auto l = integer(left[static_cast<std::size_t>(i)], at + "left child");
-        const auto r = integer(right[static_cast<std::size_t>(i)], at + "right child");
-        integer(dleft[static_cast<std::size_t>(i)], at + "default_left");
-        const float v = value[static_cast<std::size_t>(i)].get<float>();
-        if (!std::isfinite(v)) fail(at + "value is not finite");
-        if (l == -1 && r == -1) continue;
-        for (const auto c : {l, r})
-          if (c <= 0 || c >= static_cast<std::int64_t>(n))
-            fail(at + "child " + std::to_string(c) + " is out of range (the tree has " + std::to_string(n) + " nodes)");
-        if (integer(type[static_cast<std::size_t>(i)], at + "split_type") != 0) fail(at + "categorical splits are not supported");
-        const auto k = integer(feature[static_cast<std::size_t>(i)], at + "split index");
-        if (k < 0 || static_cast<std::size_t>(k) >= inputs)
-          fail(at + "splits on feature " + std::to_string(k) + " of " + std::to_string(inputs));
-        stack.emplace_back(l, depth + 1);
-        stack.emplace_back(r, depth + 1);
-      }
-      // Laid out breadth first with each node's two children side by side (right = left + 1):
-      // 12-byte nodes, the top levels of a tree in a few cache lines.
-      f.nodes_.emplace_back();
-      std::vector<std::pair<std::size_t, std::size_t>> queue{{0, static_cast<std::size_t>(base)}};  // (xgboost's, ours)
-      for (std::size_t q = 0; q < queue.size(); ++q) {
-        const auto [i, slot] = queue[q];
-        Node& node = f.nodes_[slot];
-        node.value = value[i].get<float>();
-        const auto l = left[i].get<std::int64_t>();  // checked by the walk above
-        if (l == -1) continue;
-        const auto children = f.nodes_.size();
-        node.left = static_cast<std::int32_t>(children);
-        node.feature = static_cast<std::uint32_t>(feature[i].get<std::int64_t>()) |
-                       (dleft[i].get<int>() != 0 ? kDefaultLeft : 0u);
-        f.nodes_.emplace_back();
-        f.nodes_.emplace_back();
-        queue.emplace_back(static_cast<std::size_t>(l), children);
-        queue.emplace_back(static_cast<std::size_t>(right[i].get<std::int64_t>()), children + 1);
-      }
-      f.roots_.push_back(static_cast<std::uint32_t>(base));
+      check_xgb_tree(trees[t], where, inputs, f.nodes_.size());
+      const auto base = static_cast<std::uint32_t>(f.nodes_.size());
+      lay_out_xgb_tree(trees[t], f.nodes_, kDefaultLeft);
+      f.roots_.push_back(base);
       f.targets_.push_back(static_cast<std::uint32_t>(target));
     }
   } catch (const FloatJson::exception& e) {

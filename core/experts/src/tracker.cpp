@@ -136,73 +136,94 @@ struct Candidate {
   PathWarp warp;
 };
 
-// Simulates `candidates` in turn from env's state (each moved into the frame of `frame`); the
-// first success wins (with robust, the first whose noisy trials all succeed too, else the
-// success with most). Failing that, the `optimise_paths` closest narrowed in shrink even
-// steps, then CMA-ES over their warps, `evaluations` each; failing all, the closest.
-TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
-                     const std::vector<Candidate>& candidates, int evaluations, std::uint64_t seed) {
-  const TrackerConfig& c = recordings.config();
-  const EnvSnapshot start = env.snapshot();
-  const int t = env.t();
-  const auto& paths = recordings.paths();
-  TrackerChoice choice;
-  double best = -1e300;
-  int best_robust = -1;
-  std::optional<TrackerChoice> robust_best;  // the success with most noisy successes so far
-  int simulations = 0;
-  // Keeps the best failure so far; returns true on a success (which is then the choice). With
-  // robust trials, a success that fails some noisy trial is kept aside and the search goes on.
-  auto consider = [&](std::size_t p, const PathWarp& w) {
-    const PathFollower follower(paths[p], w, frame, t, c.gain, c.keep_extremes);
-    Trial trial = simulate(follower, sim, start, c.hold_steps);
-    ++simulations;
-    if (trial.success && c.robust > 0) {
+// One search's tally: the best failure so far (the choice until a success), the success with
+// most noisy successes set aside under robust trials, and the episodes simulated.
+class TrackerSearch {
+ public:
+  TrackerSearch(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame, std::uint64_t seed)
+      : c_(recordings.config()), start_(env.snapshot()), t_(env.t()), paths_(recordings.paths()), sim_(sim),
+        frame_(frame), seed_(seed) {}
+
+  // Simulates path p under warp w (moved into the frame) and keeps the best failure so far; a
+  // success is then the choice. With robust trials, a success that fails some noisy trial is
+  // kept aside and reported as a failure, so the search goes on.
+  Trial consider(std::size_t p, const PathWarp& w) {
+    const PathFollower follower(paths_[p], w, frame_, t_, c_.gain, c_.keep_extremes);
+    Trial trial = simulate(follower, sim_, start_, c_.hold_steps);
+    ++simulations_;
+    if (trial.success && c_.robust > 0) {
       int wins = 0;
-      for (int k = 0; k < c.robust; ++k, ++simulations)
-        wins += robust_trial(paths[p], w, frame, t, c, sim, start, derive_seed(seed, static_cast<std::uint64_t>(simulations)));
-      if (wins > best_robust) {
-        best_robust = wins;
-        robust_best = TrackerChoice{p, w, true, 0};
+      for (int k = 0; k < c_.robust; ++k, ++simulations_) {
+        const std::uint64_t trial_seed = derive_seed(seed_, static_cast<std::uint64_t>(simulations_));
+        wins += robust_trial(paths_[p], w, frame_, t_, c_, sim_, start_, trial_seed);
       }
-      if (wins < c.robust) trial.success = false;  // keep looking
+      if (wins > best_robust_) {
+        best_robust_ = wins;
+        robust_best_ = TrackerChoice{p, w, true, 0};
+      }
+      if (wins < c_.robust) trial.success = false;  // keep looking
       else trial.score = 2.0;
     }
-    if (trial.score > best) {  // a success outscores every failure
-      best = trial.score;
-      choice.path = p;
-      choice.warp = w;
-      choice.success = trial.success;
+    if (trial.score > best_) {  // a success outscores every failure
+      best_ = trial.score;
+      choice_.path = p;
+      choice_.warp = w;
+      choice_.success = trial.success;
     }
-    choice.simulations = simulations;
+    choice_.simulations = simulations_;
     return trial;
-  };
-  auto finish = [&]() {
-    if (!choice.success && robust_best) {
-      choice = *robust_best;
-      choice.simulations = simulations;
-    }
-    return choice;
-  };
-  std::vector<std::pair<double, std::size_t>> near;  // (score, candidate) as given
-  for (std::size_t k = 0; k < candidates.size(); ++k) {
-    const Trial trial = consider(candidates[k].path, candidates[k].warp);
-    if (trial.success) return choice;
-    near.emplace_back(trial.score, k);
   }
-  if (!c.optimise || robust_best) return finish();
-  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
-  // First the least narrowing of the swing that succeeds, in even steps, the closest paths at
-  // each step: alike for neighbouring starts, where CMA-ES's warps scatter.
+
+  // The choice as it stands: the success just found or the best failure.
+  const TrackerChoice& choice() const { return choice_; }
+  bool has_robust_best() const { return robust_best_.has_value(); }
+
+  // The final choice: without a success, the success set aside if any, else the best failure.
+  TrackerChoice finish() {
+    if (!choice_.success && robust_best_) {
+      choice_ = *robust_best_;
+      choice_.simulations = simulations_;
+    }
+    return choice_;
+  }
+
+ private:
+  const TrackerConfig& c_;
+  const EnvSnapshot start_;
+  const int t_;
+  const std::vector<CupPath>& paths_;
+  DiceEnv& sim_;
+  const State& frame_;
+  const std::uint64_t seed_;
+  TrackerChoice choice_;
+  double best_ = -1e300;
+  int best_robust_ = -1;
+  std::optional<TrackerChoice> robust_best_;  // the success with most noisy successes so far
+  int simulations_ = 0;
+};
+
+using NearCandidates = std::vector<std::pair<double, std::size_t>>;  // (score, index into the candidates)
+
+// The least narrowing of the swing that succeeds, in even steps, the closest paths at each step:
+// alike for neighbouring starts, where CMA-ES's warps scatter. The search's answer once it is
+// over (a success, or a robust success set aside), else nothing.
+std::optional<TrackerChoice> search_shrunk(TrackerSearch& s, const TrackerConfig& c, const std::vector<Candidate>& candidates,
+                                           const NearCandidates& near) {
   for (int step = 1; step <= c.shrink; ++step) {
     for (const auto& [score, k] : near) {
       PathWarp w = candidates[k].warp;
       w.amplitude *= 1.0 - c.amplitude_range * static_cast<double>(step) / static_cast<double>(c.shrink);
-      if (consider(candidates[k].path, w).success) return choice;
+      if (s.consider(candidates[k].path, w).success) return s.choice();
     }
-    if (robust_best) return finish();
+    if (s.has_robust_best()) return s.finish();
   }
+  return std::nullopt;
+}
+
+// CMA-ES over the warps of the `near` candidates in turn, `evaluations` each; the first success,
+// else the search's final choice.
+TrackerChoice search_cmaes(TrackerSearch& s, const TrackerConfig& c, const std::vector<Candidate>& candidates,
+                           const NearCandidates& near, int evaluations, std::uint64_t seed) {
   for (const auto& [score, k] : near) {
     const Candidate& base = candidates[k];
     CmaesOptions o;
@@ -214,14 +235,35 @@ TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& 
       const Eigen::MatrixXd& x = es.ask();
       std::vector<double> values(static_cast<std::size_t>(x.rows()));
       for (Eigen::Index r = 0; r < x.rows(); ++r) {
-        const Trial trial = consider(base.path, warp_from(x.row(r).transpose(), c, base.warp));
-        if (trial.success) return choice;
+        const Trial trial = s.consider(base.path, warp_from(x.row(r).transpose(), c, base.warp));
+        if (trial.success) return s.choice();
         values[static_cast<std::size_t>(r)] = -trial.score;
       }
       es.tell(values);
     }
   }
-  return finish();
+  return s.finish();
+}
+
+// Simulates `candidates` in turn from env's state (each moved into the frame of `frame`); the
+// first success wins (with robust, the first whose noisy trials all succeed too, else the
+// success with most). Failing that, the `optimise_paths` closest narrowed in shrink even
+// steps, then CMA-ES over their warps, `evaluations` each; failing all, the closest.
+TrackerChoice search(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,
+                     const std::vector<Candidate>& candidates, int evaluations, std::uint64_t seed) {
+  const TrackerConfig& c = recordings.config();
+  TrackerSearch s(recordings, env, sim, frame, seed);
+  NearCandidates near;  // as given
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const Trial trial = s.consider(candidates[k].path, candidates[k].warp);
+    if (trial.success) return s.choice();
+    near.emplace_back(trial.score, k);
+  }
+  if (!c.optimise || s.has_robust_best()) return s.finish();
+  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  near.resize(std::min(near.size(), static_cast<std::size_t>(c.optimise_paths)));
+  if (auto done = search_shrunk(s, c, candidates, near)) return *done;
+  return search_cmaes(s, c, candidates, near, evaluations, seed);
 }
 
 // How far recorded state `r` (its x moved by `shift`) is from `s`, for joining a path there: the

@@ -86,6 +86,94 @@ b2Vec2 get_raw_vec(detail::ByteReader& r) {
   return {x, r.get<float>()};
 }
 
+// Reads one body's transform, sweep, velocities, flags and sleep time.
+void read_snapshot_body(detail::ByteReader& r, WorldSnapshot::Data::Body& b) {
+  b.xf.p = get_vec(r, "body position");
+  b.xf.q.s = r.get_finite<float>("body rotation");
+  b.xf.q.c = r.get_finite<float>("body rotation");
+  b.sweep.localCenter = get_vec(r, "body sweep");
+  b.sweep.c0 = get_vec(r, "body sweep");
+  b.sweep.c = get_vec(r, "body sweep");
+  b.sweep.a0 = r.get_finite<float>("body sweep");
+  b.sweep.a = r.get_finite<float>("body sweep");
+  b.sweep.alpha0 = r.get_finite<float>("body sweep");
+  b.velocity = get_vec(r, "body velocity");
+  b.angular_velocity = r.get_finite<float>("body angular velocity");
+  b.flags = r.get<uint16>();
+  b.sleep_time = r.get_finite<float>("body sleep time");
+}
+
+// Reads broad-phase node i of a tree of `capacity` nodes into `n`; returns its leaf flag.
+bool read_broad_phase_node(detail::ByteReader& r, b2TreeNode& n, int32 i, int32 capacity) {
+  // A free node (height -1) keeps only its free-list link; Box2D leaves the rest of a node
+  // it grew into uninitialised, so only nodes in use are checked.
+  n.aabb.lowerBound = get_raw_vec(r);
+  n.aabb.upperBound = get_raw_vec(r);
+  n.userData = nullptr;
+  n.parent = r.get<int32>();
+  n.child1 = r.get<int32>();
+  n.child2 = r.get<int32>();
+  n.height = r.get_in<std::int32_t>(-1, capacity, "broad-phase height");
+  const auto moved = r.get<std::uint8_t>();
+  std::memcpy(&n.moved, &moved, 1);
+  const bool leaf = r.get_in<std::uint8_t>(0, 1, "broad-phase leaf flag") != 0;
+  if (leaf != (n.height == 0)) r.fail("broad-phase node " + std::to_string(i) + " is a leaf only by its flag");
+  const auto check_index = [&](int32 index, std::string_view field) {
+    if (index < b2_nullNode || index >= capacity)
+      r.fail(std::string(field) + " of broad-phase node " + std::to_string(i) + " is " + std::to_string(index) +
+             ", outside [-1, " + std::to_string(capacity - 1) + "]");
+  };
+  check_index(n.parent, "parent");
+  if (n.height < 0) return leaf;
+  if (moved > 1) r.fail("broad-phase node " + std::to_string(i) + " has a flag that is not 0 or 1");
+  check_index(n.child1, "child");
+  check_index(n.child2, "child");
+  for (float v : {n.aabb.lowerBound.x, n.aabb.lowerBound.y, n.aabb.upperBound.x, n.aabb.upperBound.y})
+    if (!std::isfinite(v)) r.fail("broad-phase node " + std::to_string(i) + " has a box that is not finite");
+  return leaf;
+}
+
+// Reads the broad-phase tree: its nodes, root, node count, free list, insertions and move buffer.
+void read_broad_phase(detail::ByteReader& r, WorldSnapshot::Data& d) {
+  const int32 capacity = r.get_in<std::int32_t>(1, kMaxTreeNodes, "broad-phase capacity");
+  const auto node_index = [&](std::string_view field) { return r.get_in<std::int32_t>(b2_nullNode, capacity - 1, field); };
+  d.tree_nodes.resize(static_cast<std::size_t>(capacity));
+  d.tree_leaf.resize(static_cast<std::size_t>(capacity));
+  for (int32 i = 0; i < capacity; ++i) {
+    const auto at = static_cast<std::size_t>(i);
+    d.tree_leaf[at] = read_broad_phase_node(r, d.tree_nodes[at], i, capacity);
+  }
+  d.tree_root = node_index("broad-phase root");
+  d.tree_node_count = r.get_in<std::int32_t>(0, capacity, "broad-phase node count");
+  d.tree_free_list = node_index("broad-phase free list");
+  d.tree_insertions = r.get_in<std::int32_t>(0, std::numeric_limits<std::int32_t>::max(), "broad-phase insertions");
+  const auto moves = r.get_in<std::int32_t>(0, capacity, "broad-phase move count");
+  for (std::int32_t i = 0; i < moves; ++i) d.move_buffer.push_back(node_index("broad-phase move"));
+}
+
+// Reads one contact: its fixtures and children, flags, manifold and time of impact.
+WorldSnapshot::Data::Contact read_snapshot_contact(detail::ByteReader& r) {
+  WorldSnapshot::Data::Contact c{};
+  c.fixture_a = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
+  c.fixture_b = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
+  c.child_a = r.get_in<std::int32_t>(0, 0, "contact child");  // every shape is one polygon
+  c.child_b = r.get_in<std::int32_t>(0, 0, "contact child");
+  c.flags = r.get<uint32>();
+  for (auto& p : c.manifold.points) {
+    p.localPoint = get_raw_vec(r);
+    p.normalImpulse = r.get<float>();
+    p.tangentImpulse = r.get<float>();
+    p.id.key = r.get<uint32>();
+  }
+  c.manifold.localNormal = get_raw_vec(r);
+  c.manifold.localPoint = get_raw_vec(r);
+  c.manifold.type = static_cast<b2Manifold::Type>(r.get_in<std::int32_t>(0, 2, "manifold type"));
+  c.manifold.pointCount = r.get_in<std::int32_t>(0, b2_maxManifoldPoints, "manifold point count");
+  c.toi_count = r.get<int32>();
+  c.toi = r.get<float>();
+  return c;
+}
+
 }  // namespace
 
 std::string WorldSnapshot::to_bytes() const {
@@ -164,82 +252,10 @@ WorldSnapshot WorldSnapshot::from_bytes(std::string_view bytes) {
     r.fail("version " + std::to_string(version) + ", this dicestack reads " + std::to_string(kSnapshotVersion));
   auto d = std::make_shared<Data>();
   for (double& v : d->state) v = r.get_finite<double>("state");
-  for (auto& b : d->bodies) {
-    b.xf.p = get_vec(r, "body position");
-    b.xf.q.s = r.get_finite<float>("body rotation");
-    b.xf.q.c = r.get_finite<float>("body rotation");
-    b.sweep.localCenter = get_vec(r, "body sweep");
-    b.sweep.c0 = get_vec(r, "body sweep");
-    b.sweep.c = get_vec(r, "body sweep");
-    b.sweep.a0 = r.get_finite<float>("body sweep");
-    b.sweep.a = r.get_finite<float>("body sweep");
-    b.sweep.alpha0 = r.get_finite<float>("body sweep");
-    b.velocity = get_vec(r, "body velocity");
-    b.angular_velocity = r.get_finite<float>("body angular velocity");
-    b.flags = r.get<uint16>();
-    b.sleep_time = r.get_finite<float>("body sleep time");
-  }
-  const int32 capacity = r.get_in<std::int32_t>(1, kMaxTreeNodes, "broad-phase capacity");
-  const auto node_index = [&](std::string_view field) { return r.get_in<std::int32_t>(b2_nullNode, capacity - 1, field); };
-  d->tree_nodes.resize(static_cast<std::size_t>(capacity));
-  d->tree_leaf.resize(static_cast<std::size_t>(capacity));
-  for (int32 i = 0; i < capacity; ++i) {
-    b2TreeNode& n = d->tree_nodes[static_cast<std::size_t>(i)];
-    // A free node (height -1) keeps only its free-list link; Box2D leaves the rest of a node
-    // it grew into uninitialised, so only nodes in use are checked.
-    n.aabb.lowerBound = get_raw_vec(r);
-    n.aabb.upperBound = get_raw_vec(r);
-    n.userData = nullptr;
-    n.parent = r.get<int32>();
-    n.child1 = r.get<int32>();
-    n.child2 = r.get<int32>();
-    n.height = r.get_in<std::int32_t>(-1, capacity, "broad-phase height");
-    const auto moved = r.get<std::uint8_t>();
-    std::memcpy(&n.moved, &moved, 1);
-    const bool leaf = r.get_in<std::uint8_t>(0, 1, "broad-phase leaf flag") != 0;
-    if (leaf != (n.height == 0)) r.fail("broad-phase node " + std::to_string(i) + " is a leaf only by its flag");
-    d->tree_leaf[static_cast<std::size_t>(i)] = leaf;
-    const auto check_index = [&](int32 index, std::string_view field) {
-      if (index < b2_nullNode || index >= capacity)
-        r.fail(std::string(field) + " of broad-phase node " + std::to_string(i) + " is " + std::to_string(index) +
-               ", outside [-1, " + std::to_string(capacity - 1) + "]");
-    };
-    check_index(n.parent, "parent");
-    if (n.height < 0) continue;
-    if (moved > 1) r.fail("broad-phase node " + std::to_string(i) + " has a flag that is not 0 or 1");
-    check_index(n.child1, "child");
-    check_index(n.child2, "child");
-    for (float v : {n.aabb.lowerBound.x, n.aabb.lowerBound.y, n.aabb.upperBound.x, n.aabb.upperBound.y})
-      if (!std::isfinite(v)) r.fail("broad-phase node " + std::to_string(i) + " has a box that is not finite");
-  }
-  d->tree_root = node_index("broad-phase root");
-  d->tree_node_count = r.get_in<std::int32_t>(0, capacity, "broad-phase node count");
-  d->tree_free_list = node_index("broad-phase free list");
-  d->tree_insertions = r.get_in<std::int32_t>(0, std::numeric_limits<std::int32_t>::max(), "broad-phase insertions");
-  const auto moves = r.get_in<std::int32_t>(0, capacity, "broad-phase move count");
-  for (std::int32_t i = 0; i < moves; ++i) d->move_buffer.push_back(node_index("broad-phase move"));
+  for (auto& b : d->bodies) read_snapshot_body(r, b);
+  read_broad_phase(r, *d);
   const auto contacts = r.get_in<std::int32_t>(0, kFixtureCount * kFixtureCount, "contact count");
-  for (std::int32_t i = 0; i < contacts; ++i) {
-    Data::Contact c{};
-    c.fixture_a = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
-    c.fixture_b = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
-    c.child_a = r.get_in<std::int32_t>(0, 0, "contact child");  // every shape is one polygon
-    c.child_b = r.get_in<std::int32_t>(0, 0, "contact child");
-    c.flags = r.get<uint32>();
-    for (auto& p : c.manifold.points) {
-      p.localPoint = get_raw_vec(r);
-      p.normalImpulse = r.get<float>();
-      p.tangentImpulse = r.get<float>();
-      p.id.key = r.get<uint32>();
-    }
-    c.manifold.localNormal = get_raw_vec(r);
-    c.manifold.localPoint = get_raw_vec(r);
-    c.manifold.type = static_cast<b2Manifold::Type>(r.get_in<std::int32_t>(0, 2, "manifold type"));
-    c.manifold.pointCount = r.get_in<std::int32_t>(0, b2_maxManifoldPoints, "manifold point count");
-    c.toi_count = r.get<int32>();
-    c.toi = r.get<float>();
-    d->contacts.push_back(c);
-  }
+  for (std::int32_t i = 0; i < contacts; ++i) d->contacts.push_back(read_snapshot_contact(r));
   d->inv_dt0 = r.get_finite<float>("inverse time step");
   d->new_contacts = r.get_in<std::uint8_t>(0, 1, "world flag") != 0;
   d->step_complete = r.get_in<std::uint8_t>(0, 1, "world flag") != 0;
