@@ -121,13 +121,9 @@ class Dagger final : public Learner {
   // the learner ("policy").
   static Episode mixture_rollout(DiceEnv& pooled, Expert& expert, const Model* model, double beta, std::uint64_t seed,
                                  const Perturbation& perturbation) {
-    const PerturbationDraw draw = draw_perturbation(perturbation, pooled.config(), seed);
-    std::optional<DiceEnv> own;
-    DiceEnv& env = episode_env(draw, pooled, own);
-    MixturePolicy mixture(expert, env, model, beta);
-    RolloutOptions options;
-    options.perturbation = &draw;
-    Episode e = rollout(env, mixture, random_start_state(draw.world, seed), seed, StepSource::policy, options);
+    PerturbedEnv episode(pooled, perturbation, seed);
+    MixturePolicy mixture(expert, episode.env(), model, beta);
+    Episode e = rollout(episode, mixture, episode.random_start(seed), seed, StepSource::policy);
     e.origin = "dagger";
     return e;
   }

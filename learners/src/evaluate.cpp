@@ -23,44 +23,34 @@ InitialPush initial_push_from(std::string_view text) {
   throw ConfigError("initial push \"" + std::string(text) + "\" is not one of none, left, right");
 }
 
-DiceEnv& episode_env(const PerturbationDraw& draw, DiceEnv& pooled, std::optional<DiceEnv>& own) {
-  if (!draw.physics) return pooled;
-  own.emplace(draw.world);
-  return *own;
-}
-
-Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
+Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
                 const RolloutOptions& options) {
   Episode e;
   e.seed = seed;
   e.origin = policy.name();
-  const auto& limit = env.config().action.limit;
-  const bool noisy = options.noise[0] > 0.0 || options.noise[1] > 0.0 || options.noise[2] > 0.0;
-  Rng noise(options.noise_seed);
-  std::optional<PerturbedChannel> perturbed;
+  DiceEnv& env = world.env();
+  const bool channelled = world.channelled();
   std::vector<State> seen;  // what the policy was shown, when that is not the true states
-  if (options.perturbation && options.perturbation->acts) perturbed.emplace(*options.perturbation);
   std::vector<Action> applied, pending, unseen;
   policy.attach(env);
-  e.states.push_back(env.reset_to(start, seed));
+  const State shown = world.reset_to(start, seed);
+  e.states.push_back(env.get_state());
+  if (channelled) seen.push_back(shown);
   policy.reset(seed);
   while (true) {
     if (options.before_step) options.before_step(env, applied.size());
-    if (perturbed) {
-      seen.push_back(perturbed->observe(e.states.back()));
-      pending.assign(perturbed->pending().begin(), perturbed->pending().end());
-      unseen.assign(perturbed->unseen().begin(), perturbed->unseen().end());
+    if (channelled) {
+      pending.assign(world.pending().begin(), world.pending().end());
+      unseen.assign(world.unseen().begin(), world.unseen().end());
     }
-    Action a = policy.act(History{perturbed ? seen : e.states, applied, pending, unseen});
+    Action a = policy.act(History{channelled ? seen : e.states, applied, pending, unseen});
     if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
-    for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
-    Action executed = perturbed ? perturbed->execute(a) : a;
-    if (noisy)
-      for (std::size_t k = 0; k < kActionDim; ++k) executed[k] += options.noise[k] * noise.normal();
+    a = world.clip(a);
     const auto label = policy.label();
     e.actions.push_back(label ? label->label : a);
     e.sources.push_back(label ? label->source : source);
-    const StepResult r = env.step(executed);
+    const PerturbedStep step = world.step(a);
+    const StepResult& r = step.result;
     applied.push_back(r.applied);
     e.rewards.push_back(r.reward);
     if (r.terminated || r.truncated || applied.size() == options.max_steps) {
@@ -70,11 +60,17 @@ Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t 
       break;
     }
     e.states.push_back(r.observation);
+    if (channelled) seen.push_back(step.shown);
   }
   e.outcome = env.outcome();
-  if (options.perturbation && (options.perturbation->physics || options.perturbation->acts))
-    e.perturbation = draw_to_json(*options.perturbation);
+  if (world.perturbed()) e.perturbation = draw_to_json(world.draw());
   return e;
+}
+
+Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
+                const RolloutOptions& options) {
+  PerturbedEnv world(env);
+  return rollout(world, policy, start, seed, source, options);
 }
 
 Rate wilson(int successes, int trials) {
@@ -193,19 +189,16 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, c
         Timed t;
         TimedPolicy timed(*policies[slot], t.policy_seconds);
         const std::uint64_t episode_seed = evaluation_start_seed(request.seed, i);
-        const PerturbationDraw draw = draw_perturbation(request.perturbation, world, episode_seed);
+        PerturbedEnv episode(envs.at(w), request.perturbation, episode_seed);
         RolloutOptions episode_options = options;
-        episode_options.perturbation = &draw;
-        std::optional<DiceEnv> own;
-        DiceEnv& env = episode_env(draw, envs.at(w), own);
-        const State start = random_start_state(draw.world, episode_seed);
+        const State start = episode.random_start(episode_seed);
         // Only when results are asked for (a call per step): before step k the outcome covers
         // steps 0..k-1, so the first k that sees a wall names step k-1.
         if (request.results)
           episode_options.before_step = [&t](const DiceEnv& e, std::size_t k) {
             if (t.wall_step < 0 && e.outcome().wall_contact) t.wall_step = static_cast<int>(k) - 1;
           };
-        t.episode = rollout(env, timed, start, episode_seed, StepSource::policy, episode_options);
+        t.episode = rollout(episode, timed, start, episode_seed, StepSource::policy, episode_options);
         if (t.wall_step < 0 && t.episode.outcome.wall_contact) t.wall_step = static_cast<int>(t.episode.size()) - 1;
         if (request.progress) request.progress(std::min(episodes, ++finished * ranks), episodes);
         return t;

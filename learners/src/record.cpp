@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <optional>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
@@ -21,13 +20,13 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
   validate(request.perturbation, world);
   require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "episodes");
-  RolloutOptions options;
+  Action noise{0.0, 0.0, 0.0};  // world units
   for (std::size_t k = 0; k < kActionDim; ++k) {
-    const double noise = request.noise[k];
-    if (!(noise >= 0.0) || !std::isfinite(noise))
+    const double fraction = request.noise[k];
+    if (!(fraction >= 0.0) || !std::isfinite(fraction))
       throw ConfigError("noise for " + std::string(action_names()[k]) + " must be a finite fraction >= 0, got " +
-                        std::to_string(noise));
-    options.noise[k] = noise * world.action.scale[k];
+                        std::to_string(fraction));
+    noise[k] = fraction * world.action.scale[k];
   }
   const int threads = request.threads;
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
@@ -39,14 +38,10 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!expert) expert = make_expert(name, config);
         const std::uint64_t s = training_start_seed(request.seed, request.first + i);
-        const PerturbationDraw draw = draw_perturbation(request.perturbation, world, s);
-        std::optional<DiceEnv> own;
-        DiceEnv& env = episode_env(draw, envs.at(w), own);
-        ExpertPolicy policy(*expert, env);
-        RolloutOptions o = options;
-        o.noise_seed = derive_seed(s, 2);
-        o.perturbation = &draw;
-        Episode e = rollout(env, policy, random_start_state(draw.world, s), s, StepSource::expert, o);
+        PerturbedEnv episode(envs.at(w), request.perturbation, s);
+        episode.add_executed_noise(noise, derive_seed(s, 2));
+        ExpertPolicy policy(*expert, episode.env());
+        Episode e = rollout(episode, policy, episode.random_start(s), s, StepSource::expert);
         e.origin = "expert " + name;
         return e;
       },

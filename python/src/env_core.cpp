@@ -1,6 +1,5 @@
 #include "env_core.hpp"
 
-#include <algorithm>
 #include <random>
 #include <stdexcept>
 
@@ -27,24 +26,17 @@ std::uint64_t EpisodeSeeds::next(std::optional<std::uint64_t> seed) {
 EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation)
     : world_(world),
       perturbation_(perturbation),
-      env_(std::make_unique<DiceEnv>(world)),
+      nominal_(std::make_unique<DiceEnv>(world)),
       goal_(goal_state(world)),
       nominal_hash_(dicestack::world_hash(world)),
       world_hash_(nominal_hash_),
-      draw_(draw_perturbation(Perturbation{}, world, 0)) {
+      nominal_draw_(draw_perturbation(Perturbation{}, world, 0)) {
   validate(perturbation, world);
 }
 
 void EnvCore::begin(const Perturbation* perturbation) {
-  const Perturbation& p = perturbation ? *perturbation : perturbation_;
-  const bool was_perturbed = draw_.physics;
-  draw_ = draw_perturbation(p, world_, episode_seed_);
-  if (draw_.physics || was_perturbed) {
-    env_ = std::make_unique<DiceEnv>(draw_.world);
-    world_hash_ = draw_.physics ? dicestack::world_hash(draw_.world) : nominal_hash_;
-  }
-  channel_.reset();
-  if (draw_.acts) channel_.emplace(draw_);
+  episode_ = std::make_unique<PerturbedEnv>(*nominal_, perturbation ? *perturbation : perturbation_, episode_seed_);
+  world_hash_ = episode_->draw().physics ? dicestack::world_hash(episode_->draw().world) : nominal_hash_;
 }
 
 State EnvCore::reset(std::optional<std::uint64_t> seed, const Perturbation* perturbation) {
@@ -52,7 +44,8 @@ State EnvCore::reset(std::optional<std::uint64_t> seed, const Perturbation* pert
   episode_seed_ = seeds_.next(seed);
   ++episodes_;
   begin(perturbation);
-  return observed(env_->reset(episode_seed_));
+  // DiceEnv::reset's own start and noise seed, in the drawn world.
+  return episode_->reset_to(episode_->random_start(episode_seed_), derive_seed(episode_seed_, 1));
 }
 
 State EnvCore::reset_to(const State& state, std::optional<std::uint64_t> seed, const Perturbation* perturbation) {
@@ -61,31 +54,28 @@ State EnvCore::reset_to(const State& state, std::optional<std::uint64_t> seed, c
   episode_seed_ = seeds_.next(seed);
   ++episodes_;
   begin(perturbation);
-  return observed(env_->reset_to(state, episode_seed_));
+  return episode_->reset_to(state, episode_seed_);
 }
 
 StepResult EnvCore::step(const Action& action) {
   if (episodes_ == 0) throw std::logic_error("Cannot call step() before calling reset()");
-  if (!channel_) return env_->step(action);
-  // As rollout() does: the choice clipped to the limits, then delayed, biased and noised.
-  Action chosen = action;
-  const auto& limit = env_->config().action.limit;
-  for (std::size_t k = 0; k < kActionDim; ++k) chosen[k] = std::clamp(chosen[k], -limit[k], limit[k]);
-  StepResult r = env_->step(channel_->execute(chosen));
-  r.observation = channel_->observe(r.observation);
-  return r;
+  PerturbedStep s = episode_->step(action);
+  s.result.observation = s.shown;
+  return s.result;
 }
 
 StepInfo EnvCore::info() const {
   StepInfo i;
-  i.t = env_->t();
-  i.distance = state_distance(env_->get_state(), goal_, env_->config().cost);
-  i.outcome = env_->outcome();
+  const DiceEnv& e = env();
+  i.t = e.t();
+  i.distance = state_distance(e.get_state(), goal_, e.config().cost);
+  i.outcome = e.outcome();
   return i;
 }
 
 void EnvCore::restored(std::uint64_t episode_seed) {
   episode_seed_ = episode_seed;
+  if (!episode_) episode_ = std::make_unique<PerturbedEnv>(*nominal_);  // restored before any reset
   ++episodes_;  // a restored episode is a new one for an expert acting here
 }
 

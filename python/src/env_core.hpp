@@ -10,6 +10,7 @@
 
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/perturbation.hpp>
+#include <dicestack/core/perturbed_env.hpp>
 
 namespace dicestack::python {
 
@@ -30,9 +31,10 @@ class EpisodeSeeds {
   std::uint64_t count_ = 0;
 };
 
-/// A DiceEnv with its seed stream and what the Python info dict reports. Under a perturbation
-/// each episode runs in the world drawn from its seed, and observations and actions
-/// pass through the draw's PerturbedChannel, as in rollout(): the same episodes as C++.
+/// A DiceEnv with its seed stream and what the Python info dict reports. Each episode steps
+/// through a PerturbedEnv, as rollout() does: under a perturbation it runs in the world drawn from
+/// its seed, and its observations and actions pass through the draw's sensing and actuation; the
+/// same episodes as C++.
 class EnvCore {
  public:
   explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {});
@@ -45,26 +47,26 @@ class EnvCore {
   /// One control step. Throws std::logic_error before the first reset (Gymnasium's order).
   StepResult step(const Action& action);
   /// What the current episode drew (nominal: the world unchanged, nothing else).
-  const PerturbationDraw& draw() const { return draw_; }
+  const PerturbationDraw& draw() const { return episode_ ? episode_->draw() : nominal_draw_; }
   /// True when the current episode's actuation or sensing is perturbed (its delays and noise
   /// stream are not in a snapshot).
-  bool channelled() const { return channel_.has_value(); }
+  bool channelled() const { return episode_ && episode_->channelled(); }
   /// What runs before the next action under the episode's action delay (History::pending):
   /// an expert acting here simulates through it. Empty without a delay.
   std::vector<Action> pending() const {
-    return channel_ ? std::vector<Action>(channel_->pending().begin(), channel_->pending().end()) : std::vector<Action>{};
+    return episode_ ? std::vector<Action>(episode_->pending().begin(), episode_->pending().end()) : std::vector<Action>{};
   }
   /// What ran since the state the last observation showed, under an observation delay
   /// (History::unseen). Empty without a delay.
   std::vector<Action> unseen() const {
-    return channel_ ? std::vector<Action>(channel_->unseen().begin(), channel_->unseen().end()) : std::vector<Action>{};
+    return episode_ ? std::vector<Action>(episode_->unseen().begin(), episode_->unseen().end()) : std::vector<Action>{};
   }
 
   /// The info of the episode's latest state (what reset reports; step's own is in StepResult).
   StepInfo info() const;
 
-  DiceEnv& env() { return *env_; }
-  const DiceEnv& env() const { return *env_; }
+  DiceEnv& env() { return episode_ ? episode_->env() : *nominal_; }
+  const DiceEnv& env() const { return episode_ ? episode_->env() : *nominal_; }
   std::uint64_t world_hash() const { return world_hash_; }
   /// The seed of the current episode (0 before the first reset).
   std::uint64_t episode_seed() const { return episode_seed_; }
@@ -78,15 +80,14 @@ class EnvCore {
  private:
   // Draws the new episode's perturbation and makes its world.
   void begin(const Perturbation* perturbation);
-  State observed(const State& s) { return channel_ ? channel_->observe(s) : s; }
 
   WorldConfig world_;  // the nominal world
   Perturbation perturbation_;
-  std::unique_ptr<DiceEnv> env_;
+  std::unique_ptr<DiceEnv> nominal_;  // the world of every episode whose physics is nominal
+  std::unique_ptr<PerturbedEnv> episode_;  // the current episode (null before the first reset)
   State goal_;
   std::uint64_t nominal_hash_, world_hash_;
-  PerturbationDraw draw_;
-  std::optional<PerturbedChannel> channel_;
+  PerturbationDraw nominal_draw_;  // draw() before the first reset
   EpisodeSeeds seeds_;
   std::uint64_t episode_seed_ = 0;
   std::uint64_t episodes_ = 0;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
@@ -189,6 +190,20 @@ TEST(Expert, UnknownNamesAndBadConfigsAreConfigErrors) {
     }
     EXPECT_EQ(make_expert(info.name)->name(), info.name);
   }
+}
+
+TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
+  EXPECT_NE(test::error_of([] { make_expert("tracker"); }).find("needs recordings"), std::string::npos);
+  EXPECT_NE(test::error_of([] { make_expert("trackr"); }).find("scripted, mpc, tracker"), std::string::npos);
+  EXPECT_THROW(ExpertRegistry::global().add({"mpc", "again"}, nullptr), ConfigError);
+}
+
+TEST(ExpertRegistry, AReplacedFactoryIsUsedAndCanBePutBack) {
+  auto old = ExpertRegistry::global().replace(
+      "scripted", [](const ExpertConfig&) -> std::unique_ptr<Expert> { throw std::logic_error("no scripted here"); });
+  EXPECT_EQ(test::error_of([] { make_expert("scripted"); }), "no scripted here");
+  ExpertRegistry::global().replace("scripted", std::move(old));
+  EXPECT_EQ(make_expert("scripted")->name(), "scripted");
 }
 
 }  // namespace

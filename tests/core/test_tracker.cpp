@@ -1,5 +1,5 @@
 // The tracker: recorded cup paths followed by feedback on the cup, chosen by
-// simulation; and the expert registry it is built through.
+// simulation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -82,7 +82,7 @@ TEST(PathFollower, HoldsTheLastPoseAfterThePathEnds) {
   for (double v : a) EXPECT_NEAR(v, 0.0, 1e-9);
 }
 
-TEST(Recordings, RefuseBadRecordingsNamingThem) {
+TEST(TrackerRecordings, RefuseBadRecordingsNamingThem) {
   const WorldConfig w;
   EXPECT_THROW(Recordings({}, w, {}, 0), InputError);
   CupPath p = scripted_path(4);
@@ -97,7 +97,7 @@ TEST(Recordings, RefuseBadRecordingsNamingThem) {
   EXPECT_NE(test::error_of([&] { Recordings({scripted_path(4)}, w, bad, 0); }).find("time_scale_range"), std::string::npos);
 }
 
-TEST(Recordings, RankingDoesNotDependOnThreads) {
+TEST(TrackerRecordings, RankingDoesNotDependOnThreads) {
   const WorldConfig w = test::short_world(200);
   std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
   TrackerConfig c;
@@ -197,7 +197,7 @@ TEST(ChoosePath, WhenNoRecordingSucceedsAsRecordedTheLeastNarrowingComesBeforeCm
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 0); }).find("\"shrink\""), std::string::npos);
 }
 
-TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
+TEST(TrackerRecordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
   const WorldConfig w = test::short_world(200);
   std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
   TrackerConfig c;
@@ -215,7 +215,7 @@ TEST(Recordings, RobustProbesScoreEachNoisyTrialThatSucceedsToo) {
   EXPECT_EQ(Recordings(paths, w, c, 7, 1).probe_successes(), Recordings(paths, w, c, 7, 2).probe_successes());
 }
 
-TEST(Recordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainFromFreshStarts) {
+TEST(TrackerRecordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainFromFreshStarts) {
   const WorldConfig w = test::short_world(200);
   std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
   TrackerConfig c;
@@ -256,20 +256,6 @@ TEST(Recordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScoredAgainF
   EXPECT_EQ(two.probe_successes(), r.probe_successes());
   c.variants = {-1.0};
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"variants\""), std::string::npos);
-}
-
-TEST(ExpertRegistry, TrackerNeedsRecordingsAndUnknownNamesListIt) {
-  EXPECT_NE(test::error_of([] { make_expert("tracker"); }).find("needs recordings"), std::string::npos);
-  EXPECT_NE(test::error_of([] { make_expert("trackr"); }).find("scripted, mpc, tracker"), std::string::npos);
-  EXPECT_THROW(ExpertRegistry::global().add({"mpc", "again"}, nullptr), ConfigError);
-}
-
-TEST(ExpertRegistry, AReplacedFactoryIsUsedAndCanBePutBack) {
-  auto old = ExpertRegistry::global().replace(
-      "scripted", [](const ExpertConfig&) -> std::unique_ptr<Expert> { throw std::logic_error("no scripted here"); });
-  EXPECT_EQ(test::error_of([] { make_expert("scripted"); }), "no scripted here");
-  ExpertRegistry::global().replace("scripted", std::move(old));
-  EXPECT_EQ(make_expert("scripted")->name(), "scripted");
 }
 
 TEST(TrackerExpert, ChoosesOnceAndFollows) {
@@ -314,7 +300,7 @@ TEST(PathFollower, JoinsAPathMidwayAtItsPhase) {
   }
 }
 
-TEST(Recordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
+TEST(TrackerRecordings, SmoothRemovesAPersonsJitterAndKeepsTheMotion) {
   const WorldConfig w = test::short_world(100);
   CupPath path = scripted_path(4, w);
   const CupPath clean = path;

@@ -1,4 +1,5 @@
-// DART, the training/evaluation start streams, histories in rollouts, and honest evaluation.
+// DART: the expert's episodes under noise, randomised worlds and drawn delays, on any thread
+// count, and a model file that then rolls out alone.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -22,73 +23,6 @@ namespace {
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-TEST(Starts, TrainingAndEvaluationStreamsShareNoStart) {
-  // Every seed a user is likely to type, on both sides: no start seed (hence no start) in common.
-  std::set<std::uint64_t> evaluation;
-  for (std::uint64_t s = 0; s < 20; ++s)
-    for (std::uint64_t i = 0; i < 500; ++i) evaluation.insert(evaluation_start_seed(s, i));
-  for (std::uint64_t s = 0; s < 20; ++s)
-    for (std::uint64_t i = 0; i < 500; ++i) ASSERT_FALSE(evaluation.contains(training_start_seed(s, i))) << s << " " << i;
-  // And the starts themselves: record --seed 0 against evaluate --seed 0.
-  const WorldConfig w = test::short_world();
-  const auto recorded = record_expert("scripted", {}, w, test::record_request(5, 0, 1));
-  std::vector<Episode> evaluated;
-  evaluate([] { return std::make_unique<PlaybackPolicy>(Episode{}); }, w, test::eval_request(5, 0, 1, &evaluated));
-  for (const auto& r : recorded)
-    for (const auto& e : evaluated) EXPECT_NE(r.states.front(), e.states.front());
-}
-
-// Records what it was shown, and acts with a fixed pattern.
-class Probe final : public Policy {
- public:
-  std::vector<std::size_t> ts, action_counts;
-  std::vector<State> starts;
-  Action act(const History& h) override {
-    ts.push_back(h.t());
-    action_counts.push_back(h.actions.size());
-    starts.push_back(h.start());
-    return {h.t() % 2 ? 5.0 : -0.3, 0.1, 0.0};  // 5 m/s is beyond the limit: the world clips it
-  }
-  std::string name() const override { return "probe"; }
-};
-
-TEST(Rollout, PoliciesSeeTheirHistoryAndTheActionsTheWorldApplied) {
-  const WorldConfig w = test::short_world();
-  DiceEnv env(w);
-  Probe p;
-  const State start = random_start_state(w, 3);
-  const Episode e = rollout(env, p, start, 3, StepSource::policy);
-  ASSERT_EQ(p.ts.size(), e.size());
-  for (std::size_t t = 0; t < e.size(); ++t) {
-    EXPECT_EQ(p.ts[t], t);
-    EXPECT_EQ(p.action_counts[t], t);
-    EXPECT_EQ(p.starts[t], e.states.front());
-    EXPECT_LE(e.actions[t][0], w.action.limit[0]);  // recorded as applied: clipped
-  }
-}
-
-TEST(Rollout, NoiseIsExecutedButTheCleanActionIsRecorded) {
-  const WorldConfig w = test::short_world();
-  DiceEnv a(w), b(w);
-  auto expert = make_expert("scripted");
-  ExpertPolicy pa(*expert, a);
-  RolloutOptions noisy;
-  noisy.noise = {0.2, 0.02, 0.1};
-  noisy.noise_seed = 9;
-  const State start = random_start_state(w, 4);
-  const Episode clean = rollout(a, pa, start, 4, StepSource::expert);
-  ExpertPolicy pb(*expert, b);
-  const Episode perturbed = rollout(b, pb, start, 4, StepSource::expert, noisy);
-  EXPECT_NE(clean.states[10], perturbed.states[10]);
-  // The recorded labels are what the expert chose in the states it was in, not what ran.
-  DiceEnv replay(w);
-  replay.reset_to(start, 4);
-  expert->reset(4);
-  EXPECT_EQ(perturbed.actions[0], expert->act(replay));
-  const StepResult r = replay.step(perturbed.actions[0]);
-  EXPECT_NE(r.observation, perturbed.states[1]);  // the executed action differed
-}
 
 // knn on the short world, seed 5, one thread: DART's test runs.
 LearnContext knn_context() {

@@ -1,308 +1,42 @@
+// The robustness table: a row per factor and level, the same on any thread count, rendered in the
+// leaderboard's formats, and its html page.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
-#include <dicestack/core/expert.hpp>
-#include <dicestack/core/initial_state.hpp>
-#include <dicestack/datasets/dataset.hpp>
-#include <dicestack/datasets/features.hpp>
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/results_page.hpp>
 #include <dicestack/learners/robustness.hpp>
 
-#include <dicestack/test/requests.hpp>
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/pages.hpp>
+#include <dicestack/test/policies.hpp>
 
 namespace dicestack {
 namespace {
 
+namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-// A fixed swing that reads the state it is shown, and remembers every state it saw.
-class Watcher final : public Policy {
- public:
-  Action act(const History& h) override {
-    seen.push_back(h.current());
-    const State& s = h.current();
-    return {(h.t() / 10) % 2 ? 0.4 : -0.4, 4.0 / 30.0 - s[state_index::kCupVy] * 0.5, -0.1 * s[state_index::kCupW]};
-  }
-  std::string name() const override { return "watcher"; }
-  std::vector<State> seen;
-};
-
-const PolicyFactory watcher = [] { return std::make_unique<Watcher>(); };
-
-TEST(Perturbed, NoneIsTodaysEvaluationByteForByte) {
-  // Today's evaluation, by hand: each start from its seed in the nominal world, one rollout.
-  const WorldConfig w = test::short_world(50);
-  std::vector<Episode> eps;
-  EvalRequest r = test::eval_request(4, 21, 2, &eps);
-  r.perturbation = perturbation_level("none");
-  evaluate(watcher, w, r);
-  DiceEnv env(w);
-  for (std::size_t i = 0; i < eps.size(); ++i) {
-    Watcher p;
-    const std::uint64_t seed = evaluation_start_seed(21, i);
-    const Episode e = rollout(env, p, random_start_state(w, seed), seed, StepSource::policy);
-    ASSERT_EQ(e.states.size(), eps[i].states.size());
-    for (std::size_t t = 0; t < e.states.size(); ++t) ASSERT_TRUE(test::bit_equal(e.states[t], eps[i].states[t]));
-    EXPECT_EQ(e.actions, eps[i].actions);
-  }
-}
-
-TEST(Perturbed, EvaluationIsTheSameOnAnyThreadCountAndDiffersFromNominal) {
-  const WorldConfig w = test::short_world(50);
-  std::vector<Episode> one, two, nominal;
-  EvalRequest r = test::eval_request(4, 5, 1, &one);
-  r.perturbation = perturbation_level("hard");
-  evaluate(watcher, w, r);
-  r.threads = 2;
-  r.rollouts = &two;
-  evaluate(watcher, w, r);
-  evaluate(watcher, w, test::eval_request(4, 5, 2, &nominal));
-  ASSERT_EQ(one.size(), two.size());
-  for (std::size_t i = 0; i < one.size(); ++i) {
-    EXPECT_EQ(one[i].states, two[i].states) << i;
-    EXPECT_NE(one[i].states, nominal[i].states) << i;
-  }
-}
-
-TEST(Perturbed, AnExpertPlansInEachEpisodesOwnWorldOnAnyThreadCount) {
-  // An expert keeps its planning simulator between episodes; each perturbed episode must plan
-  // in its own world, not in the first one the thread happened to run.
-  const WorldConfig w = test::short_world(40);
-  const PolicyFactory mpc = [] { return std::make_unique<OwnedExpertPolicy>(make_expert("mpc", ExpertConfig{})); };
-  std::vector<Episode> one, two;
-  EvalRequest r = test::eval_request(4, 2, 1, &one);
-  r.perturbation = perturbation_factor("dice_mass", "hard");
-  evaluate(mpc, w, r);
-  r.threads = 2;
-  r.rollouts = &two;
-  evaluate(mpc, w, r);
-  for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].states, two[i].states) << i;
-}
-
-// A draw with nothing on but what the caller sets next.
-PerturbationDraw bare_draw(const WorldConfig& w) {
-  PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
-  d.acts = true;
-  return d;
-}
-
-// One rollout of `p` in the world `w` with only what `d` sets perturbed.
-Episode perturbed_rollout(const WorldConfig& w, const PerturbationDraw& d, Policy& p, std::uint64_t seed = 1) {
-  RolloutOptions o;
-  o.perturbation = &d;
-  DiceEnv env(w);
-  return rollout(env, p, random_start_state(w, seed), seed, StepSource::policy, o);
-}
-
-TEST(Perturbed, ObservationDelayShowsOlderStates) {
-  const WorldConfig w = test::short_world(30);
-  PerturbationDraw d = bare_draw(w);
-  d.observation_delay = 3;
-  Watcher p;
-  const Episode e = perturbed_rollout(w, d, p);
-  ASSERT_EQ(p.seen.size(), e.actions.size());
-  for (std::size_t t = 0; t < p.seen.size(); ++t) EXPECT_EQ(p.seen[t], e.states[t >= 3 ? t - 3 : 0]) << t;
-}
-
-// The Watcher's swing, writing down the row and label `map` makes of what it is shown.
-class RowWatcher final : public Policy {
- public:
-  explicit RowWatcher(const FeatureMap& map) : map_(map) {}
-  Action act(const History& h) override {
-    const Action a = watch_.act(h);
-    rows.emplace_back(map_.width());
-    map_.compute(h, rows.back());
-    labels.emplace_back(kActionDim);
-    map_.label(h, a, labels.back());
-    return a;
-  }
-  std::string name() const override { return "row-watcher"; }
-  std::vector<std::vector<double>> rows, labels;
-
- private:
-  const FeatureMap& map_;
-  Watcher watch_;
-};
-
-TEST(Perturbed, TrainingRowsShowWhatTheRolloutShowedThePolicy) {
-  const WorldConfig w = test::short_world(30);
-  PerturbationDraw d = bare_draw(w);
-  for (std::size_t k = 0; k < kStateDim; ++k) d.observation_noise[k] = 0.05 * observation_spread()[k];
-  d.observation_delay = 2;
-  d.action_delay = 1;
-  d.action_noise = {0.05, 0.05, 0.05};
-  d.noise_seed = 99;
-  for (const char* name : {"state+clock+start_state/velocity", "state+clock/velocity/ahead", "state/position/ahead", "state"}) {
-    const FeatureMap& map = feature_map(name);
-    RowWatcher p(map);
-    RolloutOptions o;
-    o.perturbation = &d;
-    DiceEnv env(w);
-    // Labelled as an expert's steps: what a learner chose under a delay is not rebuilt.
-    Episode e = rollout(env, p, random_start_state(w, 1), 1, StepSource::expert, o);
-    const Dataset rows = make_dataset({e}, map);
-    ASSERT_EQ(static_cast<std::size_t>(rows.x.rows()), p.rows.size()) << name;
-    for (std::size_t t = 0; t < p.rows.size(); ++t) {
-      for (std::size_t k = 0; k < map.width(); ++k)
-        ASSERT_EQ(rows.x(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(k)), p.rows[t][k]) << name << " " << t << " " << k;
-      for (std::size_t k = 0; k < kActionDim; ++k)
-        ASSERT_EQ(rows.y(static_cast<Eigen::Index>(t), static_cast<Eigen::Index>(k)), p.labels[t][k]) << name << " " << t << " " << k;
-    }
-    e.perturbation.clear();  // negative control: the true states are other rows
-    EXPECT_NE(make_dataset({e}, map).x, rows.x) << name;
-  }
-}
-
-TEST(Perturbed, ActionDelayExecutesNothingUntilTheFirstChoiceArrives) {
-  const WorldConfig w = test::short_world(30);
-  PerturbationDraw d = bare_draw(w);
-  d.action_delay = 4;
-  RolloutOptions o;
-  o.perturbation = &d;
-  DiceEnv env(w), plain(w);
-  Watcher p, q;
-  const State start = random_start_state(w, 1);
-  const Episode late = rollout(env, p, start, 1, StepSource::policy, o);
-  const Episode now = rollout(plain, q, start, 1, StepSource::policy);
-  // Doing nothing for 4 steps is not what the policy chose: the states part.
-  EXPECT_NE(late.states[5], now.states[5]);
-  // The first 4 steps are the world left alone.
-  DiceEnv idle(w);
-  idle.reset_to(start, 1);
-  State s{};
-  for (int t = 0; t < 4; ++t) s = idle.step({0.0, 0.0, 0.0}).observation;
-  EXPECT_TRUE(test::bit_equal(s, late.states[4]));
-}
-
-// Chooses a different action each step and remembers what it was told runs before it.
-class PendingWatcher final : public Policy {
- public:
-  Action act(const History& h) override {
-    pending.emplace_back(h.pending.begin(), h.pending.end());
-    return {0.01 * static_cast<double>(h.t() + 1), 0.0, 0.0};
-  }
-  std::string name() const override { return "pending watcher"; }
-  std::vector<std::vector<Action>> pending;
-};
-
-TEST(Perturbed, PendingHoldsWhatRunsBeforeTheChoiceInOrder) {
-  const WorldConfig w = test::short_world(12);
-  PerturbationDraw d = bare_draw(w);
-  d.action_delay = 3;
-  PendingWatcher p;
-  const Episode e = perturbed_rollout(w, d, p);
-  ASSERT_EQ(p.pending.size(), e.actions.size());
-  for (std::size_t t = 0; t < p.pending.size(); ++t) {
-    ASSERT_EQ(p.pending[t].size(), 3u) << t;
-    for (std::size_t k = 0; k < 3; ++k) {  // the choice of step t - 3 + k, zeros before step 0
-      const double chosen = t + k >= 3 ? 0.01 * static_cast<double>(t + k - 3 + 1) : 0.0;
-      EXPECT_EQ(p.pending[t][k][0], chosen) << t << " " << k;
-    }
-  }
-  PendingWatcher q;  // no delay: nothing pending
-  DiceEnv env(w);
-  rollout(env, q, random_start_state(w, 1), 1, StepSource::policy);
-  for (const auto& v : q.pending) EXPECT_TRUE(v.empty());
-}
-
-// Does nothing for `idle` steps, then lets the expert act with no delay.
-class IdleThenExpert final : public Policy {
- public:
-  IdleThenExpert(std::unique_ptr<Expert> expert, std::size_t idle) : expert_(std::move(expert)), idle_(idle) {}
-  void attach(const DiceEnv& env) override { expert_.attach(env); }
-  void reset(std::uint64_t seed) override { expert_.reset(seed); }
-  Action act(const History& h) override { return h.t() < idle_ ? Action{0.0, 0.0, 0.0} : expert_.act(h); }
-  std::string name() const override { return "idle then expert"; }
-
- private:
-  OwnedExpertPolicy expert_;
-  std::size_t idle_;
-};
-
-// An mpc search small enough for a unit test.
-ExpertConfig quick_search() {
-  ExpertConfig c;
-  c.search_budget = 8;
-  c.replan_budget = 4;
-  return c;
-}
-
-// Two episodes through the same states, bit for bit.
-void expect_same_states(const Episode& a, const Episode& b, const std::string& what) {
-  ASSERT_EQ(a.states.size(), b.states.size()) << what;
-  for (std::size_t t = 0; t < a.states.size(); ++t) ASSERT_TRUE(test::bit_equal(a.states[t], b.states[t])) << what << " " << t;
-}
-
-TEST(Perturbed, AnExpertUnderActionDelayActsForTheStateItsActionLandsIn) {
-  // With the simulator as its model (a Smith predictor), an expert whose actions run 4 steps
-  // late moves the world exactly as the same expert with no delay does once 4 idle steps have
-  // passed: the same states, bit for bit, and the same outcome.
-  const WorldConfig w = test::short_world(40);
-  const ExpertConfig c = quick_search();
-  PerturbationDraw d = bare_draw(w);
-  d.action_delay = 4;
-  RolloutOptions o;
-  o.perturbation = &d;
-  for (std::uint64_t seed : {1, 2}) {
-    const State start = random_start_state(w, seed);
-    DiceEnv env(w), plain(w);
-    OwnedExpertPolicy late(make_expert("mpc", c));
-    IdleThenExpert idle(make_expert("mpc", c), 4);
-    const Episode a = rollout(env, late, start, seed, StepSource::expert, o);
-    const Episode b = rollout(plain, idle, start, seed, StepSource::expert);
-    expect_same_states(a, b, "seed " + std::to_string(seed));
-    // Fed the observations (here the true states), its feedback is moved through what is
-    // pending as the world is: the same episode.
-    DiceEnv sensing_env(w);
-    OwnedExpertPolicy sensing(make_expert("mpc", c), ExpertFeedback::observations);
-    expect_same_states(rollout(sensing_env, sensing, start, seed, StepSource::expert, o), a,
-                       "observations, seed " + std::to_string(seed));
-    EXPECT_EQ(a.outcome.realistic_success(), b.outcome.realistic_success());
-    EXPECT_EQ(a.outcome.wall_contact, b.outcome.wall_contact);
-  }
-}
-
-TEST(Perturbed, AnExpertsFeedbackOnTheObservationsIsItsOwnWhereTheyAreTrueAndMovesWithTheirNoise) {
-  // Told to act on what a policy is shown, an expert's feedback reads the observations while
-  // its choices read the world: where the observations are the true states, the episode is the
-  // world-fed expert's, bit for bit; under observation noise that expert ignores the noise and
-  // the observation-fed one does not.
-  const WorldConfig w = test::short_world(40);
-  const ExpertConfig c = quick_search();
-  PerturbationDraw noisy = bare_draw(w);
-  for (std::size_t k = 0; k < kStateDim; ++k) noisy.observation_noise[k] = 0.05 * observation_spread()[k];
-  for (const std::string name : {"scripted", "mpc"}) {
-    OwnedExpertPolicy own(make_expert(name, c)), sensing(make_expert(name, c), ExpertFeedback::observations);
-    const Episode nominal = perturbed_rollout(w, bare_draw(w), own);
-    expect_same_states(perturbed_rollout(w, bare_draw(w), sensing), nominal, name + ", observations true");
-    expect_same_states(perturbed_rollout(w, noisy, own), nominal, name + " reading the world, observations noisy");
-    const Episode moved = perturbed_rollout(w, noisy, sensing);
-    ASSERT_GT(moved.states.size(), 1u);
-    EXPECT_FALSE(test::bit_equal(moved.states[1], nominal.states[1])) << name << ": the first noisy feedback moves the cup";
-  }
-}
-
-TEST(Perturbed, AnInvalidPerturbationIsRefusedBeforeAnyRollout) {
-  std::atomic<int> made{0};
-  EvalRequest r = test::eval_request(3, 0, 1);
-  r.perturbation.friction = 1.5;
-  EXPECT_THAT(test::error_of([&] {
-                evaluate([&] { ++made; return std::make_unique<Watcher>(); }, test::short_world(30), r);
-              }),
-              HasSubstr("\"friction\""));
-  EXPECT_EQ(made, 0);
-}
+using test::page_data;
+using test::read;
+using test::Watcher;
+using test::watcher;
 
 TEST(Robustness, RowsCoverEveryFactorAndLevelAndAreThreadIndependent) {
   RobustnessRequest r;
@@ -405,6 +139,87 @@ TEST(Robustness, EachFormatHasOneEntryAndReplacesOnlyItsOwnFiles) {
   }
   EXPECT_EQ(names, (std::set<std::string>{"md", "csv", "json", "html"}));
   std::filesystem::remove_all(dir);
+}
+
+// A robustness table of three rows, run by `policy`, with `record` as the model's training record.
+RobustnessTable robustness_example(const std::string& policy, const std::map<std::string, std::string>& record = {}) {
+  std::vector<RobustnessRow> rows;
+  const std::vector<std::pair<const char*, const char*>> names{{"none", "none"}, {"friction", "hard"}, {"all", "easy"}};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    RobustnessRow r{names[i].first, names[i].second, {}};
+    r.stats.episodes = 4;
+    r.stats.realistic_success = wilson(3 - static_cast<int>(i), 4);
+    r.stats.wall_contact = wilson(static_cast<int>(i), 4);
+    r.stats.dice_in_cup_mean = 3.0 - 0.5 * static_cast<double>(i);
+    rows.push_back(r);
+  }
+  RobustnessRun run;
+  run.policy = policy;
+  run.world = "short.json";
+  run.episodes = 4;
+  run.seed = 7;
+  run.record = record;
+  return robustness_table(rows, run);
+}
+
+TEST(RobustnessPage, HoldsTheJsonRowsAndTheRunsFactsWithNoNetwork) {
+  const RobustnessTable table = robustness_example("model m.dsm (knn, state)", {{"learner", "bc"}});
+  const std::string page = render_robustness(table, "html");
+  EXPECT_EQ(page.rfind(std::string(kResultsPageMarker) + "\n<!doctype html>", 0), 0u);
+  for (const char* remote : {"http://", "https://", "//cdn", "<link", "src="}) EXPECT_EQ(page.find(remote), std::string::npos) << remote;
+  const auto data = page_data(page);
+  const auto json = nlohmann::json::parse(render_robustness(table, "json"));
+  EXPECT_EQ(data["title"], "dicestack robustness: model m.dsm (knn, state)");
+  EXPECT_EQ(data["header"], json["header"]);
+  ASSERT_EQ(data["rows"].size(), json["rows"].size());
+  for (std::size_t i = 0; i < data["rows"].size(); ++i) {
+    const auto& shown = data["rows"][i];
+    for (const auto& [key, value] : json["rows"][i].items()) EXPECT_EQ(shown[key], value) << key;  // the json row, whole
+    EXPECT_EQ(shown["rank"], i + 1);
+    const auto& ci = json["rows"][i]["realistic_success_rate_ci95"];
+    EXPECT_EQ(shown["realistic_success_ci95"], (nlohmann::json{ci[1], ci[2]})) << "the interval the page shows";
+    EXPECT_EQ(shown["successes"], 3 - static_cast<int>(i));
+  }
+  std::map<std::string, nlohmann::json> facts;
+  for (const auto& f : data["facts"]) facts[f[0]] = f[1];
+  EXPECT_EQ(facts["policy"], "model m.dsm (knn, state)");
+  EXPECT_EQ(facts["world"], "short.json");
+  EXPECT_EQ(facts["rollouts_per_row"], 4);
+  EXPECT_EQ(facts["seed"], 7);
+  EXPECT_EQ(facts["dicestack_version"], json["dicestack_version"]);
+  EXPECT_EQ(facts["model_record"], (nlohmann::json{{"learner", "bc"}}));
+  EXPECT_EQ(facts.count("sensing_factors"), 0u);
+}
+
+TEST(RobustnessPage, TextFromTheModelAndTheSetCannotCloseItsScript) {
+  const std::string hostile = "</script><script>alert(1)</script>";
+  const RobustnessTable table = robustness_example("model " + hostile, {{"demos", "<!-- & -->"}});
+  const std::string page = render_robustness(table, "html");
+  EXPECT_EQ(page.find("alert(1)</script>"), std::string::npos);
+  EXPECT_EQ(page.find("<!-- & -->"), std::string::npos);
+  const auto data = page_data(page);
+  EXPECT_EQ(data["title"], "dicestack robustness: model " + hostile);
+  EXPECT_THAT(data["header"].get<std::string>(), ::testing::HasSubstr(hostile));
+  bool record = false;
+  for (const auto& f : data["facts"]) record |= f[0] == "model_record" && f[1]["demos"] == "<!-- & -->";
+  EXPECT_TRUE(record);
+}
+
+TEST(RobustnessPage, ReplacesOnlyAPageOfOursAndLeavesNothingBeside) {
+  const fs::path dir = test::scratch_path("dicestack_robustness_page_test");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "robust.html";
+  write_robustness(robustness_example("expert scripted"), "html", out);
+  EXPECT_TRUE(results_page_ownership().recognises(out));
+  write_robustness(robustness_example("expert mpc"), "html", out);  // ours: replaced
+  EXPECT_NE(read(out).find("expert mpc"), std::string::npos);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << "one file, no media folder";
+  std::ofstream(out) << "<p>mine</p>";
+  EXPECT_THROW(check_robustness_out(out, "html"), InputError);
+  EXPECT_THROW(write_robustness(robustness_example("expert mpc"), "html", out), InputError);
+  EXPECT_EQ(read(out), "<p>mine</p>");
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -20,12 +20,15 @@
 #include <dicestack/regressors/model.hpp>
 
 #include <dicestack/test/helpers.hpp>
+#include <dicestack/test/regressors.hpp>
 
 namespace dicestack {
 namespace {
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
+using test::inputs;
+using test::target;
 
 Matrix random_rows(Eigen::Index n, Eigen::Index d, std::uint64_t seed) {
   Rng rng(seed);
@@ -334,6 +337,52 @@ TEST(ModelFile, APickleThatIsNotOursIsNeverReplaced) {
   save_model(knn, path);
   EXPECT_FALSE(fs::exists(pkl));
   EXPECT_EQ(load_model(path).regressor().name(), "knn");
+  fs::remove(path);
+}
+
+TEST(ModelFile, TruncatedCorruptedOrForeignFilesAreRejected) {
+  const Matrix x = inputs(100, 24, 13);
+  const Model model = Model::train(RegressorRegistry::global().create("knn"), x, target(x, true), 1);
+  const fs::path path = test::scratch_path("dicestack_model_file.dsm");
+  save_model(model, path);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto rewrite = [&](const std::string& content) { std::ofstream(path, std::ios::binary | std::ios::trunc) << content; };
+  rewrite(bytes.substr(0, bytes.size() - 100));
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("truncated: the payload has"));
+  std::string flipped = bytes;
+  flipped[flipped.size() - 10] ^= 0x55;
+  rewrite(flipped);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("corrupted: the payload's checksum"));
+  rewrite("hello\n");
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("not a dicestack model"));
+  std::string newer = bytes;
+  newer.replace(newer.find("\"version\":2"), 11, "\"version\":7");
+  rewrite(newer);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }),
+              HasSubstr("format version 7 is newer than this dicestack reads (2); upgrade dicestack"));
+  std::string dims = bytes;
+  dims.replace(dims.find("\"state_dim\":24"), 14, "\"state_dim\":26");
+  rewrite(dims);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("the header's checksum does not match"));
+  std::string unknown = bytes;
+  unknown.replace(unknown.find("\"regressor\":\"knn\""), 17, "\"regressor\":\"zzz\"");
+  rewrite(unknown);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("the header's checksum does not match"));
+  EXPECT_EQ(test::error_of([&] { load_model("/nonexistent/model.dsm"); }),
+            "/nonexistent/model.dsm: cannot open for reading: No such file or directory");
+  rewrite(bytes);
+  fs::permissions(path, fs::perms::none);
+  const auto denied = test::unprivileged([&] { return test::error_of([&] { load_model(path); }); });
+  if (denied) {
+    EXPECT_EQ(*denied, path.string() + ": cannot open for reading: Permission denied");
+  }
+  fs::remove(path);
+  fs::create_directory(path);
+  EXPECT_EQ(test::error_of([&] { load_model(path); }), path.string() + ": read failed: Is a directory");
   fs::remove(path);
 }
 

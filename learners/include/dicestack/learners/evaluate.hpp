@@ -7,6 +7,7 @@
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/perturbation.hpp>
+#include <dicestack/core/perturbed_env.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/policy.hpp>
 
@@ -18,36 +19,29 @@ enum class InitialPush { none, left, right };
 /// Parses "none", "left" or "right"; throws ConfigError otherwise.
 InitialPush initial_push_from(std::string_view text);
 
-/// How a rollout perturbs what its policy chooses.
+/// How a rollout runs beyond its world (the world's perturbation and executed-action noise are
+/// the PerturbedEnv's).
 struct RolloutOptions {
   InitialPush push = InitialPush::none;  ///< the paper's jump-start at the first step
-  /// DART (Laskey et al. 2017): std of Gaussian noise added to each executed action, world units
-  /// (all zero: none). Drawn from the rollout's own stream (noise_seed), outside the environment,
-  /// so an expert that simulates cannot foresee it.
-  Action noise{0.0, 0.0, 0.0};
-  std::uint64_t noise_seed = 0;
   /// Stop after this many steps (0: at the world's time limit or success).
   std::size_t max_steps = 0;
   /// Called before each step's action is chosen, with the environment and the step index
   /// (DaD snapshots the world there). May be empty.
   std::function<void(const DiceEnv&, std::size_t)> before_step;
-  /// Actuation and sensing of a perturbed world, or null: the policy sees each state
-  /// with the draw's observation noise and delay; what it chooses runs action_delay steps late,
-  /// plus the bias and per-step noise. The episode records the true states. The draw's physics
-  /// is the environment's own (made from draw.world).
-  const PerturbationDraw* perturbation = nullptr;
 };
 
-/// The environment an episode of `draw` runs in: `pooled` when its physics is the nominal one,
-/// else a world of its own, made in `own`.
-DiceEnv& episode_env(const PerturbationDraw& draw, DiceEnv& pooled, std::optional<DiceEnv>& own);
-
-/// The one rollout loop. Runs `policy` from `start` until termination, the time limit or
-/// options.max_steps, and records the episode: the state before each action, the outcome, and
-/// per step the policy's label() if it has one, else its action clipped to the world's limits
-/// (its clean label; without noise, exactly what the world applied), tagged `source`, and (format
-/// v2) the final state, each step's reward and whether it ended in success (terminated) or
-/// otherwise (truncated). The policy's History holds the actions the world applied.
+/// The one rollout loop. Runs `policy` in `world` from `start` until termination, the time limit
+/// or options.max_steps, and records the episode: the true state before each action, the
+/// outcome, and per step the policy's label() if it has one, else its action clipped to the
+/// world's limits (its clean label; without perturbation or noise, exactly what the world
+/// applied), tagged `source`, and (format v2) the final state, each step's reward and whether it
+/// ended in success (terminated) or otherwise (truncated); under a perturbation, what the episode
+/// drew. The policy's History holds what it was shown (world.channelled(): noisy or late states,
+/// with the pending and unseen actions) and the actions the world applied. `seed` seeds the
+/// world's own physics noise.
+Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
+                const RolloutOptions& options = {});
+/// The same in `env`, unperturbed.
 Episode rollout(DiceEnv& env, Policy& policy, const State& start, std::uint64_t seed, StepSource source,
                 const RolloutOptions& options = {});
 

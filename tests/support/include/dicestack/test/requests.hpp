@@ -1,10 +1,11 @@
 #pragma once
-// An EvalRequest or a RecordRequest in one line, for the learners' tests (include only where
-// dicestack::learners is linked).
+// An EvalRequest, a RecordRequest or a small LearnContext in one line, for the learners' tests
+// (include only where dicestack::learners is linked).
 #include <cstdint>
 #include <vector>
 
 #include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/record.hpp>
 
 namespace dicestack::test {
@@ -27,6 +28,16 @@ inline RecordRequest record_request(int episodes, std::uint64_t seed, int thread
   r.threads = threads;
   r.noise = noise;
   return r;
+}
+
+/// A context for quick learner runs: 60-step episodes, knn, seed 11, on `threads` threads.
+inline LearnContext small_context(int threads) {
+  LearnContext c;
+  c.world.episode.max_steps = 60;
+  c.regressor = "knn";
+  c.seed = 11;
+  c.threads = threads;
+  return c;
 }
 
 }  // namespace dicestack::test

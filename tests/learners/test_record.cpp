@@ -1,0 +1,51 @@
+// Recording an expert's episodes: seeded, the same on any thread count, and through the tracker
+// naming it.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <vector>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/expert.hpp>
+#include <dicestack/core/tracker.hpp>
+#include <dicestack/learners/demonstrator.hpp>
+#include <dicestack/learners/record.hpp>
+
+#include <dicestack/test/demos.hpp>
+#include <dicestack/test/requests.hpp>
+
+namespace dicestack {
+namespace {
+
+using test::human_six;
+
+TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
+  WorldConfig w;
+  w.episode.max_steps = 80;
+  const auto a = record_expert("scripted", {}, w, test::record_request(4, 3, 1)), b = record_expert("scripted", {}, w, test::record_request(4, 3, 2));
+  ASSERT_EQ(a.size(), 4u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].states, b[i].states);
+    EXPECT_EQ(a[i].actions, b[i].actions);
+    EXPECT_EQ(a[i].sources.front(), StepSource::expert);
+  }
+  EXPECT_THROW(record_expert("nobody", {}, w, test::record_request(1, 0, 1)), ConfigError);
+}
+
+TEST(RecordTracker, RecordingThroughItDoesNotDependOnThreadsAndNamesItsExpert) {
+  TrackerConfig t;
+  t.probes = 1;
+  t.optimise = false;
+  ExpertConfig config;
+  config.recordings = make_recordings(human_six(), WorldConfig{}, t, 0, 2);
+  const auto one = record_expert("tracker", config, WorldConfig{}, test::record_request(2, 4, 1));
+  const auto two = record_expert("tracker", config, WorldConfig{}, test::record_request(2, 4, 2));
+  ASSERT_EQ(one.size(), 2u);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states);
+    EXPECT_EQ(one[i].origin, "expert tracker");
+  }
+}
+
+}  // namespace
+}  // namespace dicestack
