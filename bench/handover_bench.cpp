@@ -20,7 +20,7 @@
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/policy.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 
 using namespace dicestack;
 

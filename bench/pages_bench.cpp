@@ -12,8 +12,8 @@
 #include <dicestack/core/env.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/learners/leaderboard.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/leaderboard.hpp>
+#include <dicestack/experiments/train.hpp>
 
 namespace fs = std::filesystem;
 using namespace dicestack;

@@ -32,7 +32,7 @@
 #include <dicestack/core/rng.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 
 using namespace dicestack;
 

@@ -12,9 +12,10 @@
 #include <dicestack/datasets/data_paths.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/learners/learning_curve.hpp>
-#include <dicestack/learners/results_page.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/learning_curve.hpp>
+#include <dicestack/pages/dataset_viewer.hpp>
+#include <dicestack/pages/page.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

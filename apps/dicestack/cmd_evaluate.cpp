@@ -7,9 +7,9 @@
 #include <dicestack/core/video.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
-#include <dicestack/learners/report.hpp>
-#include <dicestack/learners/results_page.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/report.hpp>
+#include <dicestack/experiments/results_page.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

@@ -11,7 +11,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/datasets/replay.hpp>
 #include <dicestack/interop/interop.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <iostream>
 
-#include <dicestack/learners/baseline.hpp>
+#include <dicestack/experiments/baseline.hpp>
 #include <dicestack/core/error.hpp>
-#include <dicestack/learners/leaderboard.hpp>
-#include <dicestack/learners/learning_curve.hpp>
-#include <dicestack/learners/profile.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/leaderboard.hpp>
+#include <dicestack/experiments/learning_curve.hpp>
+#include <dicestack/experiments/profile.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

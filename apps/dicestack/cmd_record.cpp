@@ -10,7 +10,7 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/record.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

@@ -10,8 +10,8 @@
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/policy.hpp>
-#include <dicestack/learners/robustness.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/robustness.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "cli.hpp"
 #include "options.hpp"

@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include "cli.hpp"

@@ -8,7 +8,7 @@
 
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/train.hpp>
 
 namespace dicestack::cli {
 

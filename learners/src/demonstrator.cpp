@@ -13,7 +13,7 @@
 #include <dicestack/core/rng.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/learners/record.hpp>
 
 namespace dicestack {
 namespace {

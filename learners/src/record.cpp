@@ -48,6 +48,12 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
       [](const Episode& e) { return episode_to_bytes(e); }, [](std::string_view b) { return episode_from_bytes(b); });
 }
 
+std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const WorldConfig& world) {
+  if (spec.empty() || (spec == "builtin" && !std::filesystem::exists(spec))) return builtin_demo_set(world);
+  if (spec == "human" && !std::filesystem::exists(spec)) return human_demo_set(world);
+  return spec;
+}
+
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads) {
   const std::uint64_t h = world_hash(world);
   char name[40];

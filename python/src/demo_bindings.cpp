@@ -5,8 +5,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <dicestack/datasets/demo_set.hpp>
-#include <dicestack/learners/results_page.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/pages/dataset_viewer.hpp>
+#include <dicestack/experiments/train.hpp>
 
 #include "bindings.hpp"
 #include "convert.hpp"

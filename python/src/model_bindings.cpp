@@ -13,11 +13,11 @@
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
-#include <dicestack/learners/leaderboard.hpp>
+#include <dicestack/experiments/leaderboard.hpp>
 #include <dicestack/learners/policy.hpp>
-#include <dicestack/learners/report.hpp>
-#include <dicestack/learners/results_page.hpp>
-#include <dicestack/learners/train.hpp>
+#include <dicestack/experiments/report.hpp>
+#include <dicestack/experiments/results_page.hpp>
+#include <dicestack/experiments/train.hpp>
 #include <dicestack/regressors/model.hpp>
 
 #include "bindings.hpp"

@@ -46,4 +46,9 @@ inline constexpr int kBuiltinSuccesses = 80;
 /// transitions, so older caches are not reused); afterwards read from there.
 std::filesystem::path builtin_demo_set(const WorldConfig& world, int threads = 0);
 
+/// The folder a demonstration name stands for: "builtin" (the built-in set, generated into the
+/// cache on first use), "human" (the paper's 68 recordings, converted), an empty path (the
+/// built-in set), or the folder itself. An existing folder called "builtin" or "human" wins.
+std::filesystem::path resolve_demo_set(const std::filesystem::path& spec, const WorldConfig& world);
+
 }  // namespace dicestack

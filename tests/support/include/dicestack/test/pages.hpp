@@ -12,7 +12,7 @@
 
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/learners/evaluate.hpp>
-#include <dicestack/learners/leaderboard.hpp>
+#include <dicestack/experiments/leaderboard.hpp>
 
 namespace dicestack::test {
 
