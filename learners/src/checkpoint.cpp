@@ -26,8 +26,10 @@ constexpr const char* kFormat = "dicestack-checkpoint";
 // 1: the same fields without "version" (and, before the marker, without "format"); 2: adds
 // "version"; 3: "run"'s learner options as an object of key -> value, not one "k=v, k=v" text;
 // 4: "run"'s regressor settings as "regressor_params", an object of every schema parameter ->
-// its parsed value (JSON number, boolean or string), not the --set text "regressor_sets".
-constexpr int kVersion = 4;
+// its parsed value (JSON number, boolean or string), not the --set text "regressor_sets";
+// 5: "run"'s learner options as the run used them (resolved_option: tracker_paths -1 and retry
+// auto as the feature map resolved them).
+constexpr int kVersion = 5;
 
 // "data-<digits>" or "best-<digits>.model" (suffix empty or ".model").
 bool numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
@@ -69,19 +71,23 @@ std::string value_before(const std::string& learner, const std::string& key) {
   return "";
 }
 
-// What an option's text means in a run: a default that depends on the run's feature map
-// (tracker_paths -1, the default since it depends on the map, 3 before; retry auto) resolved
-// with it.
-std::string meaning(const std::string& key, const std::string& text, const json& run) {
+// An option's value as a run uses it: the defaults that depend on the run's feature map
+// (tracker_paths -1; retry auto) resolved with it, the rest as given. Version 5 writes options
+// so; older checkpoints saved them as given, and are resolved with their own map when read.
+std::string resolved_option(const std::string& key, const std::string& text, const std::string& features) {
   const bool by_map = (key == "tracker_paths" && text == "-1") || (key == "retry" && text == "auto");
-  if (!by_map || !run.contains("features") || !run["features"].is_string()) return text;
-  const std::string features = run["features"].get<std::string>();
+  if (!by_map || features.empty()) return text;
   try {
     if (key == "retry") return expert_retries(text, features) ? "true" : "false";
     return std::to_string(tracker_paths_for(-1, features));
   } catch (const ConfigError&) {  // a map this version does not know: compared as written
     return text;
   }
+}
+
+// The feature map a run recorded ("" when none).
+std::string run_features(const json& run) {
+  return run.contains("features") && run["features"].is_string() ? run["features"].get<std::string>() : "";
 }
 
 // Every parameter of `schema` -> its value in `params`, typed: what a run's regressor settings mean.
@@ -200,7 +206,8 @@ json run_settings(const LearnContext& c, const std::vector<std::pair<std::string
                   const std::vector<std::string>& extendable) {
   json options = json::object();
   for (const auto& [key, value] : learner_options)
-    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end()) options[key] = value;
+    if (std::find(extendable.begin(), extendable.end(), key) == extendable.end())
+      options[key] = resolved_option(key, value, c.features);
   const auto& schema = c.registry->info(c.regressor).params;
   return {{"regressor", c.regressor},
           {"regressor_params", typed_params(schema, Params(schema, c.regressor_sets, c.regressor))},
@@ -314,7 +321,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
         const std::string then = option_then(k);
-        if (meaning(k, then, saved_run) != meaning(k, now, run))
+        if (resolved_option(k, then, run_features(saved_run)) != resolved_option(k, now, run_features(run)))
           differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
       }
     }

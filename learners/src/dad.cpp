@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <optional>
 
@@ -81,7 +82,8 @@ CodeParts code_parts(const std::string& text) {
   return p;
 }
 
-// Everything a run does, resolved from its options once, before any work.
+// Everything a run does, resolved from its options once, before any work (make_plan); the
+// model records it as "dad_settings".
 struct DadPlan {
   CodeParts code;
   int windows = 10, per_window = 3;
@@ -89,6 +91,22 @@ struct DadPlan {
   std::string corrector;
   CorrectorOptions search;
   bool filter = true, keep_best = true;
+  bool from_training = false;  // targets: the tracker's episodes from training starts, else demonstrations
+  std::size_t demos = 0;       // demonstrations as targets (0: all)
+  int episodes = 0;            // training starts the tracker runs from
+  bool retry = false;          // the tracker tries again (from training starts)
+
+  std::string summary() const {
+    static const char* aims[] = {"state", "cup", "dice"};
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "windows=%d, iterations=%d, target=%s, corrector=%s, corrector_iterations=%d, evaluations=%d, sigma0=%g, "
+                  "population=%d, filter=%s, keep_best=%s, starts=%s, demos=%zu, episodes=%d, retry=%s",
+                  windows, per_window, aims[static_cast<int>(aim)], corrector.c_str(), search.iterations, search.evaluations,
+                  search.sigma0, search.population, filter ? "true" : "false", keep_best ? "true" : "false",
+                  from_training ? "training" : "demonstrations", demos, episodes, retry ? "true" : "false");
+    return text;
+  }
 };
 
 // One window to correct: where in which demonstration, and the problem the corrector solves.
@@ -161,12 +179,12 @@ class Dad final : public Learner {
   }
 
   LearnResult learn(const LearnContext& c) const override {
-    const DadPlan plan = make_plan();
-    const bool from_training = params().choice("starts") == "training";
+    const DadPlan plan = make_plan(c.features);
+    const bool from_training = plan.from_training;
     std::string followed;  // from training starts: the recordings the tracker followed
     const int total = plan.windows * plan.per_window;
     const std::vector<Episode> targets =
-        from_training ? tracker_targets(c, followed) : pick_targets(c.demos, static_cast<std::size_t>(params().integer("demos")), c.world.cost);
+        from_training ? tracker_targets(c, plan, followed) : pick_targets(c.demos, plan.demos, c.world.cost);
     // From training starts the policy is measured where it is trained to go: the targets' starts.
     LearnContext measured = c;
     if (from_training) measured.held_out.clear();
@@ -212,6 +230,7 @@ class Dad final : public Learner {
     chosen->record["dad_corrections_kept"] = std::to_string(run.corrections);
     chosen->record["dad_corrections_filtered"] = std::to_string(run.filtered);
     if (plan.code.any()) chosen->record["dad_faithful"] = params().choice("faithful");
+    chosen->record["dad_settings"] = plan.summary();  // the options as this run used them
     run.result.model = chosen;
     return run.result;
   }
@@ -347,7 +366,7 @@ class Dad final : public Learner {
     remove_old_best_models(c.checkpoint_dir, best_file);
   }
 
-  DadPlan make_plan() const {
+  DadPlan make_plan(const std::string& features) const {
     DadPlan p;
     p.code = code_parts(params().choice("faithful"));
     p.windows = p.code.schedule ? kCodeWindows : static_cast<int>(params().integer("windows"));
@@ -364,6 +383,10 @@ class Dad final : public Learner {
     }
     p.filter = !p.code.search && params().boolean("filter");
     p.keep_best = !p.code.schedule && params().boolean("keep_best");
+    p.from_training = params().choice("starts") == "training";
+    p.demos = static_cast<std::size_t>(params().integer("demos"));
+    p.episodes = static_cast<int>(params().integer("episodes"));
+    p.retry = expert_retries(params().choice("retry"), features);
     return p;
   }
 
@@ -376,11 +399,11 @@ class Dad final : public Learner {
 
   // The targets from training starts: the tracker's successful episodes (the recordings of
   // --demos, each start's choice moved into its frame and followed), without noise.
-  std::vector<Episode> tracker_targets(const LearnContext& c, std::string& followed) const {
+  std::vector<Episode> tracker_targets(const LearnContext& c, const DadPlan& plan, std::string& followed) const {
     ExpertConfig expert = learner_expert_config("tracker", *this, c);
-    expert.retry = expert_retries(params().choice("retry"), c.features);
+    expert.retry = plan.retry;
     RecordRequest request;
-    request.episodes = static_cast<int>(params().integer("episodes"));
+    request.episodes = plan.episodes;
     request.seed = c.seed;
     request.threads = c.threads;
     std::vector<Episode> targets;

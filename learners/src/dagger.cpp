@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include <dicestack/core/error.hpp>
@@ -18,6 +19,43 @@
 namespace dicestack {
 namespace {
 
+// DAgger's options as one run uses them, resolved in one place (dagger_settings): retry from the
+// feature map. The model records them as "dagger_settings".
+struct DaggerSettings {
+  int iterations = 0, rollouts = 0;
+  double beta = 0.0;
+  bool linear = false;  // the schedule: 1 down to 0, else beta^(i-1)
+  std::string expert;
+  bool replan = true, retry = false, include_demos = true;
+
+  std::string summary() const {
+    char text[256];
+    std::snprintf(text, sizeof text, "iterations=%d, rollouts=%d, beta=%g, schedule=%s, expert=%s, replan=%s, retry=%s, include_demos=%s",
+                  iterations, rollouts, beta, linear ? "linear" : "exponential", expert.c_str(), replan ? "true" : "false",
+                  retry ? "true" : "false", include_demos ? "true" : "false");
+    return text;
+  }
+
+  // The mixture's expert share in round i (1-based).
+  double beta_at(int i) const {
+    if (linear) return iterations <= 1 ? 1.0 : 1.0 - static_cast<double>(i - 1) / (iterations - 1);
+    return std::pow(beta, i - 1);
+  }
+};
+
+DaggerSettings dagger_settings(const Params& params, const std::string& features) {
+  DaggerSettings d;
+  d.iterations = static_cast<int>(params.integer("iterations"));
+  d.rollouts = static_cast<int>(params.integer("rollouts"));
+  d.beta = params.real("beta");
+  d.linear = params.choice("schedule") == "linear";
+  d.expert = params.choice("expert");
+  d.replan = params.boolean("replan");
+  d.retry = expert_retries(params.choice("retry"), features);
+  d.include_demos = params.boolean("include_demos");
+  return d;
+}
+
 // DAgger (Ross et al.): roll out the mixture beta_i * expert + (1 - beta_i) * learner from
 // random starts, label every visited state with the expert's action, aggregate, refit.
 class Dagger final : public Learner {
@@ -26,15 +64,15 @@ class Dagger final : public Learner {
 
   LearnResult learn(const LearnContext& c) const override {
     const Perturbation perturbation = learner_perturbation(params(), c.world, "dagger");  // before any work
-    const int iterations = static_cast<int>(params().integer("iterations"));
-    const int rollouts = static_cast<int>(params().integer("rollouts"));
-    const std::string expert_name = params().choice("expert");
+    const DaggerSettings d = dagger_settings(params(), c.features);
+    const int iterations = d.iterations, rollouts = d.rollouts;
+    const std::string& expert_name = d.expert;
     ExpertConfig expert_config = learner_expert_config(expert_name, *this, c);
     // Without replanning, mpc's labels are a function of the start, the step and the state: the
     // same on and off its own path (docs/learners.md).
-    expert_config.replan = params().boolean("replan");
-    expert_config.retry = expert_retries(params().choice("retry"), c.features);
-    std::vector<Episode> data = params().boolean("include_demos") ? c.demos : std::vector<Episode>{};
+    expert_config.replan = d.replan;
+    expert_config.retry = d.retry;
+    std::vector<Episode> data = d.include_demos ? c.demos : std::vector<Episode>{};
     std::shared_ptr<Model> model;
     LearnResult result;
     int first = 1;
@@ -49,7 +87,7 @@ class Dagger final : public Learner {
     EnvPool envs(c.world, c.threads);
     std::vector<std::unique_ptr<Expert>> experts(workers);
     for (int i = first; i <= iterations; ++i) {
-      const double beta = beta_at(i, iterations);
+      const double beta = d.beta_at(i);
       std::atomic<int> finished{0};
       const int ranks = c.cluster->size();
       // Dealt among the ranks, gathered in index order on every rank.
@@ -81,7 +119,11 @@ class Dagger final : public Learner {
     if (!model) throw InputError("dagger: no data (no demonstrations and no iterations)");
     model->record["learner"] = "dagger";
     model->record["expert"] = expert_name;
-    if (expert_config.recordings) model->record["tracker_followed"] = followed_recordings(*expert_config.recordings);
+    model->record["dagger_settings"] = d.summary();  // the options as this run used them
+    if (expert_config.recordings) {
+      model->record["tracker_followed"] = followed_recordings(*expert_config.recordings);
+      model->record["tracker_settings"] = tracker_summary(expert_config.recordings->config());
+    }
     if (!perturbation.nominal()) model->record["perturb"] = params().choice("perturb");
     result.model = model;
     return result;
@@ -108,12 +150,6 @@ class Dagger final : public Learner {
   // on the round count); the linear schedule's betas do.
   std::vector<std::string> extendable() const {
     return params().choice("schedule") == "exponential" ? std::vector<std::string>{"iterations"} : std::vector<std::string>{};
-  }
-
-  double beta_at(int i, int iterations) const {
-    if (params().choice("schedule") == "linear")
-      return iterations <= 1 ? 1.0 : 1.0 - static_cast<double>(i - 1) / (iterations - 1);
-    return std::pow(params().real("beta"), i - 1);
   }
 
   // One episode of the mixture policy, in the world `perturbation` draws for it; every visited

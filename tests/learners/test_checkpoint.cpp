@@ -48,7 +48,7 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   const auto path = c.checkpoint_dir / "dagger.json";
   nlohmann::json saved;
   std::ifstream(path) >> saved;
-  EXPECT_EQ(saved.at("version"), 4);
+  EXPECT_EQ(saved.at("version"), 5);
   c.resume = true;
   auto resume_with = [&](const nlohmann::json& state) {
     { std::ofstream(path) << state.dump(); }
@@ -61,7 +61,7 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   };
   using ::testing::HasSubstr;
   using ::testing::Not;
-  EXPECT_THAT(edited("/version", 5), HasSubstr("dagger.json: format version 5 is newer than this dicestack reads (4)"));
+  EXPECT_THAT(edited("/version", 6), HasSubstr("dagger.json: format version 6 is newer than this dicestack reads (5)"));
   EXPECT_THAT(edited("/version", 1.5), HasSubstr("dagger.json: field \"version\" must be an integer"));
   EXPECT_THAT(edited("/iteration", "one"), HasSubstr("field \"iteration\" must be an integer in [0, 1000000], got \"one\""));
   EXPECT_THAT(edited("/iteration", -1), HasSubstr("field \"iteration\""));
@@ -79,27 +79,32 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   nlohmann::json tracked = saved;
   tracked["run"]["learner_options"]["expert"] = "tracker";
   EXPECT_THAT(resume_with(tracked), HasSubstr("option expert \"tracker\" in the checkpoint, \"scripted\" in this run"));
-  // Written when tracker_paths defaulted to 3, which -1 now means for this run's map.
-  EXPECT_EQ(saved["run"]["learner_options"]["tracker_paths"], "-1");
+  // tracker_paths=-1 is saved as what this run's map made of it (3); a checkpoint of version 4
+  // saved "-1" and is resolved with its own map when read; 3 matches, 1 does not.
+  EXPECT_EQ(saved["run"]["learner_options"]["tracker_paths"], "3");
   tracked["run"]["learner_options"]["tracker_paths"] = "3";
   EXPECT_THAT(resume_with(tracked), Not(HasSubstr("tracker_paths")));
+  nlohmann::json v4 = tracked;
+  v4["version"] = 4;
+  v4["run"]["learner_options"]["tracker_paths"] = "-1";
+  EXPECT_THAT(resume_with(v4), Not(HasSubstr("tracker_paths")));
   tracked["run"]["learner_options"]["tracker_paths"] = "1";
-  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_paths \"1\" in the checkpoint, \"-1\" in this run"));
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_paths \"1\" in the checkpoint, \"3\" in this run"));
   // Written before tracker_shrink existed, when the tracker never narrowed a path.
   EXPECT_EQ(saved["run"]["learner_options"]["tracker_shrink"], "5");
   tracked["run"]["learner_options"]["tracker_paths"] = "-1";
   tracked["run"]["learner_options"].erase("tracker_shrink");
   EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_shrink \"(absent)\" in the checkpoint, \"5\" in this run"));
   // Written before retry existed: its absence meant no retries, which auto means for this map
-  // (state); "false" means the same, "true" does not.
-  EXPECT_EQ(saved["run"]["learner_options"]["retry"], "auto");
+  // (state) and is saved as; "false" and "auto" mean the same, "true" does not.
+  EXPECT_EQ(saved["run"]["learner_options"]["retry"], "false");
   nlohmann::json retried = saved;
   retried["run"]["learner_options"].erase("retry");
   EXPECT_EQ(resume_with(retried), "");
-  retried["run"]["learner_options"]["retry"] = "false";
+  retried["run"]["learner_options"]["retry"] = "auto";
   EXPECT_EQ(resume_with(retried), "");
   retried["run"]["learner_options"]["retry"] = "true";
-  EXPECT_THAT(resume_with(retried), HasSubstr("option retry \"true\" in the checkpoint, \"auto\" in this run"));
+  EXPECT_THAT(resume_with(retried), HasSubstr("option retry \"true\" in the checkpoint, \"false\" in this run"));
   nlohmann::json v2 = saved;  // version 2: the learner's options joined into one string, the --set text
   v2["version"] = 2;
   v2["run"].erase("regressor_params");

@@ -125,6 +125,9 @@ TEST(Dad, TheCodesScheduleCorrectsGrowingPrefixesFiveTimesEachAndKeepsTheLastRef
   }
   EXPECT_EQ(r.model->record.at("dad_iteration"), "50");
   EXPECT_EQ(r.model->record.at("dad_faithful"), "schedule+label");
+  // The options as the run used them: the code's schedule (10 windows of 5 refits) over the given ones.
+  EXPECT_THAT(r.model->record.at("dad_settings"), testing::StartsWith("windows=10, iterations=5, target=cup, corrector=cmaes"));
+  EXPECT_THAT(r.model->record.at("dad_settings"), testing::EndsWith("starts=demonstrations, demos=2, episodes=300, retry=false"));
 }
 
 TEST(Dad, AWindowCarriesTheRolloutBeforeItAsHistoryForAMapThatReadsTheEpisode) {

@@ -31,6 +31,10 @@ TEST(Dagger, BetaOneOnlyLetsTheExpertAct) {
   c.checkpoint_dir = test::scratch_path("dicestack_dagger_beta1");
   std::filesystem::remove_all(c.checkpoint_dir);
   const LearnResult r = learner->learn(c);
+  // The options as the run used them, retry resolved for the map ("state": no retries).
+  EXPECT_EQ(r.model->record.at("dagger_settings"),
+            "iterations=1, rollouts=3, beta=1, schedule=exponential, expert=scripted, replan=true, retry=false, "
+            "include_demos=false");
   const DemoSet data = read_demo_set(c.checkpoint_dir / "data-1");
   ASSERT_EQ(data.episodes.size(), 3u);
   for (const auto& e : data.episodes)
