@@ -1,0 +1,211 @@
+// The episode CSV: one file per episode of a demonstration folder (docs/formats.md), written and
+// read here; demo_set.cpp holds the folder around the files.
+#include "episode_csv.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/read_file.hpp>
+#include <dicestack/datasets/demo_set.hpp>
+
+namespace dicestack {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
+constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
+constexpr std::size_t kNumbers = 1 + kStateDim + kActionDim;         // t, state, action
+
+// Splits one CSV line on commas (no quoting: none of our fields contain commas).
+void split_fields(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    out.push_back(line.substr(start, comma == std::string_view::npos ? comma : comma - start));
+    if (comma == std::string_view::npos) return;
+    start = comma + 1;
+  }
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+
+// Checks a CSV header row (either layout version's columns, in order); sets `columns` to its
+// column names and returns the version.
+int check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
+  if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2)
+    throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
+                     std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1) or " +
+                     std::to_string(kColumnsV2) + " (the same and reward: version 2)");
+  const std::size_t width = fields.size();
+  const int version = width == kColumnsV1 ? 1 : 2;
+  columns = episode_csv_columns(version);
+  for (std::size_t c = 0; c < width; ++c)
+    if (trim(fields[c]) != columns[c])
+      throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
+                       "\", expected \"" + columns[c] + "\"");
+  return version;
+}
+
+// The numeric columns of a row (t, state, action), each a finite number.
+std::array<double, kNumbers> parse_csv_numbers(const std::vector<std::string_view>& fields, const std::string& prefix,
+                                               const std::vector<std::string>& columns) {
+  std::array<double, kNumbers> values{};
+  for (std::size_t c = 0; c < kNumbers; ++c) {
+    const std::string_view f = trim(fields[c]);
+    double v = 0.0;
+    const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+    if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
+      throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
+                       (f.size() > 40 ? "...\"" : "\"") + " is not a number");
+    if (!std::isfinite(v))
+      throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
+                       "; demonstrations must be finite");
+    values[c] = v;
+  }
+  return values;
+}
+
+// The reward cell `f` of the row just appended to `e`: empty in every row (unknown, as in the
+// first row, which sets `reward_empty`) or a finite number in every row.
+void parse_csv_reward(std::string_view f, const std::string& prefix, bool& reward_empty, Episode& e) {
+  if (e.states.size() == 1) reward_empty = f.empty();
+  if (f.empty() != reward_empty)
+    throw InputError(prefix + "column \"reward\" is " + (f.empty() ? "empty" : "a number") + " but line 2's is " +
+                     (reward_empty ? "empty" : "a number") + "; an episode's rewards are all known or all empty");
+  if (f.empty()) return;
+  double v = 0.0;
+  const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+  if (r.ec != std::errc() || r.ptr != f.data() + f.size())
+    throw InputError(prefix + "column \"reward\": \"" + std::string(f.substr(0, 40)) + (f.size() > 40 ? "...\"" : "\"") +
+                     " is not a number");
+  if (!std::isfinite(v))
+    throw InputError(prefix + "column \"reward\" is " + (std::isnan(v) ? "NaN" : "infinite") + "; demonstrations must be finite");
+  e.rewards.push_back(v);
+}
+
+// Appends one data row (its width already checked) to `e`: the next step's state, action,
+// source and, in version 2, reward.
+void append_csv_row(const std::vector<std::string_view>& fields, const std::string& prefix,
+                    const std::vector<std::string>& columns, int version, bool& reward_empty, Episode& e) {
+  const std::array<double, kNumbers> values = parse_csv_numbers(fields, prefix, columns);
+  const double expected_t = static_cast<double>(e.states.size());
+  if (values[0] != expected_t)
+    throw InputError(prefix + "column \"t\" is " + episode_csv::number_text(values[0]) + ", expected " + episode_csv::number_text(expected_t) +
+                     " (rows are consecutive steps from 0)");
+  State s;
+  std::copy(values.begin() + 1, values.begin() + 1 + kStateDim, s.begin());
+  Action a;
+  std::copy(values.begin() + 1 + kStateDim, values.end(), a.begin());
+  e.states.push_back(s);
+  e.actions.push_back(a);
+  try {
+    e.sources.push_back(step_source_from(trim(fields[kNumbers])));
+  } catch (const InputError& err) {
+    throw InputError(prefix + "column \"source\": " + err.what());
+  }
+  if (version >= 2) parse_csv_reward(trim(fields[kNumbers + 1]), prefix, reward_empty, e);
+}
+
+std::string csv_header(int version) {
+  std::string header;
+  for (const auto& c : episode_csv_columns(version)) header += (header.empty() ? "" : ",") + c;
+  return header;
+}
+
+}  // namespace
+
+namespace episode_csv {
+
+std::string number_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
+  return std::string(buf, r.ptr);
+}
+
+void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftovers) {
+  AtomicFile file(path, ownership(), leftovers);
+  auto& out = file.stream();
+  const auto columns = episode_csv_columns();
+  for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
+  out << '\n';
+  for (std::size_t t = 0; t < e.states.size(); ++t) {
+    out << t;
+    for (double v : e.states[t]) out << ',' << number_text(v);
+    for (double v : e.actions[t]) out << ',' << number_text(v);
+    out << ',' << to_string(e.sources[t]) << ',';
+    if (e.has_transitions()) out << number_text(e.rewards[t]);  // empty cell: unknown
+    out << '\n';
+  }
+  file.commit();
+}
+
+Ownership ownership() {
+  return Ownership::first_line("dicestack episode CSV", {csv_header(1), csv_header(2)});
+}
+
+Episode parse(std::string_view text, const std::string& where, std::string name, int& version) {
+  std::vector<std::string> columns;
+  std::size_t width = 0;
+  bool reward_empty = false;
+  Episode e;
+  e.name = std::move(name);
+  std::vector<std::string_view> fields;
+  std::size_t line_no = 0, pos = 0;
+  while (pos < text.size()) {
+    const auto nl = text.find('\n', pos);
+    const std::string_view line = text.substr(pos, (nl == std::string_view::npos ? text.size() : nl) - pos);
+    pos = nl == std::string_view::npos ? text.size() : nl + 1;
+    ++line_no;
+    const std::string prefix = where + ":" + std::to_string(line_no) + ": ";
+    if (trim(line).empty()) {
+      if (pos >= text.size()) break;  // trailing blank line
+      throw InputError(prefix + "empty line inside the file");
+    }
+    split_fields(line, fields);
+    if (line_no == 1) {
+      version = check_csv_header(fields, prefix, columns);
+      width = fields.size();
+      continue;
+    }
+    if (fields.size() != width)
+      throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
+                       std::to_string(width) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
+    append_csv_row(fields, prefix, columns, version, reward_empty, e);
+  }
+  if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
+  if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");
+  return e;
+}
+
+}  // namespace episode_csv
+
+std::vector<std::string> episode_csv_columns(int version) {
+  std::vector<std::string> cols{"t"};
+  for (auto n : state_names()) cols.emplace_back(n);
+  for (auto n : action_names()) cols.emplace_back(n);
+  cols.emplace_back("source");
+  if (version >= 2) cols.emplace_back("reward");
+  return cols;
+}
+
+Episode read_episode_csv(const fs::path& file) {
+  return parse_episode_csv(read_file(file), file.string(), file.stem().string());
+}
+
+Episode parse_episode_csv(std::string_view text, const std::string& where, std::string name) {
+  int version = 0;
+  return episode_csv::parse(text, where, std::move(name), version);
+}
+
+}  // namespace dicestack
