@@ -127,7 +127,8 @@ LeaderboardRow row_from(const json& j) {
 double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
                           const Profile& profile, int rollouts) {
   // Seconds on one core, from the measured quick and paper leaderboards (docs/learners.md,
-  // docs/scaling.md). Only the ratios matter: they decide which rank gets which row. A profile
+  // docs/notebook/2026-11-27-learners-page-history.md "The paper profile", docs/scaling.md).
+  // Only the ratios matter: they decide which rank gets which row. A profile
   // other than "paper" is costed as quick.
   const bool paper = profile.name == "paper";
   if (learner == "baseline") {

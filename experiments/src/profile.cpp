@@ -28,7 +28,8 @@ std::vector<Profile> make_profiles() {
   paper.rollouts = 100;
   // Every regressor learns the tracker's row: at DART's 300 episodes, not its 1200 (a kernel
   // SVR's fit grows with the square of the rows), and so with no narrowing, which pays only with
-  // more episodes (built-in set, gbt: 36 / 37 % narrowed, 55 / 47 % not; docs/learners.md).
+  // more episodes (built-in set, gbt: 36 / 37 % narrowed, 55 / 47 % not;
+  // docs/notebook/2026-11-27-learners-page-history.md, "The paper profile").
   paper.learner_options = {{"dagger", {"iterations=5", "rollouts=20"}},  // dad: its defaults
                            {"dart:expert=tracker", {"episodes=300", "tracker_shrink=0"}}};
   paper.learners = {"bc", "dagger", "dart", "dart:expert=tracker"};

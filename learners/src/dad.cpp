@@ -170,7 +170,8 @@ struct DadRun {
 // with target=state, all simulated states onto the demonstration's: eq. 11 as written);
 // add those (state, action) pairs to the data once (eq. 10); refit. Windows grow from 1/10 of
 // the demonstration to all of it, with a few iterations each. `faithful` runs the paper's code
-// instead, difference by difference (docs/learners.md, "DaD as the paper's code runs it").
+// instead, difference by difference (docs/notebook/2026-11-27-learners-page-history.md, "DaD as
+// the paper's code runs it"; in brief: docs/learners.md, "DaD in the paper's setting").
 class Dad final : public Learner {
  public:
   // A bad `faithful` is refused where the options are parsed, before any work.

@@ -40,13 +40,15 @@ DartSettings dart_settings(const Params& params, const std::string& features) {
   d.expert = params.choice("expert");
   d.episodes = static_cast<int>(params.integer("episodes"));
   // A servo policy's labels do not change with the noise, so it learns the reference from
-  // how many starts it saw (docs/learners.md: 300 -> 600 episodes 60.2 -> 70.3 %; in the dice
-  // frame, 600 -> 1200 on the tuning seeds 83.0 -> 84.8 %).
+  // how many starts it saw (docs/notebook/2026-11-27-learners-page-history.md, "Policies from the
+  // human recordings": 300 -> 600 episodes 60.2 -> 70.3 %; in the dice frame, 600 -> 1200 on the
+  // tuning seeds 83.0 -> 84.8 %).
   if (d.episodes == 0) d.episodes = d.expert == "tracker" && servo_targets(features) ? kDartServoEpisodes : kDartEpisodes;
   const double noise = params.real("noise");
   d.noise = {noise, noise, noise};
   // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
-  // that (docs/learners.md: 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
+  // that (docs/notebook/2026-11-27-learners-page-history.md, "Policies from the human recordings":
+  // 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
   if (d.expert == "tracker") d.noise = {noise, kDartTrackerNoiseDvy, kDartTrackerNoiseDw};
   const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
   for (std::size_t k = 0; k < kActionDim; ++k)

@@ -56,11 +56,14 @@ std::string number_text(double v) {
 // The recordings the learners follow by default: the best-ranked one for a "/position" map,
 // whose policy plays one reference with a servo (two or three references are not a smooth
 // function of the start: 55.7 % against 60.2 % with one), the three best for the others (one
-// path alone: 38-43 % as velocities). Measured in docs/learners.md.
+// path alone: 38-43 % as velocities). Measured in docs/notebook/2026-11-27-learners-page-history.md
+// ("Policies from the human recordings") and docs/notebook/2026-11-27-learners-history.md
+// ("Robust choices and velocity targets").
 constexpr int kServoPaths = 1, kOtherPaths = 3;
 
 // The learners' tracker preset: tuned for DART on the tuning seeds (docs/learners.md, "Policies
-// from the human recordings"): smoothed, chosen robust to a learner's errors, narrowed before
+// from the human recordings"; the measurements: docs/notebook/2026-11-27-learners-page-history.md,
+// the same section): smoothed, chosen robust to a learner's errors, narrowed before
 // warped where none succeeds as recorded (in the dice frame 80.8 -> 83.0 %, and a 3x faster
 // search), each recording's smoothing chosen among variants (from 3 recordings 36 -> 81 %).
 constexpr const char* kLearnerPreset = "distill";

@@ -35,7 +35,7 @@ struct PathWarp {
 };
 
 /// Settings of the tracker. The warp bounds say how far a correction may go, they are not tuned
-/// gains (docs/learners.md, "The tracker").
+/// gains (docs/learners.md, "From recordings alone: the tracker").
 struct TrackerConfig {
   double gain = 10.0;        ///< feedback gain on the cup's pose, 1/s (the issue's k)
   int probes = 16;           ///< training starts that rank the recordings (most successes first), >= 0
@@ -96,7 +96,8 @@ inline constexpr std::array<double, 7> kTrackerVariantWidths{0.0, 1.0, 2.0, 3.0,
 ///  - "distill": tuned for a learner distilling it (the learners' default): the 3 best-ranked
 ///    recordings, smoothed by 4 steps, chosen robust to a learner's errors (5 noisy trials,
 ///    warps of std 0.02), narrowed in 5 steps before warped, each recording's smoothing chosen
-///    among kTrackerVariantWidths. Measured in docs/learners.md.
+///    among kTrackerVariantWidths. Measured in docs/notebook/2026-11-27-learners-page-history.md
+///    ("Policies from the human recordings"); the recipe: docs/learners.md.
 /// Throws ConfigError for another name, listing the presets.
 TrackerConfig tracker_preset(std::string_view name);
 /// The presets' names, in listing order.
@@ -203,7 +204,8 @@ TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, Dice
 /// Whether `follower`, followed from env's current state, simulates to a realistic success
 /// within `follower.length() + hold_steps` steps from now (and the episode's limit). For a
 /// follower started earlier that is longer than the rest of its path plus the hold: a lenient
-/// check, as measured (docs/learners.md).
+/// check, as measured (docs/notebook/2026-11-27-learners-page-history.md, "A demonstrator that
+/// chooses again: rescue and smoothing").
 bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps);
 
 /// A rescue, mid-episode, when the followed path (`current`, moved into the frame of `frame`,
