@@ -76,14 +76,24 @@ const FloatJson& read_xgb_model(const FloatJson& j, std::size_t inputs, std::siz
   return model;
 }
 
+// A tree's node arrays in xgboost's JSON, under the names this reader gives them.
+struct XgbTreeArrays {
+  const FloatJson& left;
+  const FloatJson& right;
+  const FloatJson& feature;
+  const FloatJson& value;
+  const FloatJson& dleft;
+};
+
+XgbTreeArrays xgb_tree_arrays(const FloatJson& tree) {
+  return {tree.at("left_children"), tree.at("right_children"), tree.at("split_indices"), tree.at("split_conditions"),
+          tree.at("default_left")};
+}
+
 // Checks one tree's node arrays for a forest already holding `nodes_before` nodes, then walks
 // it from the root: each node reached once (a tree), every index checked before use.
 void check_xgb_tree(const FloatJson& tree, const std::string& where, std::size_t inputs, std::size_t nodes_before) {
-  const auto& left = tree.at("left_children");
-  const auto& right = tree.at("right_children");
-  const auto& feature = tree.at("split_indices");
-  const auto& value = tree.at("split_conditions");
-  const auto& dleft = tree.at("default_left");
+  const auto& [left, right, feature, value, dleft] = xgb_tree_arrays(tree);
   const auto& type = tree.at("split_type");
   const std::size_t n = left.size();
   if (n == 0 || n > (1u << 24)) fail(where + "has " + std::to_string(n) + " nodes");
@@ -122,11 +132,7 @@ void check_xgb_tree(const FloatJson& tree, const std::string& where, std::size_t
 // `Node` is XgbForest's node, deduced; `default_left` is its flag for a NaN going left.
 template <class Node>
 void lay_out_xgb_tree(const FloatJson& tree, std::vector<Node>& nodes, std::uint32_t default_left) {
-  const auto& left = tree.at("left_children");
-  const auto& right = tree.at("right_children");
-  const auto& feature = tree.at("split_indices");
-  const auto& value = tree.at("split_conditions");
-  const auto& dleft = tree.at("default_left");
+  const auto& [left, right, feature, value, dleft] = xgb_tree_arrays(tree);
   const std::size_t base = nodes.size();
   nodes.emplace_back();
   std::vector<std::pair<std::size_t, std::size_t>> queue{{0, base}};  // (xgboost's, ours)
