@@ -16,9 +16,9 @@ PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw) : draw
 
 PerturbedEnv::PerturbedEnv(DiceEnv& env) : env_(&env) { draw_.world = env.config(); }
 
-void PerturbedEnv::add_executed_noise(const Action& std, std::uint64_t seed) {
-  executed_noise_ = std;
-  noisy_ = std[0] > 0.0 || std[1] > 0.0 || std[2] > 0.0;
+void PerturbedEnv::add_executed_noise(const Action& sigma, std::uint64_t seed) {
+  executed_noise_ = sigma;
+  noisy_ = sigma[0] > 0.0 || sigma[1] > 0.0 || sigma[2] > 0.0;
   noise_ = Rng(seed);
 }
 

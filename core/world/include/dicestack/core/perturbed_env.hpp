@@ -34,10 +34,10 @@ class PerturbedEnv {
   PerturbedEnv(const PerturbedEnv&) = delete;  // env_ may point into own_
   PerturbedEnv& operator=(const PerturbedEnv&) = delete;
 
-  /// Adds N(0, std[k]) world units to each executed action, after the perturbation's bias and
+  /// Adds N(0, sigma[k]) world units to each executed action, after the perturbation's bias and
   /// noise, from its own stream `seed`: outside the world, so an expert that simulates cannot
   /// foresee it (DART's noise). All zero: none.
-  void add_executed_noise(const Action& std, std::uint64_t seed);
+  void add_executed_noise(const Action& sigma, std::uint64_t seed);
 
   /// The random start of the episode of `episode_seed` in the drawn world (its start ranges).
   State random_start(std::uint64_t episode_seed) const;
