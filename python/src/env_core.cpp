@@ -44,8 +44,7 @@ State EnvCore::reset(std::optional<std::uint64_t> seed, const Perturbation* pert
   episode_seed_ = seeds_.next(seed);
   ++episodes_;
   begin(perturbation);
-  // DiceEnv::reset's own start and noise seed, in the drawn world.
-  return episode_->reset_to(episode_->random_start(episode_seed_), derive_seed(episode_seed_, 1));
+  return episode_->reset(episode_seed_);
 }
 
 State EnvCore::reset_to(const State& state, std::optional<std::uint64_t> seed, const Perturbation* perturbation) {

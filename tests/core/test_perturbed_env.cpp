@@ -26,6 +26,15 @@ TEST(PerturbedEnv, RunsInThePooledWorldUnlessTheDrawChangesThePhysics) {
   EXPECT_FALSE(heavy.env().config() == w);
 }
 
+TEST(PerturbedEnv, ResetStartsAsTheDrawnWorldsOwnResetDoes) {
+  const WorldConfig w;
+  DiceEnv pooled(w);
+  PerturbedEnv heavy(pooled, perturbation_factor("dice_mass", "hard"), 5);
+  DiceEnv own(heavy.draw().world);
+  EXPECT_TRUE(test::bit_equal(heavy.reset(5), own.reset(5)));
+  EXPECT_TRUE(test::bit_equal(heavy.step({1.0, 0.5, 0.0}).result.observation, own.step({1.0, 0.5, 0.0}).observation));
+}
+
 TEST(PerturbedEnv, ClipsWhatThePolicyChoseThenDelaysItAndShowsTheStateLate) {
   const WorldConfig w;
   DiceEnv pooled(w), plain(w);

@@ -113,6 +113,19 @@ def test_a_state_outside_the_world_is_refused_naming_the_body(env):
         env.reset(options={"state": inside})
 
 
+def test_an_action_past_the_limits_is_clipped_before_the_worlds_own_noise():
+    # As in the C++ rollout: the same episode as the action at the limits, noise and all.
+    world = dicestack.default_world()
+    world["physics"]["action_noise"] = 0.5
+    far, edge = dicestack.DiceStackEnv(world=world), dicestack.DiceStackEnv(world=world)
+    far.reset(seed=3)
+    edge.reset(seed=3)
+    limit = np.array(world["action"]["limit"], dtype=float)
+    for _ in range(10):
+        np.testing.assert_array_equal(far.step(limit * 100)[0], edge.step(limit)[0])
+        np.testing.assert_array_equal(far.step(-limit * 100)[0], edge.step(-limit)[0])
+
+
 def test_time_limit_truncates():
     env = dicestack.DiceStackEnv(world=short_world(5))
     env.reset(seed=0)

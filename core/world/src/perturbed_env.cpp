@@ -31,6 +31,11 @@ State PerturbedEnv::reset_to(const State& start, std::uint64_t seed) {
   return channel_ ? channel_->observe(s) : s;
 }
 
+State PerturbedEnv::reset(std::uint64_t seed) {
+  const State s = env_->reset(seed);
+  return channel_ ? channel_->observe(s) : s;
+}
+
 Action PerturbedEnv::clip(const Action& a) const {
   const auto& limit = env_->config().action.limit;
   Action c = a;

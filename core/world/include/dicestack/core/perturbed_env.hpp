@@ -44,6 +44,9 @@ class PerturbedEnv {
   /// Starts the episode at `start`, the world's own physics noise seeded by `seed`; returns what
   /// the policy is shown of it.
   State reset_to(const State& start, std::uint64_t seed);
+  /// Starts the episode as DiceEnv::reset(seed) does, in the drawn world; returns what the policy
+  /// is shown of it.
+  State reset(std::uint64_t seed);
   /// One control step from what the policy chose.
   PerturbedStep step(const Action& chosen);
   /// `a` within the world's action limits: what step() runs before any delay or noise.
