@@ -51,6 +51,7 @@ int run(int argc, char** argv, Cluster& cluster, const FailFn& fail_fn) {
   add_render_command(app);
   add_rollout_command(app);
   add_robustness_command(app, cluster);
+  add_reference_command(app);
   // The long runs, whose work is dealt over threads and ranks. Ctrl-C stops them as an error
   // would, at the next episode (interrupt.hpp); the other subcommands keep the default (play
   // waits for keys, and must end at once). With several ranks, the other subcommands run on the

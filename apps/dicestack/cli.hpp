@@ -30,6 +30,7 @@ void add_learners_command(CLI::App& app);
 void add_play_command(CLI::App& app);
 void add_train_command(CLI::App& app, Cluster& cluster);
 void add_record_command(CLI::App& app, Cluster& cluster);
+void add_reference_command(CLI::App& app);  // its cli page reads the whole app as it runs
 void add_regressors_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);

@@ -233,16 +233,35 @@ TEST(CliInput, AnOverlongValueInAnyOptionIsCutInTheMessage) {
   }
 }
 
-// The reference pages are generated from the schemas: the committed pages are what the
-// commands print today (regenerate them with the commands when a schema changes).
+// The reference pages are generated from the code: each committed page, up to its hand-written
+// version history, is what `dicestack reference PAGE` prints today (scripts/regenerate-reference.sh
+// rewrites them when the code changes).
 TEST(Cli, TheReferencePagesAreWhatTheCommandsPrint) {
-  for (const std::string what : {"learners", "regressors"}) {
-    const Process p = run(what + " --markdown", false);
-    ASSERT_EQ(p.status, 0) << what;
-    const std::string page = std::string(DICESTACK_SOURCE_DIR) + "/docs/reference/" + what + ".md";
-    EXPECT_TRUE(p.output == read_text(page))
-        << page << " differs from `dicestack " << what << " --markdown`: regenerate it with that command";
+  for (const std::string page : {"cli", "learners", "perturbations", "regressors", "world-config"}) {
+    const Process p = run("reference " + page, false);
+    ASSERT_EQ(p.status, 0) << page;
+    const std::string path = std::string(DICESTACK_SOURCE_DIR) + "/docs/reference/" + page + ".md";
+    const std::string text = read_text(path);
+    const auto history = text.find("\n## Version history\n");
+    ASSERT_NE(history, std::string::npos) << path << " has no version history";
+    EXPECT_TRUE(p.output == text.substr(0, history))
+        << path << " differs from `dicestack reference " << page << "`: run scripts/regenerate-reference.sh";
   }
+  // The listing commands print the same pages.
+  EXPECT_EQ(run("learners --markdown", false).output, run("reference learners", false).output);
+  EXPECT_EQ(run("regressors --markdown", false).output, run("reference regressors", false).output);
+}
+
+// The command-line page lists every subcommand and option a user can give.
+TEST(Cli, TheCommandLinePageNamesEverySubcommand) {
+  const std::string page = run("reference cli", false).output;
+  for (const std::string sub : {"bench sim", "config", "dataset subset", "evaluate", "import robomimic", "leaderboard",
+                                "play", "record", "reference", "robustness", "train"})
+    EXPECT_THAT(page, HasSubstr("`dicestack " + sub + "`")) << sub;
+  EXPECT_THAT(page, HasSubstr("| `--perturb` | TEXT | `none` |"));
+  const Process bad = run("reference nosuch");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_THAT(bad.output, HasSubstr("nosuch"));
 }
 
 // Every name and option of a training run is checked before its demonstrations are read: a

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/perturbation.hpp>
 
@@ -64,6 +66,24 @@ TEST(Perturbation, InvalidRangesAreRefusedNamingTheField) {
   p = {};
   p.gravity = std::nan("");
   EXPECT_THAT(test::error_of([&] { validate(p, w); }), HasSubstr("\"gravity\""));
+}
+
+// The reference page's keys are the file's: each is read, written and refused past its range.
+TEST(Perturbation, TheKeyListIsTheFilesKeys) {
+  const WorldConfig w;
+  const auto written = nlohmann::json::parse(perturbation_to_json(Perturbation{}));
+  const auto keys = perturbation_keys();
+  EXPECT_EQ(keys.size() + 2, written.size());  // and "format", "version"
+  for (const auto& k : keys) {
+    EXPECT_TRUE(written.contains(k.name)) << k.name;
+    EXPECT_FALSE(k.meaning.empty()) << k.name;
+    if (k.type == "boolean") continue;
+    nlohmann::json file = written;
+    file[k.name] = 1000;
+    EXPECT_THAT(test::error_of([&] { perturbation_from_json(file.dump(), "p.json", w); }),
+                HasSubstr("field \"" + k.name + "\" must be in [0, "))
+        << k.name;
+  }
 }
 
 TEST(Perturbation, NominalDrawLeavesTheWorldAlone) {

@@ -219,6 +219,26 @@ TEST(WorldConfig, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
   EXPECT_EQ(*denied, path.string() + ": cannot open for reading: Permission denied");
 }
 
+// The reference page's list is the file's: every field the writer writes, in its order, with
+// the default it writes and a meaning.
+TEST(WorldConfig, TheFieldListIsTheFilesFields) {
+  const auto fields = world_config_fields();
+  const nlohmann::json file = default_json();
+  std::size_t leaves = 0;
+  for (const auto& [section, values] : file.items())
+    if (values.is_object()) leaves += values.size();
+  EXPECT_EQ(fields.size(), leaves);
+  for (const auto& f : fields) {
+    const auto dot = f.path.find('.');
+    ASSERT_NE(dot, std::string::npos) << f.path;
+    const auto& value = file.at(f.path.substr(0, dot)).at(f.path.substr(dot + 1));
+    EXPECT_EQ(f.default_value, value.dump()) << f.path;
+    EXPECT_FALSE(f.meaning.empty()) << f.path;
+  }
+  EXPECT_EQ(fields.front().path, "walls.floor_y");
+  EXPECT_EQ(fields.back().path, "cost.sigma");
+}
+
 TEST(WorldConfig, HashIsTheWorldsIdentityNotItsFileFormat) {
   // The value every cache name and checkpoint recorded before the format had a version.
   EXPECT_EQ(world_hash(WorldConfig{}) >> 32, 0x3f53a1beULL);

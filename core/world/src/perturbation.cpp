@@ -68,24 +68,48 @@ std::string list(const std::vector<std::string>& names) {
   return out;
 }
 
-// The JSON keys and their fields, in file order.
+// The JSON keys and their fields, in file order, with the largest value each takes (0 is the
+// least of every one) and what it does: one table serves reading, writing, checking and the
+// reference page.
 struct Key {
   const char* name;
   double Perturbation::*real;
   int Perturbation::*whole;
+  double hi;         // largest value; a delay must also leave the episode a step to act
+  bool hi_open;      // hi itself is refused
+  const char* unit;  // after the range in messages, e.g. " m/s^2"
+  const char* why;   // why the bound, for messages ("" when plain)
+  const char* meaning;
 };
 constexpr Key kKeys[] = {
-    {"friction", &Perturbation::friction, nullptr},
-    {"dice_mass", &Perturbation::dice_mass, nullptr},
-    {"cup_mass", &Perturbation::cup_mass, nullptr},
-    {"gravity", &Perturbation::gravity, nullptr},
-    {"action_noise", &Perturbation::action_noise, nullptr},
-    {"action_bias", &Perturbation::action_bias, nullptr},
-    {"action_delay", nullptr, &Perturbation::action_delay},
-    {"observation_noise", &Perturbation::observation_noise, nullptr},
-    {"observation_delay", nullptr, &Perturbation::observation_delay},
-    {"start_widening", &Perturbation::start_widening, nullptr},
+    {"friction", &Perturbation::friction, nullptr, 1, true, "", "friction would turn negative",
+     "dice, cup and walls/table friction each x U(1 - a, 1 + a), drawn apart"},
+    {"dice_mass", &Perturbation::dice_mass, nullptr, 1, true, "", "a mass would turn non-positive",
+     "dice mass x U(1 - a, 1 + a)"},
+    {"cup_mass", &Perturbation::cup_mass, nullptr, 1, true, "", "a mass would turn non-positive",
+     "cup segment mass x U(1 - a, 1 + a)"},
+    {"gravity", &Perturbation::gravity, nullptr, 2, false, " m/s^2", "", "gravity's y + N(0, sigma), m/s^2"},
+    {"action_noise", &Perturbation::action_noise, nullptr, 10, false, "", "",
+     "every executed action + N(0, s) each step, s a fraction of action.scale"},
+    {"action_bias", &Perturbation::action_bias, nullptr, 10, false, "", "",
+     "every executed action + a bias drawn once per episode from N(0, b), b a fraction of action.scale"},
+    {"action_delay", nullptr, &Perturbation::action_delay, kMaxActionDelay, false, "", "",
+     "what the policy chooses runs this many control steps later (nothing runs before)"},
+    {"observation_noise", &Perturbation::observation_noise, nullptr, 10, false, "", "",
+     "the policy sees each state number + N(0, f x its spread) (spreads: the built-in set's standard deviations)"},
+    {"observation_delay", nullptr, &Perturbation::observation_delay, kMaxActionDelay, false, "", "",
+     "the policy sees the state of this many control steps ago (the start before then)"},
+    {"start_widening", &Perturbation::start_widening, nullptr, 3, false, "", "",
+     "the start's scene shift, cup lift and cup tilt ranges x (1 + w)"},
 };
+
+// "in [0, 1) (friction would turn negative)": a key's range as messages and the reference say it.
+std::string range_text(const Key& k, double hi) {
+  std::ostringstream text;
+  text << "in [0, " << hi << (k.hi_open ? ")" : "]") << k.unit;
+  if (*k.why) text << " (" << k.why << ")";
+  return text.str();
+}
 
 }  // namespace
 
@@ -129,19 +153,15 @@ void validate(const Perturbation& p, const WorldConfig& world, const std::string
       throw ConfigError(text.str());
     }
   };
-  require(p.friction >= 0 && p.friction < 1, "friction", "in [0, 1) (friction would turn negative)", p.friction);
-  require(p.dice_mass >= 0 && p.dice_mass < 1, "dice_mass", "in [0, 1) (a mass would turn non-positive)", p.dice_mass);
-  require(p.cup_mass >= 0 && p.cup_mass < 1, "cup_mass", "in [0, 1) (a mass would turn non-positive)", p.cup_mass);
-  require(p.gravity >= 0 && p.gravity <= 2, "gravity", "in [0, 2] m/s^2", p.gravity);
-  require(p.action_noise >= 0 && p.action_noise <= 10, "action_noise", "in [0, 10]", p.action_noise);
-  require(p.action_bias >= 0 && p.action_bias <= 10, "action_bias", "in [0, 10]", p.action_bias);
-  require(p.observation_noise >= 0 && p.observation_noise <= 10, "observation_noise", "in [0, 10]", p.observation_noise);
-  require(p.start_widening >= 0 && p.start_widening <= 3, "start_widening", "in [0, 3]", p.start_widening);
   const int room = std::min(kMaxActionDelay, world.episode.max_steps - 1);
-  const std::string delays = "in [0, " + std::to_string(room) + "] (shorter than the episode's " +
-                             std::to_string(world.episode.max_steps) + " steps)";
-  require(p.action_delay >= 0 && p.action_delay <= room, "action_delay", delays, p.action_delay);
-  require(p.observation_delay >= 0 && p.observation_delay <= room, "observation_delay", delays, p.observation_delay);
+  for (const auto& k : kKeys) {
+    const double v = k.real ? p.*k.real : p.*k.whole;
+    const double hi = k.whole ? room : k.hi;
+    const std::string rule = k.whole ? "in [0, " + std::to_string(room) + "] (shorter than the episode's " +
+                                           std::to_string(world.episode.max_steps) + " steps)"
+                                     : range_text(k, hi);
+    require(v >= 0 && (k.hi_open ? v < hi : v <= hi), k.name, rule, v);
+  }
   if (p.delays_drawn && p.action_delay == 0 && p.observation_delay == 0)
     throw ConfigError(source + ": field \"" + kDelaysDrawn +
                       "\" draws each episode's delays from 0 to action_delay and observation_delay, and both are 0");
@@ -158,6 +178,18 @@ void validate(const Perturbation& p, const WorldConfig& world, const std::string
                         " makes starts that do not fit this world (" + e.what() + ")");
     }
   }
+}
+
+std::vector<PerturbationKey> perturbation_keys() {
+  std::vector<PerturbationKey> out;
+  for (const auto& k : kKeys) {
+    const std::string range = range_text(k, k.hi);
+    out.push_back({k.name, k.real ? "number" : "integer", k.whole ? range + ", and shorter than the episode" : range,
+                   k.meaning});
+  }
+  out.push_back({kDelaysDrawn, "boolean", "version 2",
+                 "each episode's delays drawn uniformly from 0 to action_delay and observation_delay"});
+  return out;
 }
 
 std::string perturbation_to_json(const Perturbation& p) {

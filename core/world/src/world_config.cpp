@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -112,6 +113,61 @@ void visit_fields(Config& c, Visitor&& v) {
   v("cost.sigma", c.cost.sigma, Bounds{0.0, 1e6, true});
 }
 
+// What each field is, for the reference page (world_config_fields); keyed by the paths
+// visit_fields walks, and a path without an entry is a defect world_config_fields reports.
+struct Meaning {
+  const char* path;
+  const char* text;
+};
+constexpr Meaning kMeanings[] = {
+    {"walls.floor_y", "floor centre line, m; the table surface is floor_y + radius"},
+    {"walls.left_x", "left wall centre line, m"},
+    {"walls.right_x", "right wall centre line, m"},
+    {"walls.ceiling_y", "ceiling centre line, m"},
+    {"walls.radius", "radius of the four wall segments, m"},
+    {"walls.friction", "Coulomb coefficient of the walls and table (paper eq. 3)"},
+    {"cup.base_width", "length of the cup's base segment, m"},
+    {"cup.wall_height", "vertical rise of each side wall, m"},
+    {"cup.flare", "outward offset of each wall's top, m (the cup's outward tilt)"},
+    {"cup.radius", "radius of the cup's three segments, m"},
+    {"cup.segment_mass", "mass of each cup segment, kg"},
+    {"cup.friction", "Coulomb coefficient of the cup (paper eq. 4)"},
+    {"cup.start_anchor", "left end of the base before the start rotation, m (x, y)"},
+    {"cup.start_angle", "the cup's start rotation about its centre of mass, rad (pi: mouth down)"},
+    {"dice.half_size", "half the side of a die's square, m"},
+    {"dice.corner_cut", "length cut off each corner along both sides, m; below half_size"},
+    {"dice.mass", "mass of a die, kg"},
+    {"dice.friction", "Coulomb coefficient of the dice (paper eq. 2)"},
+    {"dice.start_x", "the three dice's start x, m"},
+    {"dice.start_y", "the dice's start height, m; they drop onto the table"},
+    {"physics.gravity", "gravity, m/s^2 (x, y) (paper eq. 1)"},
+    {"physics.control_dt", "one control step (one action), s"},
+    {"physics.substeps", "physics steps per control step"},
+    {"physics.velocity_iterations", "Box2D solver iterations per substep"},
+    {"physics.position_iterations", "Box2D position correction passes per substep"},
+    {"physics.allow_sleep", "let resting bodies sleep (faster, changes episodes)"},
+    {"physics.units_per_metre", "Box2D's internal length scale; 10 keeps its 0.01-unit skin at 1 mm"},
+    {"physics.action_noise", "std of Gaussian noise on each action, as a fraction of action.scale; 0: deterministic"},
+    {"action.scale", "what an optimiser's x = 1 means per action dimension (dvx m/s, dvy m/s, dw rad/s)"},
+    {"action.limit", "largest |action| accepted per dimension; larger ones are clipped"},
+    {"randomization.shift", "the whole scene shifts by U(-shift, shift) in x at a random start, m"},
+    {"randomization.die_jitter", "each die moves by U(-j, j) in x, m"},
+    {"randomization.cup_lift", "the cup starts U(0, lift) higher, m"},
+    {"randomization.cup_tilt", "the cup's start angle changes by U(-tilt, tilt), rad"},
+    {"randomization.die_quarter_turns", "each die starts turned by a random multiple of 90 degrees"},
+    {"judge.column_tolerance", "largest x offset between a die and the one below it in a stack, m"},
+    {"judge.gap_tolerance", "largest deviation of the dice's centre spacing from one side, m"},
+    {"judge.angle_tolerance", "largest deviation of a die from a multiple of 90 degrees, rad"},
+    {"judge.rest_speed", "largest die speed at rest, m/s"},
+    {"judge.rest_angular_speed", "largest die angular speed at rest, rad/s"},
+    {"judge.wall_contact_distance", "a gap at most this wide counts as touching a wall, m"},
+    {"judge.success_hold_steps", "control steps a realistic success must hold"},
+    {"episode.max_steps", "the time limit, control steps"},
+    {"cost.gamma", "discount of the optimisers' cost: step j weighs gamma^(T - j) (paper eq. 6)"},
+    {"cost.goal_x", "x of the goal stack, m"},
+    {"cost.sigma", "per state number scale of the cost's distance (the human recordings' spreads)"},
+};
+
 [[noreturn]] void fail(std::string_view source, std::string_view path, const std::string& what) {
   throw ConfigError("world config " + std::string(source) + ": field \"" + std::string(path) + "\" " + what);
 }
@@ -206,6 +262,31 @@ struct JsonReader {
     std::array<double, 2> a{};
     read_array(p, a);
     v = {a[0], a[1]};
+  }
+};
+
+// Lists every field with its type, default, range and meaning (world_config_fields).
+struct FieldLister {
+  std::vector<WorldConfigField>* out;
+
+  static std::string meaning(std::string_view path) {
+    for (const auto& m : kMeanings)
+      if (path == m.path) return m.text;
+    throw std::logic_error("world config field \"" + std::string(path) + "\" has no meaning in kMeanings");
+  }
+  void add(std::string_view p, std::string type, const json& value, const Bounds& b) const {
+    const bool any = b.lo == -HUGE_VAL && b.hi == HUGE_VAL;
+    out->push_back({std::string(p), std::move(type), value.dump(), any ? "" : bound_text(b), meaning(p)});
+  }
+  void operator()(std::string_view p, const double& v, const Bounds& b) const { add(p, "number", v, b); }
+  void operator()(std::string_view p, const int& v, const Bounds& b) const { add(p, "integer", v, b); }
+  void operator()(std::string_view p, const bool& v, const Bounds& b) const { add(p, "boolean", v, b); }
+  void operator()(std::string_view p, const Vec2& v, const Bounds& b) const {
+    add(p, "2 numbers", json::array({v.x, v.y}), b);
+  }
+  template <std::size_t N>
+  void operator()(std::string_view p, const std::array<double, N>& a, const Bounds& b) const {
+    add(p, std::to_string(N) + " numbers", a, b);
   }
 };
 
@@ -338,6 +419,14 @@ CostConfig WorldConfig::default_cost() {
 void validate(const WorldConfig& config) {
   visit_fields(config, RangeChecker{"<value>"});
   validate_relations(config, "<value>");
+}
+
+std::vector<WorldConfigField> world_config_fields() {
+  std::vector<WorldConfigField> out;
+  const WorldConfig defaults;
+  visit_fields(defaults, FieldLister{&out});
+  if (out.size() != std::size(kMeanings)) throw std::logic_error("world config: kMeanings names a field that is gone");
+  return out;
 }
 
 WorldConfig world_config_from_json(std::string_view text, std::string_view source) {

@@ -74,6 +74,16 @@ Perturbation perturbation_from_json(std::string_view text, const std::string& so
 /// The longest delay, in control steps, of either kind (and shorter than the episode).
 inline constexpr int kMaxActionDelay = 100;
 
+/// One key of a perturbation file, as its reference page lists it.
+struct PerturbationKey {
+  std::string name;
+  std::string type;  ///< "number", "integer" or "boolean"
+  std::string range;
+  std::string meaning;
+};
+/// The keys of a perturbation file, in file order: the table its reader and checks use.
+std::vector<PerturbationKey> perturbation_keys();
+
 /// What one episode got.
 struct PerturbationDraw {
   WorldConfig world;        ///< the world it runs in (physics and start ranges changed)

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/vec2.hpp>
@@ -144,6 +145,19 @@ std::string to_json(const WorldConfig& config);
 /// FNV-1a of the fields alone (not the format version): the world's identity in cache names,
 /// checkpoints and snapshots, unchanged when only the file format moves on.
 std::uint64_t world_hash(const WorldConfig& config);
+
+/// One field of the world config file, as its reference page lists it.
+struct WorldConfigField {
+  std::string path;           ///< the JSON path, e.g. "physics.substeps"
+  std::string type;           ///< "number", "integer", "boolean" or "N numbers"
+  std::string default_value;  ///< WorldConfig{}'s value, as JSON
+  std::string range;          ///< e.g. "in [1, 1000]"; empty when any value of the type is valid
+  std::string meaning;        ///< what it is, with its unit
+};
+
+/// Every field of the file, in file order: the list the reader, the writer and the range check
+/// walk, so the reference page cannot miss one.
+std::vector<WorldConfigField> world_config_fields();
 
 /// Reads a JSON file; throws InputError if unreadable, ConfigError if invalid.
 WorldConfig load_world_config(const std::filesystem::path& path);
