@@ -248,6 +248,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_load_command(*bench);
   add_bench_dataset_command(*bench);
   add_bench_optimise_command(*bench);
+  add_bench_estimator_command(*bench);
 }
 
 }  // namespace dicestack::cli

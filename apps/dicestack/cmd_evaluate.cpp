@@ -26,6 +26,7 @@ struct EvaluateOptions {
   int threads = 0;
   std::string push = "none";
   std::string perturb = "none";
+  std::string estimator = "none";
   bool json = false;
 };
 
@@ -50,11 +51,12 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   request.threads = opt.threads;
   request.push = initial_push_from(opt.push);
   request.perturbation = perturbation;
+  request.estimator = estimator_config(opt.estimator);
   request.rollouts = keep ? &rollouts : nullptr;
   request.results = &results;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
-  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb, opt.world.start};
+  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb, opt.world.start, opt.estimator};
   if (!opt.report.empty())
     write_report_folder(evaluation_board(run, *model, s, results, rollouts, world, errors ? &*errors : nullptr), opt.report);
   if (!opt.video_dir.empty()) {
@@ -77,6 +79,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.description = "rollouts of " + opt.model.string();
     set.provenance = "dicestack evaluate --model " + opt.model.string() + " --episodes " + std::to_string(opt.episodes) +
                      (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
+                     (opt.estimator == "none" ? "" : " --estimator " + opt.estimator) +
                      (opt.world.start == "random" ? "" : " --start " + opt.world.start) + " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
@@ -92,7 +95,8 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
                 "  dice in cup (most, mean) %.2f, all three %.1f%%, mean length %.0f steps, %.2f us per step",
                 opt.model.string().c_str(), model->regressor().name().c_str(), s.episodes,
                 opt.world.start == "random" ? "" : (" from " + opt.world.start + " starts").c_str(),
-                static_cast<unsigned long long>(opt.seed), opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb).c_str(),
+                static_cast<unsigned long long>(opt.seed),
+                opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb + (opt.estimator == "none" ? "" : ", estimator " + opt.estimator)).c_str(),
                 100 * s.realistic_success.value, 100 * s.realistic_success.low,
                 100 * s.realistic_success.high, 100 * s.stacked.value, 100 * s.stacked.low, 100 * s.stacked.high,
                 100 * s.wall_contact.value, 100 * s.wall_contact.low, 100 * s.wall_contact.high, s.dice_in_cup_mean,
@@ -124,6 +128,7 @@ void add_evaluate_command(CLI::App& app, Cluster& cluster) {
                   "Perturbed worlds: none, easy, medium, hard (every factor at that level) or a perturbation file "
                   "(docs/robustness.md)")
       ->capture_default_str();
+  add_estimator_option(*cmd, opt->estimator);
   cmd->add_option("--save-rollouts", opt->save_rollouts,
                   "Also write the rollouts as a demonstration set (source policy; outcomes in meta.json)");
   cmd->add_option("--video-dir", opt->video_dir,

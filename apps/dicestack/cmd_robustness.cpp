@@ -22,7 +22,7 @@ namespace {
 struct RobustnessOptions {
   WorldOption world;
   std::filesystem::path model, demos, out;
-  std::string expert, format = "md", expert_feedback = "world";
+  std::string expert, format = "md", expert_feedback = "world", estimator = "none";
   int episodes = 100;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -40,6 +40,9 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   const bool sensed = opt.expert_feedback == "observations";
   if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
+  if (opt.estimator != "none" && !opt.expert.empty() && !sensed)
+    throw ConfigError("robustness: --estimator stands between the sensors and the policy: with --expert it needs "
+                      "--expert-feedback observations (the expert's own feedback reads the world)");
   {
     EvalRequest rows;  // the rollouts' count, checked before any recordings are read
     rows.episodes = opt.episodes;
@@ -57,6 +60,8 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   request.seed = opt.seed;
   request.threads = opt.threads;
   request.factors = opt.factors;
+  request.estimator = estimator_config(opt.estimator);
+  run.estimator = opt.estimator;
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
     check_ahead_world(model->features(), world);
@@ -120,6 +125,7 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
                   "observations (what a policy is shown; its choices still read the world)")
       ->check(CLI::IsMember({"world", "observations"}))
       ->capture_default_str();
+  add_estimator_option(*cmd, opt->estimator);
   cmd->add_option("--episodes", opt->episodes, "Rollouts per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the starts and the draws")->check(seed_check())->capture_default_str();
   cmd->add_option("--factors", opt->factors,

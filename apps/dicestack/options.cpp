@@ -1,5 +1,7 @@
 #include "options.hpp"
 
+#include <dicestack/core/estimator.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -118,6 +120,15 @@ CLI::Validator threads_check() {
                "] (0: all cores; results do not depend on it), got \"" + text.substr(0, 40) + "\"";
       },
       "THREADS");
+}
+
+CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {
+  return cmd
+      .add_option("--estimator", name,
+                  "What the policy is shown under sensing factors: none (the observations) or kalman (a Kalman "
+                  "filter whose motion model is the simulator; docs/robustness.md)")
+      ->check(CLI::IsMember(estimator_names()))
+      ->capture_default_str();
 }
 
 CLI::Validator seed_check() {

@@ -46,6 +46,9 @@ CLI::Validator seed_check();
 /// `--threads`: a whole number in [0, kMaxThreads] (0: all cores).
 CLI::Validator threads_check();
 
+/// `--estimator NAME` (none, kalman): what a policy is shown under sensing factors.
+CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name);
+
 /// Prints a JSON object or a human-readable text on stdout.
 void print_line(const std::string& text);
 

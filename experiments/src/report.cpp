@@ -32,6 +32,7 @@ std::string evaluation_json(const EvaluationRun& run, const Model& model, const 
                    {"us_per_step", s.policy_us_per_step},
                    {"seconds", s.seconds}};
   if (run.perturb != "none") j["perturb"] = run.perturb;
+  if (run.estimator != "none") j["estimator"] = run.estimator;
   if (run.start != "random") j["start"] = run.start;
   if (errors) {
     j["train_error"] = errors->train_error;
@@ -63,6 +64,7 @@ Leaderboard evaluation_board(const EvaluationRun& run, const Model& model, const
                       {"episodes", stats.episodes}, {"seed", run.seed},
                       {"initial_push", run.initial_push}};
   if (run.perturb != "none") meta["perturb"] = run.perturb;
+  if (run.estimator != "none") meta["estimator"] = run.estimator;
   if (run.start != "random") meta["start"] = run.start;
   for (const auto& [key, value] : model.record) meta["training " + key] = value;
   board.meta_json = meta.dump();

@@ -84,6 +84,7 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
     r.seed = request.seed;
     r.threads = request.threads;
     r.perturbation = perturbation(f, level);
+    r.estimator = request.estimator;
     rows.push_back({f, level, evaluate(make_policy, world, r, cluster)});
   }
   return rows;
@@ -95,13 +96,16 @@ RobustnessTable robustness_table(std::vector<RobustnessRow> rows, const Robustne
   t.header = "dicestack robustness: " + run.policy + "; " + std::to_string(run.episodes) +
              " rollouts per row from evaluation starts (seed " + std::to_string(run.seed) +
              "); rates with 95% Wilson intervals (successes)" +
-             (run.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "");
+             (run.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "") +
+             (run.estimator.empty() || run.estimator == "none" ? "" : "; the policy sees the " + run.estimator +
+                                                                         " estimator's estimate");
   nlohmann::json meta{{"policy", run.policy},
                       {"world", run.world},
                       {"rollouts_per_row", run.episodes},
                       {"seed", run.seed},
                       {"dicestack_version", DICESTACK_VERSION}};
   if (run.reads_world) meta["sensing_factors"] = "left out (an expert reads the world itself)";
+  if (!run.estimator.empty() && run.estimator != "none") meta["estimator"] = run.estimator;
   if (!run.record.empty()) meta["model_record"] = run.record;
   t.meta_json = meta.dump();
   return t;

@@ -190,6 +190,7 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, c
         TimedPolicy timed(*policies[slot], t.policy_seconds);
         const std::uint64_t episode_seed = evaluation_start_seed(request.seed, i);
         PerturbedEnv episode(envs.at(w), request.perturbation, episode_seed);
+        episode.use_estimator(request.estimator);
         RolloutOptions episode_options = options;
         const State start = episode.random_start(episode_seed);
         // Only when results are asked for (a call per step): before step k the outcome covers

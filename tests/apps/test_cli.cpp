@@ -233,6 +233,26 @@ TEST(CliInput, AnOverlongValueInAnyOptionIsCutInTheMessage) {
   }
 }
 
+// The estimator is chosen by name at the edge: a bad name, or an estimator for an expert whose
+// feedback reads the world, is refused before any rollout; `none` changes no byte, and without
+// sensing factors the policy sees the state whatever the estimator.
+TEST(CliInput, TheEstimatorIsCheckedFirstAndNoneChangesNothing) {
+  const Process bad = run_within(5, "robustness --expert scripted --estimator particles --episodes 1");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_THAT(bad.output, HasSubstr("--estimator"));
+  const Process world = run_within(5, "robustness --expert scripted --estimator kalman --episodes 1");
+  EXPECT_EQ(world.status, 1);
+  EXPECT_THAT(world.output, HasSubstr("--expert-feedback observations"));
+  const std::string base = "robustness --expert scripted --expert-feedback observations --factors none --episodes 3";
+  const Process plain = run(base, false), none = run(base + " --estimator none", false),
+                kalman = run(base + " --estimator kalman", false);
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  EXPECT_EQ(plain.output, none.output);
+  const auto row = [](const std::string& out) { return out.substr(out.find("| none | none |")); };
+  EXPECT_EQ(row(plain.output), row(kalman.output));
+  EXPECT_THAT(kalman.output, HasSubstr("the kalman estimator's estimate"));
+}
+
 // The reference pages are generated from the code: each committed page, up to its hand-written
 // version history, is what `dicestack reference PAGE` prints today (scripts/regenerate-reference.sh
 // rewrites them when the code changes).

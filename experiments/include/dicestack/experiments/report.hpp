@@ -22,12 +22,13 @@ struct EvaluationRun {
   std::string initial_push = "none";
   std::string perturb = "none";  ///< --perturb as given: a level or a file (in the JSON unless none)
   std::string start = "random";  ///< the start distribution (initial_state.hpp's with_starts)
+  std::string estimator = "none";  ///< between the sensors and the policy (in the JSON unless none)
 };
 
 /// The `evaluate --json` object as one line of JSON: model, regressor, features, episodes,
 /// seed, initial_push, dice_in_cup_mean, dice_in_cup_3_rate, stacked_rate, wall_contact_rate,
 /// realistic_success_rate (each rate also as [value, low, high] under *_ci95),
-/// mean_episode_length, us_per_step, seconds, start and perturb unless random and none, and train_error, test_error, split when `errors`
+/// mean_episode_length, us_per_step, seconds, start, perturb and estimator unless random and none, and train_error, test_error, split when `errors`
 /// is given.
 std::string evaluation_json(const EvaluationRun& run, const Model& model, const EvalStats& stats,
                             const Score* errors = nullptr);

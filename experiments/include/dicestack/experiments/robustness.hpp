@@ -10,6 +10,7 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/cluster.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/learners/evaluate.hpp>
 
@@ -31,6 +32,8 @@ struct RobustnessRequest {
   /// The factors to measure ("none", "all" and perturbation_factors()), in the table's order;
   /// empty: every one. An unknown name is refused before any row runs.
   std::vector<std::string> factors;
+  /// What the policy is shown under the sensing factors: the observation, or an estimate.
+  EstimatorConfig estimator;
   /// Called as each row starts with (row index, rows in all, factor, level).
   std::function<void(int, int, const std::string&, const std::string&)> progress;
 };
@@ -53,6 +56,7 @@ struct RobustnessRun {
   int episodes = 0;               ///< rollouts per row
   std::uint64_t seed = 0;         ///< the request's seed
   bool reads_world = false;       ///< an expert: the sensing factors were left out
+  std::string estimator = "none";  ///< between the sensors and the policy (none: the observations)
   /// The model's training record (Model::record: learner, demos, ...), shown among the facts.
   std::map<std::string, std::string> record{};
 };

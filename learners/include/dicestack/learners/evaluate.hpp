@@ -6,6 +6,7 @@
 
 #include <dicestack/core/cluster.hpp>
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/core/perturbed_env.hpp>
 #include <dicestack/datasets/episode.hpp>
@@ -102,6 +103,8 @@ struct EvalRequest {
   InitialPush push = InitialPush::none;
   /// Drawn per episode from its seed (draw_perturbation); nominal: today's world, byte for byte.
   Perturbation perturbation;
+  /// What the policy is shown under sensing factors: the observation (none) or an estimate.
+  EstimatorConfig estimator;
   std::size_t max_steps = 0;  ///< 0: the world's time limit
   std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
   std::vector<EpisodeResult>* results = nullptr;  ///< if set, receives every rollout's results in index order

@@ -3,13 +3,16 @@
 // an environment: the perturbation's factors drawn from the episode's seed, the world they make,
 // and between the policy and that world the sensing (what the policy is shown: noisy, late) and
 // the actuation (what runs: the choice clipped to the world's limits, late, biased and noised,
-// plus noise the world cannot foresee, such as DART's). rollout() and the Python environment step
+// plus noise the world cannot foresee, such as DART's); and, when asked, a state estimator
+// between the sensors and the policy. rollout() and the Python environment step
 // through it, so both give the same episodes.
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/core/rng.hpp>
 #include <dicestack/core/types.hpp>
@@ -39,6 +42,11 @@ class PerturbedEnv {
   /// foresee it (DART's noise). All zero: none.
   void add_executed_noise(const Action& sigma, std::uint64_t seed);
 
+  /// Shows the policy `config`'s estimate of the state instead of the raw observation, from the
+  /// next reset on; without sensing factors in the draw the policy sees the state and nothing
+  /// changes. Its model is the nominal world (the pooled one).
+  void use_estimator(const EstimatorConfig& config);
+
   /// The random start of the episode of `episode_seed` in the drawn world (its start ranges).
   State random_start(std::uint64_t episode_seed) const;
   /// Starts the episode at `start`, the world's own physics noise seeded by `seed`; returns what
@@ -61,18 +69,23 @@ class PerturbedEnv {
   bool channelled() const { return channel_.has_value(); }
   /// What runs before the next choice under an action delay (History::pending). Empty without.
   const std::deque<Action>& pending() const;
-  /// What ran since the state last shown, under an observation delay (History::unseen).
+  /// What ran since the state last shown, under an observation delay (History::unseen). Empty
+  /// without, and with an estimator: its estimate is of the current state.
   const std::deque<Action>& unseen() const;
 
  private:
   PerturbationDraw draw_;
   std::optional<DiceEnv> own_;  // the world of a draw whose physics differs
   DiceEnv* env_;
+  const WorldConfig* model_;  // the nominal world, an estimator's model
   std::optional<PerturbedChannel> channel_;
+  std::unique_ptr<Estimator> estimator_;
   Action executed_noise_{0.0, 0.0, 0.0};
   bool noisy_ = false;
   Rng noise_{0};
   std::deque<Action> none_;  // pending() and unseen() without a channel
+
+  State first_shown(const State& start);
 };
 
 }  // namespace dicestack

@@ -1,0 +1,92 @@
+#pragma once
+// A state estimator between the sensors and the policy: from what the sensors give (noisy,
+// late) and the actions sent, an estimate of the current state. Its motion model is the
+// simulator of the nominal world, the robot's model: it knows neither the episode's physics
+// draw nor its actuation noise. It knows what a robot knows of its own sensors and commands:
+// the observation's latency (its timestamp), the length of its command queue and its sensor's
+// noise spread. docs/robustness.md, "The estimator".
+#include <array>
+#include <deque>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dicestack/core/perturbation.hpp>
+#include <dicestack/core/types.hpp>
+#include <dicestack/core/world.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+enum class EstimatorKind { none, kalman };
+
+/// Which estimator, and its settings: parsed once, at the edge, from `--estimator NAME`.
+struct EstimatorConfig {
+  EstimatorKind kind = EstimatorKind::none;
+  /// The model's error in one control step, as a multiple of the simulator's own one-step error
+  /// from true states (estimator.cpp): larger trusts the sensor more, smaller the simulator.
+  double model_error = 3.0;
+  bool operator==(const EstimatorConfig&) const = default;
+};
+
+/// The estimators by name: none, kalman.
+const std::vector<std::string>& estimator_names();
+/// The estimator of `name` with its default settings; throws ConfigError naming the choices.
+EstimatorConfig estimator_config(std::string_view name);
+const char* to_string(EstimatorKind kind);
+
+/// What a policy is given instead of the raw observation, one episode at a time.
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+  /// The episode's first observation; returns the estimate of the start.
+  virtual State start(const State& observed) = 0;
+  /// After one control step: what the policy chose for it (clipped to the world's limits) and
+  /// what the sensor gave after it; returns the estimate of the current state.
+  virtual State update(const Action& chosen, const State& observed) = 0;
+};
+
+/// A Kalman filter whose prediction is the simulator. It keeps an estimate of the state the
+/// newest observation shows (observation_delay steps ago): each step it steps that estimate
+/// through the simulator with the action that ran then, and corrects it towards the observation
+/// with the gain of a Kalman filter per pose number and its velocity (the pair's covariance
+/// moved as a pose integrating its velocity, plus the model's error, against the sensor's
+/// noise). The current state is that estimate simulated forward through the actions that ran
+/// since. Contacts are the simulator's: a die riding in the cup is predicted as such. Without
+/// sensor noise it trusts each observation whole and only makes up the delay.
+class KalmanEstimator final : public Estimator {
+ public:
+  /// `model`: the nominal world; `draw`: the episode's sensing and command delays and its
+  /// sensor's noise (nothing else of it is read).
+  KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config);
+  State start(const State& observed) override;
+  State update(const Action& chosen, const State& observed) override;
+
+ private:
+  struct Covariance {
+    double pp = 0.0, pv = 0.0, vv = 0.0;  // a pose number's variance, its covariance with its velocity, the velocity's
+  };
+  void predict();
+  void correct(const State& observed);
+
+  World model_;
+  double dt_;
+  int observation_delay_;
+  int action_delay_;
+  State sensor_variance_{};
+  State process_variance_{};
+  State lagged_{};  // the estimate of the state the newest observation shows
+  std::array<Covariance, 12> covariance_{};  // per pose number and its velocity
+  int steps_ = 0;   // control steps taken
+  int lagged_step_ = 0;
+  std::deque<Action> queue_;  // chosen, not run yet (the command delay)
+  std::deque<Action> since_;  // what ran from lagged_step_ to now, in order
+};
+
+/// The estimator of `config` for one episode (nullptr for none, and when the draw's sensing is
+/// nominal: the policy then sees the state itself).
+std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
+                                          const PerturbationDraw& draw);
+
+}  // namespace dicestack

@@ -1,0 +1,102 @@
+// The state estimator between the sensors and the policy: it makes up an observation delay
+// from the actions sent, filters sensor noise, and changes nothing where the sensing is nominal.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/estimator.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/perturbed_env.hpp>
+
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A swing of the cup that scoops the dice now and then: contact-rich, and the same each run.
+Action swing(int t) { return {3.0 * std::sin(0.11 * t), 1.5 * std::cos(0.07 * t), 0.8 * std::sin(0.05 * t)}; }
+
+// The pose numbers (positions and angles), not the velocities.
+bool is_pose(std::size_t k) { return k < state_index::kCupVx && (k < 3 || (k - 3) % 6 < 3); }
+
+// Mean over an episode of |what the policy is shown - the state|, in units of each number's
+// spread, over every number (or the poses alone).
+double shown_error(const Perturbation& p, const EstimatorConfig& estimator, std::uint64_t seed, bool poses = false,
+                   int steps = 200) {
+  const WorldConfig w;
+  DiceEnv pooled(w);
+  PerturbedEnv env(pooled, p, seed);
+  env.use_estimator(estimator);
+  env.reset(seed);
+  double sum = 0.0;
+  int terms = 0;
+  for (int t = 0; t < steps; ++t) {
+    const PerturbedStep s = env.step(swing(t));
+    for (std::size_t k = 0; k < kStateDim; ++k)
+      if (!poses || is_pose(k)) {
+        sum += std::abs(s.shown[k] - s.result.observation[k]) / observation_spread()[k];
+        ++terms;
+      }
+  }
+  return sum / terms;
+}
+
+TEST(Estimator, NamesAreParsedAtTheEdgeAndABadOneIsRefusedNamingTheChoices) {
+  EXPECT_EQ(estimator_config("none").kind, EstimatorKind::none);
+  EXPECT_EQ(estimator_config("kalman").kind, EstimatorKind::kalman);
+  EXPECT_THAT(test::error_of([] { estimator_config("particles"); }), HasSubstr("not one of none, kalman"));
+}
+
+TEST(Estimator, WithoutSensingFactorsThePolicySeesTheStateAsBefore) {
+  const WorldConfig w;
+  const Perturbation actuation = perturbation_factor("action_delay", "medium");
+  EXPECT_EQ(make_estimator(estimator_config("kalman"), w, draw_perturbation(actuation, w, 1)), nullptr);
+  EXPECT_EQ(shown_error(actuation, estimator_config("kalman"), 1), 0.0);
+  EXPECT_NE(make_estimator(estimator_config("kalman"), w,
+                           draw_perturbation(perturbation_factor("observation_noise", "easy"), w, 1)),
+            nullptr);
+  EXPECT_EQ(make_estimator(estimator_config("none"), w,
+                           draw_perturbation(perturbation_factor("observation_noise", "easy"), w, 1)),
+            nullptr);
+}
+
+TEST(Estimator, MakesUpAnObservationDelayFromTheActionsThatRan) {
+  const Perturbation late = perturbation_factor("observation_delay", "medium");
+  for (std::uint64_t seed : {1u, 2u}) {
+    const double raw = shown_error(late, estimator_config("none"), seed);
+    const double estimated = shown_error(late, estimator_config("kalman"), seed);
+    EXPECT_LT(estimated, 0.2 * raw) << "seed " << seed << ": raw " << raw << ", estimated " << estimated;
+  }
+}
+
+// The poses are what the simulator predicts best; the dice's velocities, made by contacts, it
+// predicts least well, and there the estimate stays near the sensor's.
+TEST(Estimator, FiltersSensorNoiseOnThePoses) {
+  const Perturbation noisy = perturbation_factor("observation_noise", "medium");
+  for (std::uint64_t seed : {1u, 2u}) {
+    const double raw = shown_error(noisy, estimator_config("none"), seed, true);
+    const double estimated = shown_error(noisy, estimator_config("kalman"), seed, true);
+    EXPECT_LT(estimated, 0.6 * raw) << "seed " << seed << ": raw " << raw << ", estimated " << estimated;
+    EXPECT_LT(shown_error(noisy, estimator_config("kalman"), seed), shown_error(noisy, estimator_config("none"), seed))
+        << "seed " << seed << ": every number";
+  }
+}
+
+TEST(Estimator, TheSameEpisodeGivesTheSameEstimatesBitForBit) {
+  const Perturbation both = perturbation_level("medium");
+  const WorldConfig w;
+  DiceEnv a(w), b(w);
+  PerturbedEnv x(a, both, 7), y(b, both, 7);
+  x.use_estimator(estimator_config("kalman"));
+  y.use_estimator(estimator_config("kalman"));
+  EXPECT_TRUE(test::bit_equal(x.reset(7), y.reset(7)));
+  for (int t = 0; t < 60; ++t) EXPECT_TRUE(test::bit_equal(x.step(swing(t)).shown, y.step(swing(t)).shown)) << t;
+  EXPECT_TRUE(x.unseen().empty());  // the estimate is of the current state
+}
+
+}  // namespace
+}  // namespace dicestack
