@@ -80,15 +80,22 @@ class DiceStackEnv(_EnvBase):
     its actions late, biased and noisy, exactly as `dicestack evaluate --perturb` runs it.
     options={"perturb": ...} perturbs that one episode instead. info["perturbation"] (at reset)
     holds the values drawn; `state` stays the true state.
+
+    estimator: "none" (the observations as the sensors give them) or "kalman": under sensing
+    factors each observation is the estimate of a Kalman filter whose motion model is the
+    simulator, as `dicestack evaluate --estimator kalman` shows a policy (docs/robustness.md,
+    "The estimator").
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
-    def __init__(self, world=None, render_mode=None, perturb=None, start="random"):
+    def __init__(self, world=None, render_mode=None, perturb=None, start="random", estimator="none"):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         self._world = resolve_world(world, start)
-        self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world))
+        if not isinstance(estimator, str):
+            raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
+        self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world), estimator)
         self.render_mode = render_mode
         self.metadata = dict(type(self).metadata, render_fps=int(round(1.0 / self._world.control_dt)))
         self.observation_space = box(*self._env.observation_bounds())

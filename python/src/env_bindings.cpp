@@ -352,7 +352,10 @@ void bind_env(py::module_& m) {
       .def_property_readonly("nominal", &Perturbation::nominal);
 
   py::class_<EnvCore>(m, "Env", "One dice-stacking environment (the core of dicestack.DiceStackEnv)")
-      .def(py::init<const WorldConfig&, const Perturbation&>(), py::arg("world"), py::arg("perturbation") = Perturbation{})
+      .def(py::init([](const WorldConfig& world, const Perturbation& perturbation, const std::string& estimator) {
+             return std::make_unique<EnvCore>(world, perturbation, estimator_config(estimator));
+           }),
+           py::arg("world"), py::arg("perturbation") = Perturbation{}, py::arg("estimator") = "none")
       .def(
           "reset",
           [](EnvCore& core, const py::object& seed, const py::object& state, const std::optional<Perturbation>& p) {

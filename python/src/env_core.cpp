@@ -23,9 +23,10 @@ std::uint64_t EpisodeSeeds::next(std::optional<std::uint64_t> seed) {
   return derive_seed(*base_, ++count_);
 }
 
-EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation)
+EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation, const EstimatorConfig& estimator)
     : world_(world),
       perturbation_(perturbation),
+      estimator_(estimator),
       nominal_(std::make_unique<DiceEnv>(world)),
       goal_(goal_state(world)),
       nominal_hash_(dicestack::world_hash(world)),
@@ -36,6 +37,7 @@ EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation)
 
 void EnvCore::begin(const Perturbation* perturbation) {
   episode_ = std::make_unique<PerturbedEnv>(*nominal_, perturbation ? *perturbation : perturbation_, episode_seed_);
+  episode_->use_estimator(estimator_);
   world_hash_ = episode_->draw().physics ? dicestack::world_hash(episode_->draw().world) : nominal_hash_;
 }
 

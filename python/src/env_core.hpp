@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <dicestack/core/env.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/core/perturbed_env.hpp>
 
@@ -37,7 +38,8 @@ class EpisodeSeeds {
 /// same episodes as C++.
 class EnvCore {
  public:
-  explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {});
+  /// `estimator`: what the policy is shown under sensing factors (estimator.hpp).
+  explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {}, const EstimatorConfig& estimator = {});
 
   /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds, under
   /// `perturbation` if given (this episode only), else the environment's own.
@@ -83,6 +85,7 @@ class EnvCore {
 
   WorldConfig world_;  // the nominal world
   Perturbation perturbation_;
+  EstimatorConfig estimator_;
   std::unique_ptr<DiceEnv> nominal_;  // the world of every episode whose physics is nominal
   std::unique_ptr<PerturbedEnv> episode_;  // the current episode (null before the first reset)
   State goal_;

@@ -172,3 +172,20 @@ def test_the_vector_env_shows_each_environments_pending_actions():
     nominal = dicestack.DiceStackVectorEnv(2, threads=1)
     nominal.reset(seed=1)
     assert [p.shape for p in nominal.pending] == [(0, 3)] * 2
+
+
+def test_the_estimator_shows_an_estimate_nearer_the_state_under_a_delay(rng):
+    actions = random_actions(rng, 40)
+    raw = episode(dicestack.DiceStackEnv(perturb={"observation_delay": 3}), 5, actions)
+    estimated = episode(dicestack.DiceStackEnv(perturb={"observation_delay": 3}, estimator="kalman"), 5, actions)
+    assert np.array_equal(raw[1], estimated[1])  # the same episode: the estimator changes what is shown, not what runs
+    assert np.abs(estimated[0] - estimated[1]).mean() < 0.2 * np.abs(raw[0] - raw[1]).mean()
+    nominal = episode(dicestack.DiceStackEnv(estimator="kalman"), 5, actions)
+    assert np.array_equal(nominal[0], nominal[1])  # no sensing factor: the state itself
+
+
+@pytest.mark.parametrize("estimator, error", [("particles", ValueError), (3, TypeError), ("x" * 100000, ValueError)])
+def test_a_bad_estimator_is_refused(estimator, error):
+    with pytest.raises(error) as caught:
+        dicestack.DiceStackEnv(estimator=estimator)
+    assert len(str(caught.value)) < 300
