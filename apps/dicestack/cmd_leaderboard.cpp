@@ -28,7 +28,7 @@ struct LeaderboardOptions {
 
 // `--recordings 1,3,10`: realistic success against the number of recordings (learning_curve.hpp).
 int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
-  for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb"})
+  for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb", "--estimator"})
     if (cmd.count(unused) > 0) throw ConfigError(std::string("leaderboard --recordings draws a learning curve; ") + unused + " is for the table");
   const LeaderboardRequest& t = opt.request;
   const auto formats = learning_curve_formats();
@@ -139,6 +139,7 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
                   "Roll out in perturbed worlds: none, easy, medium, hard or a perturbation file (docs/robustness.md); "
                   "training stays nominal")
       ->capture_default_str();
+  add_estimator_option(*cmd, r.estimator);
   cmd->add_option("--recordings", opt->recordings,
                   "Instead of the table, a learning curve: realistic success against the number of recordings each "
                   "policy learns from (comma-separated numbers, e.g. 1,3,10,68; default learners dart:expert=tracker "

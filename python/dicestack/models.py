@@ -109,14 +109,21 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
     )
 
 
+def _estimator_name(estimator):
+    if not isinstance(estimator, str):
+        raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
+    return estimator
+
+
 def evaluate(model, episodes=20, seed=0, *, world=None, start="random", demos=None, threads=None,
-             initial_push="none", perturb=None, report=None, progress=None):
+             initial_push="none", perturb=None, estimator="none", report=None, progress=None):
     """Rolls `model` out from `episodes` starts (start: "random", or "paper" for the paper's start
     shifted by up to 2 cm, as `evaluate --start`), as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
     given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
-    a perturbation file or a dict of its fields; docs/robustness.md). progress: a progress bar on
+    a perturbation file or a dict of its fields; docs/robustness.md); estimator: what the policy is
+    shown under sensing factors, as `evaluate --estimator` ("none" or "kalman"). progress: a progress bar on
     stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt.
 
     report: a folder to write the results page of `dicestack evaluate --report DIR` into:
@@ -143,6 +150,7 @@ def evaluate(model, episodes=20, seed=0, *, world=None, start="random", demos=No
             perturbation,
             perturbation_name(perturb),
             os.fspath(report) if report is not None else "",
+            _estimator_name(estimator),
         )
     )
 
@@ -163,7 +171,7 @@ def _names(values, what):
 
 def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
                 profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, start="random",
-                threads=None, out=None, format=None, perturb=None, progress=None):
+                threads=None, out=None, format=None, perturb=None, estimator="none", progress=None):
     """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
     learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
     with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
@@ -179,7 +187,8 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     seeds: training seeds per row. demos: "builtin", "human" or a folder. start: "random" or
     "paper", where training and rollouts start (as `leaderboard --start`). perturb: roll out in
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
-    nominal; docs/robustness.md).
+    nominal; docs/robustness.md); estimator: what the rolled-out policies are shown under sensing
+    factors, as `leaderboard --estimator` ("none" or "kalman").
 
     out: also write the table there, in `format` (md, csv, latex, json or html; None: from the
     file's suffix, .md .csv .tex .json .html, else md; html is a results page with its media in
@@ -215,5 +224,6 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
         format,
         progress_bar(progress),
         "none" if perturb is None else os.fspath(perturb),
+        _estimator_name(estimator),
     )
     return json.loads(table)["rows"]

@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/learners/demonstrator.hpp>
@@ -183,10 +184,12 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
 
 std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episodes, const py::handle& seed,
                            const py::handle& threads, const std::string& push, const py::handle& demos, py::object bar,
-                           const Perturbation& perturbation, const std::string& perturb, const std::filesystem::path& report) {
+                           const Perturbation& perturbation, const std::string& perturb, const std::filesystem::path& report,
+                           const std::string& estimator) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
+  const EstimatorConfig shown = estimator_config(estimator);  // before any work
   const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push,
-                          perturbation.nominal() ? "none" : perturb, start_distribution_name(world)};
+                          perturbation.nominal() ? "none" : perturb, start_distribution_name(world), estimator};
   const InitialPush initial_push = initial_push_from(push);
   const int t = threads_from(threads);
   if (!report.empty()) check_report_replaceable(report);  // before any work, as `evaluate --report`
@@ -204,6 +207,7 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   request.threads = t;
   request.push = initial_push;
   request.perturbation = perturbation;
+  request.estimator = shown;
   request.rollouts = report.empty() ? nullptr : &rollouts;  // the report's previews and per-episode results
   request.results = report.empty() ? nullptr : &results;
   request.progress = [&](int finished, int of) {
@@ -223,7 +227,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
                         const std::vector<std::string>& baselines, const std::vector<std::string>& features,
                         const std::string& profile, const std::string& split, int episodes, int seeds,
                         const py::handle& seed, const py::handle& threads, const std::string& out,
-                        const std::string& format, py::object bar, const std::string& perturb) {
+                        const std::string& format, py::object bar, const std::string& perturb, const std::string& estimator) {
   LeaderboardRequest request;
   request.world = world;
   request.regressors = regressors;
@@ -240,6 +244,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
   request.out = out;
   request.format = format;
   request.perturb = perturb;
+  request.estimator = estimator;
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
   request.demos = resolve_demo_set(demos, world);
@@ -330,7 +335,7 @@ void bind_models(py::module_& m) {
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
         py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"),
         py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none",
-        py::arg("report") = std::filesystem::path());
+        py::arg("report") = std::filesystem::path(), py::arg("estimator") = "none");
   m.def(
       "leaderboard_formats",
       [] {
@@ -342,7 +347,7 @@ void bind_models(py::module_& m) {
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),
-        py::arg("bar"), py::arg("perturb") = "none");
+        py::arg("bar"), py::arg("perturb") = "none", py::arg("estimator") = "none");
 }
 
 }  // namespace dicestack::python

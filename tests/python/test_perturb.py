@@ -122,6 +122,24 @@ def test_the_leaderboard_rolls_out_in_perturbed_worlds(builtin_episodes, tmp_pat
     dicestack.leaderboard(perturb="hard", **args)
     with pytest.raises(ValueError, match="none, easy, medium, hard"):
         dicestack.leaderboard(perturb="sideways", **args)
+    dicestack.leaderboard(perturb="hard", estimator="kalman", **args)
+    with pytest.raises(ValueError, match="none, kalman"):
+        dicestack.leaderboard(perturb="hard", estimator="particles", **args)
+
+
+def test_evaluate_shows_the_policy_the_estimate(builtin_episodes):
+    model = dicestack.train("knn", demos=builtin_episodes[:2], params={"k": 1}, split="none")
+    world = short_world(40)
+    args = dict(world=world, threads=1, perturb={"observation_delay": 2})
+    raw = dicestack.evaluate(model, 3, seed=1, **args)
+    estimated = dicestack.evaluate(model, 3, seed=1, estimator="kalman", **args)
+    assert "estimator" not in raw and estimated["estimator"] == "kalman"
+    nominal = dicestack.evaluate(model, 3, seed=1, world=world, threads=1)
+    plain = dicestack.evaluate(model, 3, seed=1, world=world, threads=1, estimator="kalman")
+    for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate"):
+        assert nominal[key] == plain[key]  # no sensing factor: the estimator is not used
+    with pytest.raises(TypeError, match="estimator"):
+        dicestack.evaluate(model, 3, estimator=None, **args)
 
 
 def test_an_expert_acts_through_the_action_delay_and_stacks():
