@@ -34,7 +34,6 @@ struct EstimatorConfig {
 const std::vector<std::string>& estimator_names();
 /// The estimator of `name` with its default settings; throws ConfigError naming the choices.
 EstimatorConfig estimator_config(std::string_view name);
-const char* to_string(EstimatorKind kind);
 
 /// What a policy is given instead of the raw observation, one episode at a time.
 class Estimator {
@@ -53,8 +52,9 @@ class Estimator {
 /// with the gain of a Kalman filter per pose number and its velocity (the pair's covariance
 /// moved as a pose integrating its velocity, plus the model's error, against the sensor's
 /// noise). The current state is that estimate simulated forward through the actions that ran
-/// since. Contacts are the simulator's: a die riding in the cup is predicted as such. Without
-/// sensor noise it trusts each observation whole and only makes up the delay.
+/// since. Contacts are the simulator's: a die riding in the cup is predicted as such. The model
+/// is rebuilt only where corrected, so without sensor noise, in the nominal world, it runs as
+/// the world does and makes up a delay exactly.
 class KalmanEstimator final : public Estimator {
  public:
   /// `model`: the nominal world; `draw`: the episode's sensing and command delays and its
