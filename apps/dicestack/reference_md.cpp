@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -86,13 +88,19 @@ std::string options_table(const CLI::App& cmd) {
   return "| option | value | default | what |\n|---|---|---|---|\n" + out;
 }
 
+// A command's subcommands, by name.
+std::vector<const CLI::App*> sorted_subcommands(const CLI::App& cmd) {
+  auto subs = cmd.get_subcommands([](const CLI::App*) { return true; });
+  std::sort(subs.begin(), subs.end(), [](const CLI::App* a, const CLI::App* b) { return a->get_name() < b->get_name(); });
+  return subs;
+}
+
 // A command, then its own subcommands, each under a heading one level deeper.
 void command_section(const CLI::App& cmd, const std::string& path, int depth, std::string& out) {
-  auto subs = cmd.get_subcommands([](const CLI::App*) { return true; });
+  const auto subs = sorted_subcommands(cmd);
   const std::string table = options_table(cmd);
   out += "\n" + std::string(static_cast<std::size_t>(depth), '#') + " `" + path + "`\n\n" + cmd.get_description() +
          "\n\n" + (table == "No options.\n" && !subs.empty() ? std::string("Its subcommands follow.\n") : table);
-  std::sort(subs.begin(), subs.end(), [](const CLI::App* a, const CLI::App* b) { return a->get_name() < b->get_name(); });
   for (const CLI::App* sub : subs) command_section(*sub, path + " " + sub->get_name(), depth + 1, out);
 }
 
@@ -109,9 +117,7 @@ std::string cli_reference_markdown(const CLI::App& app) {
          "error. Under `mpirun`, evaluate, record, train, leaderboard, "
          "optimise, reinforce, rrt and robustness share their work among the ranks, with the bytes of one "
          "process (`docs/scaling.md`).\n";
-  auto subs = app.get_subcommands([](const CLI::App*) { return true; });
-  std::sort(subs.begin(), subs.end(), [](const CLI::App* a, const CLI::App* b) { return a->get_name() < b->get_name(); });
-  for (const CLI::App* sub : subs) command_section(*sub, "dicestack " + sub->get_name(), 2, out);
+  for (const CLI::App* sub : sorted_subcommands(app)) command_section(*sub, "dicestack " + sub->get_name(), 2, out);
   return out;
 }
 
