@@ -15,6 +15,7 @@ for page in cli learners perturbations regressors world-config; do
     printf '\n' >> "$tmp"
     sed -n '/^## Version history$/,$p' "$file" >> "$tmp"
   fi
+  chmod 644 "$tmp"  # mktemp makes it owner-only
   mv "$tmp" "$file"
   trap - EXIT
   echo "wrote $file"

@@ -36,6 +36,11 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   auto model = std::make_shared<const Model>(load_model(opt.model));
   check_ahead_world(model->features(), world);
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
+  // A saved episode keeps the true states and replays what the sensors gave (dataset.cpp); the
+  // estimates a policy saw are not replayed, so a set saved behind an estimator would mislead.
+  if (!opt.save_rollouts.empty() && opt.estimator != "none" && senses(perturbation))
+    throw ConfigError("evaluate: --save-rollouts with --estimator: a saved set replays what the sensors gave, not the "
+                      "estimates the policy saw; save the rollouts without the estimator");
   if (!opt.report.empty()) check_report_replaceable(opt.report);
   if (!opt.video_dir.empty() && std::filesystem::exists(opt.video_dir) && !std::filesystem::is_directory(opt.video_dir))
     throw InputError(opt.video_dir.string() + ": --video-dir exists and is not a folder");

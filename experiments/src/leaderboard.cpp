@@ -303,7 +303,8 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   if (!plan.perturbation.nominal())
     header << "; rollouts in perturbed worlds (" << opt.perturb << ": " << perturbation_summary(plan.perturbation)
            << "), drawn per episode; training nominal";
-  if (opt.estimator != "none") header << "; the policies see the " << opt.estimator << " estimator's estimate";
+  if (opt.estimator != "none" && senses(plan.perturbation))
+    header << "; the policies see the " << opt.estimator << " estimator's estimate";
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
            << " budgets, then played from the same random starts";
@@ -314,7 +315,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
                {"training_seeds", opt.seeds}, {"seed", opt.seed}};
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
   if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
-  if (opt.estimator != "none") plan.meta["estimator"] = opt.estimator;
+  if (opt.estimator != "none" && senses(plan.perturbation)) plan.meta["estimator"] = opt.estimator;
   if (start_distribution_name(opt.world) != "random") plan.meta["start"] = start_distribution_name(opt.world);
 }
 

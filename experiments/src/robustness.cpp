@@ -97,8 +97,8 @@ RobustnessTable robustness_table(std::vector<RobustnessRow> rows, const Robustne
              " rollouts per row from evaluation starts (seed " + std::to_string(run.seed) +
              "); rates with 95% Wilson intervals (successes)" +
              (run.reads_world ? "; sensing factors left out (an expert reads the world itself)" : "") +
-             (run.estimator.empty() || run.estimator == "none" ? "" : "; the policy sees the " + run.estimator +
-                                                                         " estimator's estimate");
+             (run.estimator.empty() || run.estimator == "none" ? "" : "; under the sensing factors the policy sees the " +
+                                                                         run.estimator + " estimator's estimate");
   nlohmann::json meta{{"policy", run.policy},
                       {"world", run.world},
                       {"rollouts_per_row", run.episodes},

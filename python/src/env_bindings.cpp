@@ -186,11 +186,12 @@ class VectorEnv {
   /// of resident memory each after a reset and 3 steps of 1,000 and of 10,000 environments.
   static constexpr double kEnvironmentBytes = 120e3;
 
-  VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation)
+  VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation,
+            const EstimatorConfig& estimator)
       : pool_(pool_size(num_envs, threads)) {
     envs_.reserve(static_cast<std::size_t>(num_envs));
     validate(perturbation, world);
-    for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation);
+    for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation, estimator);
     done_.assign(envs_.size(), 0);
     slots_.resize(envs_.size());
   }
@@ -385,10 +386,13 @@ void bind_env(py::module_& m) {
       .def_property_readonly("episode_seed", &EnvCore::episode_seed);
 
   py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
-      .def(py::init([](const WorldConfig& world, long long num_envs, const py::object& threads, const Perturbation& perturbation) {
-             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation);
+      .def(py::init([](const WorldConfig& world, long long num_envs, const py::object& threads, const Perturbation& perturbation,
+                       const std::string& estimator) {
+             const EstimatorConfig shown = estimator_config(estimator);  // before any environment is made
+             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation, shown);
            }),
-           py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none(), py::arg("perturbation") = Perturbation{})
+           py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none(), py::arg("perturbation") = Perturbation{},
+           py::arg("estimator") = "none")
       .def("__len__", &VectorEnv::size)
       .def(
           "reset",

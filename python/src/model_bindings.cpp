@@ -228,6 +228,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
                         const std::string& profile, const std::string& split, int episodes, int seeds,
                         const py::handle& seed, const py::handle& threads, const std::string& out,
                         const std::string& format, py::object bar, const std::string& perturb, const std::string& estimator) {
+  estimator_config(estimator);  // a bad name is refused before any work
   LeaderboardRequest request;
   request.world = world;
   request.regressors = regressors;

@@ -72,6 +72,11 @@ TEST(Estimator, MakesUpAnObservationDelayFromTheActionsThatRan) {
     EXPECT_GT(shown_error(late, estimator_config("none"), seed), 0.1) << "seed " << seed;
     EXPECT_EQ(shown_error(late, estimator_config("kalman"), seed), 0.0) << "seed " << seed;
   }
+  // With the commands late too, the estimator's own queue knows what ran.
+  Perturbation both;
+  both.action_delay = 3;
+  both.observation_delay = 4;
+  EXPECT_EQ(shown_error(both, estimator_config("kalman"), 1), 0.0);
   // Under perturbed physics the model is the nominal world's, and the estimate comes close.
   Perturbation heavy = late;
   heavy.dice_mass = 0.5;

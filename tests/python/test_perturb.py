@@ -135,6 +135,8 @@ def test_evaluate_shows_the_policy_the_estimate(builtin_episodes):
     estimated = dicestack.evaluate(model, 3, seed=1, estimator="kalman", **args)
     assert "estimator" not in raw and estimated["estimator"] == "kalman"
     nominal = dicestack.evaluate(model, 3, seed=1, world=world, threads=1)
+    for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate", "mean_episode_length"):
+        assert estimated[key] == nominal[key]  # a delay in the nominal world is made up exactly
     plain = dicestack.evaluate(model, 3, seed=1, world=world, threads=1, estimator="kalman")
     for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate"):
         assert nominal[key] == plain[key]  # no sensing factor: the estimator is not used
@@ -200,6 +202,13 @@ def test_the_estimator_shows_an_estimate_nearer_the_state_under_a_delay(rng):
     assert np.abs(estimated[0] - estimated[1]).mean() < 0.2 * np.abs(raw[0] - raw[1]).mean()
     nominal = episode(dicestack.DiceStackEnv(estimator="kalman"), 5, actions)
     assert np.array_equal(nominal[0], nominal[1])  # no sensing factor: the state itself
+    vec = dicestack.DiceStackVectorEnv(2, perturb={"observation_delay": 3}, estimator="kalman", threads=1)
+    obs, _ = vec.reset(seed=[5, 6])
+    single, _ = dicestack.DiceStackEnv(perturb={"observation_delay": 3}, estimator="kalman").reset(seed=5)
+    assert np.array_equal(obs[0], single)
+    for a in actions[:10]:
+        obs, *_ = vec.step(np.array([a, a]))
+    assert np.array_equal(obs[0], estimated[0][10])  # as the single environment shows it
 
 
 @pytest.mark.parametrize("estimator, error", [("particles", ValueError), (3, TypeError), ("x" * 100000, ValueError)])

@@ -17,10 +17,11 @@ PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw)
 
 PerturbedEnv::PerturbedEnv(DiceEnv& env) : env_(&env), model_(&env.config()) { draw_.world = env.config(); }
 
-void PerturbedEnv::use_estimator(const EstimatorConfig& config) { estimator_ = make_estimator(config, *model_, draw_); }
+void PerturbedEnv::use_estimator(const EstimatorConfig& config) { estimator_config_ = config; }
 
 State PerturbedEnv::first_shown(const State& start) {
   const State observed = channel_ ? channel_->observe(start) : start;
+  estimator_ = make_estimator(estimator_config_, *model_, draw_);
   return estimator_ ? estimator_->start(observed) : observed;
 }
 

@@ -79,7 +79,8 @@ class PerturbedEnv {
   DiceEnv* env_;
   const WorldConfig* model_;  // the nominal world, an estimator's model
   std::optional<PerturbedChannel> channel_;
-  std::unique_ptr<Estimator> estimator_;
+  EstimatorConfig estimator_config_;
+  std::unique_ptr<Estimator> estimator_;  // made at each reset from estimator_config_
   Action executed_noise_{0.0, 0.0, 0.0};
   bool noisy_ = false;
   Rng noise_{0};
