@@ -342,6 +342,26 @@ TEST(CliLearning, TrainThenEvaluateEndToEnd) {
   std::filesystem::remove(model);
 }
 
+// A saved set replays what the sensors gave, not the estimates the policy saw: saving rollouts
+// behind an estimator under sensing factors is refused before any rollout, and nothing is written.
+TEST(CliLearning, SavedRolloutsBehindAnEstimatorAreRefusedUnderSensingFactors) {
+  const auto model = test::scratch_path("dicestack_cli_estimated.dsm");
+  const auto set = test::scratch_path("dicestack_cli_estimated_set");
+  std::filesystem::remove_all(set);
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --out " + model.string()).status, 0);
+  const std::string base = "evaluate --model " + model.string() + " --episodes 2 --save-rollouts " + set.string();
+  const Process sensed = run_within(10, base + " --estimator kalman --perturb medium");
+  EXPECT_EQ(sensed.status, 1) << sensed.output;
+  EXPECT_THAT(sensed.output, HasSubstr("--save-rollouts with --estimator"));
+  EXPECT_FALSE(std::filesystem::exists(set));
+  // Without sensing factors no estimator runs, and the set is saved.
+  const Process nominal = run_within(60, base + " --estimator kalman");
+  EXPECT_EQ(nominal.status, 0) << nominal.output;
+  EXPECT_TRUE(std::filesystem::exists(set / "meta.json"));
+  std::filesystem::remove_all(set);
+  std::filesystem::remove(model);
+}
+
 TEST(CliLearning, PaperStartsAreNamedWhereTheyAreUsedAndAnotherNameIsRefused) {
   const auto model = test::scratch_path("dicestack_cli_start.dsm");
   const auto rollouts = test::scratch_path("dicestack_cli_start_rollouts");
