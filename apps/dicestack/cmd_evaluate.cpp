@@ -26,7 +26,7 @@ struct EvaluateOptions {
   int threads = 0;
   std::string push = "none";
   std::string perturb = "none";
-  std::string estimator = "none";
+  std::string estimator;  // empty: the model's own
   bool json = false;
 };
 
@@ -35,10 +35,11 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   auto model = std::make_shared<const Model>(load_model(opt.model));
   check_ahead_world(model->features(), world);
+  const std::string estimator = estimator_for(opt.estimator, *model);
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
   // A saved episode keeps the true states and replays what the sensors gave (dataset.cpp); the
   // estimates a policy saw are not replayed, so a set saved behind an estimator would mislead.
-  if (!opt.save_rollouts.empty() && opt.estimator != "none" && senses(perturbation))
+  if (!opt.save_rollouts.empty() && estimator != "none" && senses(perturbation))
     throw ConfigError("evaluate: --save-rollouts with --estimator: a saved set replays what the sensors gave, not the "
                       "estimates the policy saw; save the rollouts without the estimator");
   if (!opt.report.empty()) check_report_replaceable(opt.report);
@@ -56,12 +57,12 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   request.threads = opt.threads;
   request.push = initial_push_from(opt.push);
   request.perturbation = perturbation;
-  request.estimator = estimator_config(opt.estimator);
+  request.estimator = estimator_config(estimator);
   request.rollouts = keep ? &rollouts : nullptr;
   request.results = &results;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);
   if (!cluster.is_root()) return 0;  // the root writes and prints
-  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb, opt.world.start, opt.estimator};
+  const EvaluationRun run{opt.model.string(), opt.seed, opt.push, opt.perturb, opt.world.start, estimator};
   if (!opt.report.empty())
     write_report_folder(evaluation_board(run, *model, s, results, rollouts, world, errors ? &*errors : nullptr), opt.report);
   if (!opt.video_dir.empty()) {
@@ -84,7 +85,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
     set.description = "rollouts of " + opt.model.string();
     set.provenance = "dicestack evaluate --model " + opt.model.string() + " --episodes " + std::to_string(opt.episodes) +
                      (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
-                     (opt.estimator == "none" ? "" : " --estimator " + opt.estimator) +
+                     (estimator == "none" ? "" : " --estimator " + estimator) +
                      (opt.world.start == "random" ? "" : " --start " + opt.world.start) + " --seed " + std::to_string(opt.seed) + "; episode i starts from evaluation_start_seed(seed, i)";
     set.episodes = std::move(rollouts);
     write_demo_set(set, opt.save_rollouts);
@@ -101,7 +102,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
                 opt.model.string().c_str(), model->regressor().name().c_str(), s.episodes,
                 opt.world.start == "random" ? "" : (" from " + opt.world.start + " starts").c_str(),
                 static_cast<unsigned long long>(opt.seed),
-                opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb + (opt.estimator == "none" ? "" : ", estimator " + opt.estimator)).c_str(),
+                opt.perturb == "none" ? "" : (", perturbed: " + opt.perturb + (estimator == "none" ? "" : ", estimator " + estimator)).c_str(),
                 100 * s.realistic_success.value, 100 * s.realistic_success.low,
                 100 * s.realistic_success.high, 100 * s.stacked.value, 100 * s.stacked.low, 100 * s.stacked.high,
                 100 * s.wall_contact.value, 100 * s.wall_contact.low, 100 * s.wall_contact.high, s.dice_in_cup_mean,

@@ -22,7 +22,8 @@ namespace {
 struct RobustnessOptions {
   WorldOption world;
   std::filesystem::path model, demos, out;
-  std::string expert, format = "md", expert_feedback = "world", estimator = "none";
+  std::string expert, format = "md", expert_feedback = "world";
+  std::string estimator;  // empty: the model's own, none for an expert
   int episodes = 100;
   std::uint64_t seed = 0;
   int threads = 0;
@@ -40,7 +41,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   const bool sensed = opt.expert_feedback == "observations";
   if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
-  if (opt.estimator != "none" && !opt.expert.empty() && !sensed)
+  if (!opt.estimator.empty() && opt.estimator != "none" && !opt.expert.empty() && !sensed)
     throw ConfigError("robustness: --estimator stands between the sensors and the policy: with --expert it needs "
                       "--expert-feedback observations (the expert's own feedback reads the world)");
   {
@@ -60,11 +61,11 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   request.seed = opt.seed;
   request.threads = opt.threads;
   request.factors = opt.factors;
-  request.estimator = estimator_config(opt.estimator);
-  run.estimator = opt.estimator;
+  run.estimator = opt.estimator.empty() ? "none" : opt.estimator;
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
     check_ahead_world(model->features(), world);
+    run.estimator = estimator_for(opt.estimator, *model);
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
     run.policy = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
     run.record = model->record;
@@ -84,6 +85,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
                  (sensed ? ", feedback on the observations" : "");
     request.reads_world = !sensed;
   }
+  request.estimator = estimator_config(run.estimator);
   run.reads_world = request.reads_world;
   if (cluster.is_root())
     request.progress = [&](int row, int rows, const std::string& factor, const std::string& level) {

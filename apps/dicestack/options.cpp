@@ -125,10 +125,10 @@ CLI::Validator threads_check() {
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {
   return cmd
       .add_option("--estimator", name,
-                  "What the policy is shown under sensing factors: none (the observations) or kalman (a Kalman "
-                  "filter whose motion model is the simulator; docs/robustness.md)")
-      ->check(CLI::IsMember(estimator_names()))
-      ->capture_default_str();
+                  "What the policy is shown under sensing factors and delays: none (the observations) or kalman (a "
+                  "Kalman filter whose motion model is the simulator; docs/robustness.md). Default: the model's own "
+                  "(a policy trained with perturb= runs behind the estimator it names), none otherwise")
+      ->check(CLI::IsMember(estimator_names()));
 }
 
 CLI::Validator seed_check() {

@@ -303,7 +303,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   if (!plan.perturbation.nominal())
     header << "; rollouts in perturbed worlds (" << opt.perturb << ": " << perturbation_summary(plan.perturbation)
            << "), drawn per episode; training nominal";
-  if (opt.estimator != "none" && senses(plan.perturbation))
+  if (!opt.estimator.empty() && opt.estimator != "none" && senses(plan.perturbation))
     header << "; the policies see the " << opt.estimator << " estimator's estimate";
   if (!opt.baselines.empty())
     header << "; baselines optimised from the paper's start with the " << opt.profile
@@ -315,7 +315,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
                {"training_seeds", opt.seeds}, {"seed", opt.seed}};
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
   if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
-  if (opt.estimator != "none" && senses(plan.perturbation)) plan.meta["estimator"] = opt.estimator;
+  if (!opt.estimator.empty() && opt.estimator != "none" && senses(plan.perturbation)) plan.meta["estimator"] = opt.estimator;
   if (start_distribution_name(opt.world) != "random") plan.meta["start"] = start_distribution_name(opt.world);
 }
 
@@ -520,7 +520,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   plan.learners = opt.learners.empty() ? plan.profile->learners : opt.learners;
   check_request(plan);
   plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
-  const EstimatorConfig estimator = estimator_config(opt.estimator);
+  if (!opt.estimator.empty()) estimator_config(opt.estimator);  // a bad name, before any work
   {
     EvalRequest rollouts;
     rollouts.episodes = plan.episodes;
@@ -559,7 +559,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   settings.seed = opt.seed;
   settings.threads = opt.threads;
   settings.perturbation = plan.perturbation;
-  settings.estimator = estimator;
+  settings.estimator = opt.estimator;
   settings.previews = opt.format == "html";
   settings.learner_options = [&plan](const std::string& spec) { return plan.options_for(spec); };
   const RowRunner runner(settings, report);

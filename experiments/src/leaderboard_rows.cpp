@@ -159,7 +159,7 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   request.seed = seed;
   request.threads = s_.threads;
   request.perturbation = s_.perturbation;
-  request.estimator = s_.estimator;
+  request.estimator = estimator_config(estimator_for(s_.estimator, *model));
   request.progress = [&](int finished, int of) { report_(rollouts_text, at(0.5 + 0.5 * finished / of), false); };
   std::vector<Episode> episodes;
   keep_rollouts(request, s_.previews, r.results, episodes);
@@ -181,7 +181,7 @@ LeaderboardRow RowRunner::baseline_row(const std::string& name, Cluster& inner, 
     request.seed = s_.seed + static_cast<std::uint64_t>(k);
     request.threads = s_.threads;
     request.perturbation = s_.perturbation;
-    request.estimator = s_.estimator;
+    request.estimator = estimator_config(s_.estimator.empty() ? "none" : s_.estimator);
     request.progress = [&](int finished, int of) {
       report_("baseline " + name, from + span * (k + static_cast<double>(finished) / of) / s_.seeds, false);
     };

@@ -27,7 +27,7 @@ struct RowSettings {
   std::uint64_t seed = 0;            ///< the first training seed, and the rollouts' starts
   int threads = 0;
   Perturbation perturbation;  ///< the rollouts' worlds, drawn per episode
-  EstimatorConfig estimator;  ///< what the rollouts' policies are shown under sensing factors
+  std::string estimator;  ///< what the rollouts' policies are shown under sensing factors (empty: each model's own)
   bool previews = false;      ///< keep each row's first successful and first failed rollout whole
   /// The options a learner runs with (the profile's, then the user's).
   std::function<std::vector<std::string>(const std::string& learner)> learner_options;

@@ -63,7 +63,7 @@ class Dagger final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
-    const Perturbation perturbation = learner_perturbation(params(), c.world, "dagger");  // before any work
+    const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dagger");  // before any work
     const DaggerSettings d = dagger_settings(params(), c.features);
     const int iterations = d.iterations, rollouts = d.rollouts;
     const std::string& expert_name = d.expert;
@@ -98,7 +98,7 @@ class Dagger final : public Learner {
             if (!expert) expert = make_expert(expert_name, expert_config);
             Episode e = mixture_rollout(envs.at(w), *expert, model.get(), beta,
                                         training_start_seed(derive_seed(c.seed, static_cast<std::uint64_t>(i)), k),
-                                        perturbation);
+                                        perturbation.trained);
             const int done = std::min(rollouts, ++finished * ranks);
             if (c.progress && w == 0)  // one thread reports
               c.progress({"rollouts", i, iterations, 0, 0, done, rollouts, (i - 1 + static_cast<double>(done) / rollouts) / iterations});
@@ -124,7 +124,7 @@ class Dagger final : public Learner {
       model->record["tracker_followed"] = followed_recordings(*expert_config.recordings);
       model->record["tracker_settings"] = tracker_summary(expert_config.recordings->config());
     }
-    if (!perturbation.nominal()) model->record["perturb"] = params().choice("perturb");
+    record_perturbation(perturbation, *model);
     result.model = model;
     return result;
   }
@@ -141,7 +141,7 @@ class Dagger final : public Learner {
             retry_param_spec(),
             {"include_demos", ParamType::boolean, "true", 0, 1, "start the aggregate from the demonstrations", {}}};
     for (auto& p : tracker_param_specs()) specs.push_back(std::move(p));
-    specs.push_back(perturb_param_spec());
+    for (auto& p : perturb_param_specs()) specs.push_back(std::move(p));
     return specs;
   }
 

@@ -69,7 +69,7 @@ class Dart final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
-    const Perturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
+    const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
     const DartSettings d = dart_settings(params(), c.features);
     const int episodes = d.episodes;
     if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
@@ -85,7 +85,7 @@ class Dart final : public Learner {
     request.seed = c.seed;
     request.threads = c.threads;
     request.noise = d.noise;
-    request.perturbation = perturbation;
+    request.perturbation = perturbation.trained;
     auto recorded = record_expert(d.expert, expert, c.world, request, *c.cluster);
     int successes = 0;
     for (auto& e : recorded) {
@@ -109,7 +109,7 @@ class Dart final : public Learner {
       r.model->record["tracker_settings"] = tracker_summary(expert.recordings->config());
     }
     r.model->record["dart_expert_successes"] = std::to_string(successes);
-    if (!perturbation.nominal()) r.model->record["perturb"] = params().choice("perturb");
+    record_perturbation(perturbation, *r.model);
     if (c.progress) c.progress({"fit", 1, 1, 0, 0, 1, 1, 1.0});
     return r;
   }
@@ -147,7 +147,7 @@ class Dart final : public Learner {
             {"include_demos", ParamType::boolean, "false", 0, 1, "also fit on the given demonstrations (--demos)", {}}};
     std::vector<ParamSpec> out = specs;
     for (auto& p : tracker_param_specs()) out.push_back(std::move(p));
-    out.push_back(perturb_param_spec());
+    for (auto& p : perturb_param_specs()) out.push_back(std::move(p));
     return out;
   }
 };

@@ -161,6 +161,21 @@ Episode unpack_one(std::string_view bytes) { return episode_from_bytes(bytes); }
 
 }  // namespace
 
+std::string estimator_for(const std::string& asked, const Model& model) {
+  if (!asked.empty()) {
+    estimator_config(asked);
+    return asked;
+  }
+  const auto named = model.record.find("estimator");
+  if (named == model.record.end()) return "none";
+  try {
+    estimator_config(named->second);
+  } catch (const Error& e) {
+    throw ConfigError(std::string("the model's record names an estimator this build does not know: ") + e.what());
+  }
+  return named->second;
+}
+
 void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   validate(request.perturbation, world);
   require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),

@@ -4,6 +4,7 @@
 
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/registry_lookup.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/demo_set.hpp>
@@ -121,19 +122,40 @@ void write_curve_csv(const std::vector<CurvePoint>& curve, const fs::path& path)
   f.commit();
 }
 
-ParamSpec perturb_param_spec() {
-  return {"perturb", ParamType::text, "none", 0, 0,
-          "domain randomisation: each episode in its own world drawn from its seed (none, easy, medium, hard or a "
-          "perturbation file; docs/robustness.md)",
-          {}};
+std::vector<ParamSpec> perturb_param_specs() {
+  std::vector<ParamSpec> specs{
+      {"perturb", ParamType::text, "none", 0, 0,
+       "domain randomisation: each episode in its own world drawn from its seed (none, easy, medium, hard or a "
+       "perturbation file; docs/robustness.md)",
+       {}},
+      {"estimator", ParamType::choice, "kalman", 0, 0,
+       "under perturb's sensing factors and delays: kalman trains without them and the policy runs behind the "
+       "estimator (the model names it); none trains through them, on what the sensors gave",
+       estimator_names()}};
+  return specs;
 }
 
-Perturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner) {
+TrainingPerturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner) {
+  TrainingPerturbation t;
+  t.name = params.choice("perturb");
   try {
-    return load_perturbation(params.choice("perturb"), world);
+    t.trained = load_perturbation(t.name, world);
   } catch (const Error& e) {
     throw ConfigError(learner + ": option perturb: " + e.what());
   }
+  if (params.choice("estimator") == "none" || !senses(t.trained)) return t;
+  t.estimator = params.choice("estimator");
+  t.trained.observation_noise = 0.0;
+  t.trained.observation_delay = 0;
+  t.trained.action_delay = 0;
+  t.trained.delays_drawn = false;
+  return t;
+}
+
+void record_perturbation(const TrainingPerturbation& p, Model& model) {
+  if (p.trained.nominal() && p.estimator == "none") return;
+  model.record["perturb"] = p.name;
+  if (p.estimator != "none") model.record["estimator"] = p.estimator;
 }
 
 }  // namespace dicestack

@@ -110,20 +110,23 @@ def train(regressor, learner="bc", demos="builtin", features=None, options=None,
 
 
 def _estimator_name(estimator):
+    if estimator is None:
+        return ""  # each model's own
     if not isinstance(estimator, str):
         raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
     return estimator
 
 
 def evaluate(model, episodes=20, seed=0, *, world=None, start="random", demos=None, threads=None,
-             initial_push="none", perturb=None, estimator="none", report=None, progress=None):
+             initial_push="none", perturb=None, estimator=None, report=None, progress=None):
     """Rolls `model` out from `episodes` starts (start: "random", or "paper" for the paper's start
     shifted by up to 2 cm, as `evaluate --start`), as `dicestack evaluate --json` does, and
     returns that command's object as a dict (stacked_rate, wall_contact_rate,
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
     given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
     a perturbation file or a dict of its fields; docs/robustness.md); estimator: what the policy is
-    shown under sensing factors, as `evaluate --estimator` ("none" or "kalman"). progress: a progress bar on
+    shown under sensing factors and delays, as `evaluate --estimator` ("none" or "kalman"; None: the
+    model's own, the one a policy trained with perturb= names, else none). progress: a progress bar on
     stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt.
 
     report: a folder to write the results page of `dicestack evaluate --report DIR` into:
@@ -171,7 +174,7 @@ def _names(values, what):
 
 def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
                 profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, start="random",
-                threads=None, out=None, format=None, perturb=None, estimator="none", progress=None):
+                threads=None, out=None, format=None, perturb=None, estimator=None, progress=None):
     """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
     learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
     with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
@@ -188,7 +191,7 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     "paper", where training and rollouts start (as `leaderboard --start`). perturb: roll out in
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
     nominal; docs/robustness.md); estimator: what the rolled-out policies are shown under sensing
-    factors, as `leaderboard --estimator` ("none" or "kalman").
+    factors and delays, as `leaderboard --estimator` ("none" or "kalman"; None: each model's own).
 
     out: also write the table there, in `format` (md, csv, latex, json or html; None: from the
     file's suffix, .md .csv .tex .json .html, else md; html is a results page with its media in

@@ -187,9 +187,10 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
                            const Perturbation& perturbation, const std::string& perturb, const std::filesystem::path& report,
                            const std::string& estimator) {
   if (episodes < 1) throw py::value_error("episodes must be at least 1, got " + std::to_string(episodes));
-  const EstimatorConfig shown = estimator_config(estimator);  // before any work
+  const std::string behind = estimator_for(estimator, *m.model);  // before any work
+  const EstimatorConfig shown = estimator_config(behind);
   const EvaluationRun run{m.path.empty() ? "<in memory>" : m.path, seed_from(seed).value_or(0), push,
-                          perturbation.nominal() ? "none" : perturb, start_distribution_name(world), estimator};
+                          perturbation.nominal() ? "none" : perturb, start_distribution_name(world), behind};
   const InitialPush initial_push = initial_push_from(push);
   const int t = threads_from(threads);
   if (!report.empty()) check_report_replaceable(report);  // before any work, as `evaluate --report`
@@ -228,7 +229,7 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
                         const std::string& profile, const std::string& split, int episodes, int seeds,
                         const py::handle& seed, const py::handle& threads, const std::string& out,
                         const std::string& format, py::object bar, const std::string& perturb, const std::string& estimator) {
-  estimator_config(estimator);  // a bad name is refused before any work
+  if (!estimator.empty()) estimator_config(estimator);  // a bad name is refused before any work
   LeaderboardRequest request;
   request.world = world;
   request.regressors = regressors;
@@ -336,7 +337,7 @@ void bind_models(py::module_& m) {
   m.def("evaluate", &evaluate_model, py::arg("model"), py::arg("world"), py::arg("episodes"), py::arg("seed"),
         py::arg("threads"), py::arg("initial_push"), py::arg("demos"), py::arg("bar"),
         py::arg("perturbation") = Perturbation{}, py::arg("perturb") = "none",
-        py::arg("report") = std::filesystem::path(), py::arg("estimator") = "none");
+        py::arg("report") = std::filesystem::path(), py::arg("estimator") = "");
   m.def(
       "leaderboard_formats",
       [] {
@@ -348,7 +349,7 @@ void bind_models(py::module_& m) {
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),
-        py::arg("bar"), py::arg("perturb") = "none", py::arg("estimator") = "none");
+        py::arg("bar"), py::arg("perturb") = "none", py::arg("estimator") = "");
 }
 
 }  // namespace dicestack::python

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <unistd.h>
 
@@ -79,6 +80,43 @@ TEST(Dart, TrainsUnderRandomisedWorldsOnAnyThreadCount) {
   for (const char* learner_name : {"dart", "dagger"})
     EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create(learner_name, {"perturb=extreme"})->learn(c); }),
                 HasSubstr(std::string(learner_name) + ": option perturb: "));
+}
+
+// Behind the estimator (the default), a level's sensing factors and delays are the estimator's
+// to make up: training randomises the rest, and the model names the estimator it runs behind.
+TEST(Dart, ALevelWithSensingTrainsWithoutItAndTheModelNamesTheEstimator) {
+  const WorldConfig w = test::short_world(60);
+  const auto parsed = [&](std::vector<std::string> options) {
+    const auto learner = LearnerRegistry::global().create("dart", std::move(options));
+    return learner_perturbation(learner->params(), w, "dart");
+  };
+  const TrainingPerturbation behind = parsed({"perturb=medium"});
+  Perturbation expected = perturbation_level("medium");
+  expected.observation_noise = 0.0;
+  expected.observation_delay = expected.action_delay = 0;
+  EXPECT_EQ(behind.trained, expected);
+  EXPECT_EQ(behind.estimator, "kalman");
+  const TrainingPerturbation through = parsed({"perturb=medium", "estimator=none"});
+  EXPECT_EQ(through.trained, perturbation_level("medium"));
+  EXPECT_EQ(through.estimator, "none");
+  // Nothing to estimate: no estimator named.
+  const std::filesystem::path physics = test::scratch_path("physics.json");
+  {
+    std::ofstream f(physics);
+    f << R"({"format": "dicestack-perturbation", "version": 2, "friction": 0.3})";
+  }
+  EXPECT_EQ(parsed({"perturb=" + physics.string()}).estimator, "none");
+  std::filesystem::remove(physics);
+
+  LearnContext c = knn_context();
+  const LearnResult model = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false", "perturb=medium"})->learn(c);
+  EXPECT_EQ(model.model->record.at("estimator"), "kalman");
+  EXPECT_EQ(estimator_for("", *model.model), "kalman");
+  EXPECT_EQ(estimator_for("none", *model.model), "none");
+  const auto nominal = LearnerRegistry::global().create("dart", {"episodes=4", "successes_only=false"})->learn(c);
+  EXPECT_EQ(estimator_for("", *nominal.model), "none");
+  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", {"estimator=particles"}); }),
+              HasSubstr("estimator"));
 }
 
 TEST(Dart, RecordedEpisodesUnderAPerturbationAreThreadIndependent) {

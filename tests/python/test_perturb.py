@@ -140,8 +140,10 @@ def test_evaluate_shows_the_policy_the_estimate(builtin_episodes):
     plain = dicestack.evaluate(model, 3, seed=1, world=world, threads=1, estimator="kalman")
     for key in ("dice_in_cup_mean", "realistic_success_rate", "stacked_rate"):
         assert nominal[key] == plain[key]  # no sensing factor: the estimator is not used
+    own = dicestack.evaluate(model, 3, seed=1, estimator=None, **args)  # the model's own: it names none
+    assert "estimator" not in own and own["dice_in_cup_mean"] == raw["dice_in_cup_mean"]
     with pytest.raises(TypeError, match="estimator"):
-        dicestack.evaluate(model, 3, estimator=None, **args)
+        dicestack.evaluate(model, 3, estimator=3, **args)
 
 
 def test_an_expert_acts_through_the_action_delay_and_stacks():

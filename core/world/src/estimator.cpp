@@ -42,7 +42,9 @@ const std::vector<std::string>& estimator_names() {
   return names;
 }
 
-bool senses(const Perturbation& p) { return p.observation_noise > 0.0 || p.observation_delay > 0; }
+bool senses(const Perturbation& p) {
+  return p.observation_noise > 0.0 || p.observation_delay > 0 || p.action_delay > 0;
+}
 
 EstimatorConfig estimator_config(std::string_view name) {
   EstimatorConfig c;
@@ -73,7 +75,7 @@ State KalmanEstimator::start(const State& observed) {
   steps_ = lagged_step_ = 0;
   queue_.assign(static_cast<std::size_t>(action_delay_), Action{0.0, 0.0, 0.0});
   since_.clear();
-  return lagged_;
+  return ahead();
 }
 
 void KalmanEstimator::predict() {
@@ -132,17 +134,22 @@ State KalmanEstimator::update(const Action& chosen, const State& observed) {
   // when that moved on by a step, the lagged estimate is predicted through it first.
   if (steps_ - observation_delay_ > lagged_step_) predict();
   correct(observed);
-  if (since_.empty()) return lagged_;
+  return ahead();
+}
+
+State KalmanEstimator::ahead() {
+  if (since_.empty() && queue_.empty()) return lagged_;
   const WorldSnapshot at_lagged = model_.snapshot();
   for (const Action& a : since_) model_.step(a);
-  const State now = model_.state();
+  for (const Action& a : queue_) model_.step(a);
+  const State landing = model_.state();
   model_.restore(at_lagged);
-  return now;
+  return landing;
 }
 
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
                                           const PerturbationDraw& draw) {
-  bool sensed = draw.observation_delay > 0;
+  bool sensed = draw.observation_delay > 0 || draw.action_delay > 0;
   for (double sigma : draw.observation_noise) sensed = sensed || sigma > 0.0;
   if (config.kind == EstimatorKind::none || !sensed) return nullptr;
   return std::make_unique<KalmanEstimator>(model, draw, config);

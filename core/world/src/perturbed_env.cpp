@@ -57,7 +57,9 @@ PerturbedStep PerturbedEnv::step(const Action& chosen) {
   return s;
 }
 
-const std::deque<Action>& PerturbedEnv::pending() const { return channel_ ? channel_->pending() : none_; }
+const std::deque<Action>& PerturbedEnv::pending() const {
+  return channel_ && !estimator_ ? channel_->pending() : none_;
+}
 
 const std::deque<Action>& PerturbedEnv::unseen() const {
   return channel_ && !estimator_ ? channel_->unseen() : none_;

@@ -39,9 +39,10 @@ struct LeaderboardRequest {
   /// The rollouts' worlds: "none" (the nominal world: today's table byte for byte),
   /// a level or a perturbation file; training stays nominal (learners take perturb= for that).
   std::string perturb = "none";
-  /// What the rollouts' policies are shown under sensing factors: "none" (the observations) or
-  /// an estimator's name (estimator.hpp).
-  std::string estimator = "none";
+  /// What the rollouts' policies are shown under sensing factors and delays: "none" (the
+  /// observations), an estimator's name (estimator.hpp), or empty: each model's own
+  /// (estimator_for; none for a baseline).
+  std::string estimator;
   /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
   /// before any work (a user's file is refused), and finished rows go to <out>.partial.json as
   /// they come, so that a rerun with the same settings resumes.

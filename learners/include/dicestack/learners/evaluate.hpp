@@ -111,6 +111,12 @@ struct EvalRequest {
   RolloutProgress progress;
 };
 
+/// The estimator an evaluation of `model` runs behind, by name: `asked` when not empty, else the
+/// one the model was trained to run behind (its record's "estimator", written by a learner whose
+/// perturb= has sensing factors or delays), else none. Throws ConfigError for a name that is not
+/// an estimator's, naming where it came from.
+std::string estimator_for(const std::string& asked, const Model& model);
+
 /// Throws ConfigError, before any work, for an evaluation that could not run: a perturbation
 /// the world cannot take, more rollouts than this machine's memory holds, a thread count out of
 /// range. evaluate() calls it, and so does every command that evaluates after other work (the

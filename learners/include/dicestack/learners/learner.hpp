@@ -143,10 +143,27 @@ std::string default_features(std::string_view learner, const std::vector<std::st
 std::shared_ptr<Model> fit_model(const LearnContext& context, const std::vector<Episode>& data, std::uint64_t seed,
                                  const RowFilter& rows = {});
 
-/// The `perturb` option of the learners that record episodes (DART, DAgger): domain
-/// randomisation, each training episode in its own world drawn from its seed (LEVEL or FILE).
-ParamSpec perturb_param_spec();
-/// That option's perturbation, checked against `world`; throws ConfigError naming the option.
-Perturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner);
+/// The `perturb` and `estimator` options of the learners that record episodes (DART, DAgger):
+/// domain randomisation, each training episode in its own world drawn from its seed (LEVEL or
+/// FILE), and what stands between the sensors and the policy.
+std::vector<ParamSpec> perturb_param_specs();
+
+/// How a learner's episodes are perturbed, and what the policy will run behind.
+struct TrainingPerturbation {
+  /// The draws the training episodes run in.
+  Perturbation trained;
+  /// "none", or the estimator the policy is to run behind (the model names it, and evaluation
+  /// uses it unless told otherwise). With an estimator, the perturbation's sensing factors and
+  /// delays are left out of training: the estimator shows the policy the state its action lands
+  /// in, so the policy is trained on the state and the expert labels it (a label then depends on
+  /// nothing the policy does not see).
+  std::string estimator = "none";
+  /// The option as given, for the model's record ("none": nominal).
+  std::string name = "none";
+};
+/// Those options, checked against `world`; throws ConfigError naming the option.
+TrainingPerturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner);
+/// Names `p` in the model's record: "perturb", and "estimator" when the policy runs behind one.
+void record_perturbation(const TrainingPerturbation& p, Model& model);
 
 }  // namespace dicestack

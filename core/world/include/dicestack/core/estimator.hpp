@@ -36,8 +36,8 @@ const std::vector<std::string>& estimator_names();
 /// The estimator of `name` with its default settings; throws ConfigError naming the choices.
 EstimatorConfig estimator_config(std::string_view name);
 
-/// True when `p` perturbs what a policy senses (observation noise or delay): only then does an
-/// estimator run.
+/// True when `p` perturbs what a policy senses (observation noise or delay) or when its commands
+/// run (action delay): only then does an estimator run.
 bool senses(const Perturbation& p);
 
 /// What a policy is given instead of the raw observation, one episode at a time.
@@ -47,7 +47,10 @@ class Estimator {
   /// The episode's first observation; returns the estimate of the start.
   virtual State start(const State& observed) = 0;
   /// After one control step: what the policy chose for it (clipped to the world's limits) and
-  /// what the sensor gave after it; returns the estimate of the current state.
+  /// what the sensor gave after it; returns the estimate of the state the next choice acts on:
+  /// under a command delay, the state it lands in (what ran, plus what is queued), so a policy
+  /// trained without the delay acts on the state its action meets. A policy's clock stays the
+  /// count of its own choices: the choice lands after as many of them as it would without.
   virtual State update(const Action& chosen, const State& observed) = 0;
 };
 
@@ -57,7 +60,8 @@ class Estimator {
 /// with the gain of a Kalman filter per pose number and its velocity (the pair's covariance
 /// moved as a pose integrating its velocity, plus the model's error, against the sensor's
 /// noise). The current state is that estimate simulated forward through the actions that ran
-/// since. Contacts are the simulator's: a die riding in the cup is predicted as such. The model
+/// since, and through the commands queued but not run yet (a command delay: the state the next
+/// action lands in). Contacts are the simulator's: a die riding in the cup is predicted as such. The model
 /// is rebuilt only where corrected, so without sensor noise, in the nominal world, it runs as
 /// the world does and makes up a delay exactly.
 class KalmanEstimator final : public Estimator {
@@ -74,6 +78,7 @@ class KalmanEstimator final : public Estimator {
   };
   void predict();
   void correct(const State& observed);
+  State ahead();
 
   World model_;
   double dt_;
@@ -89,8 +94,8 @@ class KalmanEstimator final : public Estimator {
   std::deque<Action> since_;  // what ran from lagged_step_ to now, in order
 };
 
-/// The estimator of `config` for one episode (nullptr for none, and when the draw's sensing is
-/// nominal: the policy then sees the state itself). Each episode needs its own: start() first.
+/// The estimator of `config` for one episode (nullptr for none, and when the draw's sensing and
+/// command timing are nominal: the policy then sees the state itself). Each episode needs its own: start() first.
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
                                           const PerturbationDraw& draw);
 

@@ -67,7 +67,8 @@ class PerturbedEnv {
   bool perturbed() const { return draw_.physics || draw_.acts; }
   /// True when the actuation or sensing is perturbed: what the policy is shown is not the state.
   bool channelled() const { return channel_.has_value(); }
-  /// What runs before the next choice under an action delay (History::pending). Empty without.
+  /// What runs before the next choice under an action delay (History::pending). Empty without,
+  /// and with an estimator: its estimate is of the state the next choice lands in.
   const std::deque<Action>& pending() const;
   /// What ran since the state last shown, under an observation delay (History::unseen). Empty
   /// without, and with an estimator: its estimate is of the current state.
