@@ -41,6 +41,7 @@ void add_bench_dataset_command(CLI::App& bench);     // under `bench`
 void add_interop_commands(CLI::App& import, CLI::App& dataset);  // import robomimic|minari, dataset export
 void add_bench_optimise_command(CLI::App& bench);    // under `bench`
 void add_bench_estimator_command(CLI::App& bench);   // under `bench`
+void add_bench_arm_command(CLI::App& bench);         // under `bench`
 void add_optimise_command(CLI::App& app, Cluster& cluster);
 void add_reinforce_command(CLI::App& app, Cluster& cluster);
 void add_rrt_command(CLI::App& app, Cluster& cluster);

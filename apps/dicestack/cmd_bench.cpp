@@ -31,12 +31,6 @@ struct SimOptions {
   bool json = false;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // Runs the benchmark's episodes through DiceEnv (the framework) on `threads` threads and
 // records each episode's outcome. Actions match bare_box2d_seconds draw for draw.
 double framework_seconds(const WorldConfig& config, const SimOptions& opt, int threads, std::vector<Outcome>* outcomes) {
@@ -249,6 +243,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_dataset_command(*bench);
   add_bench_optimise_command(*bench);
   add_bench_estimator_command(*bench);
+  add_bench_arm_command(*bench);
 }
 
 }  // namespace dicestack::cli

@@ -28,7 +28,7 @@ struct ExportOptions {
   bool skip_incomplete = false;
 };
 
-struct ImportOptions {
+struct FileImportOptions {
   WorldOption world;
   fs::path src, out;
 };
@@ -80,7 +80,7 @@ int run_export(const ExportOptions& opt) {
   return 0;
 }
 
-int run_import_file(const ImportOptions& opt, const std::string& format) {
+int run_import_file(const FileImportOptions& opt, const std::string& format) {
   check_demo_set_replaceable(opt.out);  // before any work
   DemoSet set = format == "robomimic" ? import_robomimic(opt.src) : import_minari(opt.src, opt.world.load());
   set.provenance = "dicestack import " + format + " " + opt.src.string() + (set.provenance.empty() ? "" : "; " + set.provenance);
@@ -165,13 +165,13 @@ int run_bench_dataset(const InteropBenchOptions& opt) {
 }  // namespace
 
 void add_interop_commands(CLI::App& import, CLI::App& dataset) {
-  auto imp = std::make_shared<ImportOptions>();
+  auto imp = std::make_shared<FileImportOptions>();
   CLI::App* cmd = import.add_subcommand("robomimic", "A robomimic HDF5 file of dicestack's environment (as `dataset export --format robomimic` writes)");
   cmd->add_option("file", imp->src, "FILE.hdf5")->required();
   cmd->add_option("--out", imp->out, "Folder to write the demonstration set to (missing, empty, or a dicestack set, which is replaced whole)")->required();
   cmd->callback([imp] { run_import_file(*imp, "robomimic"); });
 
-  auto mimp = std::make_shared<ImportOptions>();
+  auto mimp = std::make_shared<FileImportOptions>();
   cmd = import.add_subcommand("minari", "A Minari dataset folder (DIR/data/main_data.hdf5 and metadata.json)");
   cmd->add_option("dir", mimp->src, "Minari dataset folder")->required();
   cmd->add_option("--out", mimp->out, "Folder to write the demonstration set to (missing, empty, or a dicestack set, which is replaced whole)")->required();

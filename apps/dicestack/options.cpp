@@ -131,6 +131,13 @@ CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {
       ->check(CLI::IsMember(estimator_names()));
 }
 
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 CLI::Validator seed_check() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {

@@ -50,6 +50,9 @@ CLI::Validator threads_check();
 /// Left empty when not given: each model's own (estimator_for), none for an expert.
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name);
 
+/// The median of `v` (the benchmarks' figure over repeated runs); 0 for none.
+double median(std::vector<double> v);
+
 /// Prints a JSON object or a human-readable text on stdout.
 void print_line(const std::string& text);
 

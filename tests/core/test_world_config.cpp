@@ -171,20 +171,29 @@ TEST(WorldConfig, TheCupMustStartInsideTheWallsAtEveryShiftLiftAndTilt) {
   EXPECT_THAT(error_for(j), HasSubstr("outside the walls"));
 }
 
-TEST(WorldConfig, WritesVersionTwoAndReadsVersionOne) {
+TEST(WorldConfig, WritesVersionThreeAndReadsVersionsOneAndTwo) {
   const auto j = default_json();
   EXPECT_EQ(j.at("format"), "dicestack-world");
-  EXPECT_EQ(j.at("version"), 2);
-  auto v1 = j;  // version 1: no marker, the same fields
+  EXPECT_EQ(j.at("version"), 3);
+  auto v2 = j;  // version 2: no embodiment, no arm: the floating cup
+  v2["version"] = 2;
+  v2.erase("embodiment");
+  v2.erase("arm");
+  EXPECT_EQ(to_json(world_config_from_json(v2.dump(), "v2.json")), to_json(WorldConfig{}));
+  auto v1 = v2;  // version 1: no marker, the fields of version 2
   v1.erase("format");
   v1.erase("version");
   EXPECT_EQ(to_json(world_config_from_json(v1.dump(), "v1.json")), to_json(WorldConfig{}));
+  // A version 2 file that has an arm section holds a field its version does not have.
+  auto odd = j;
+  odd["version"] = 2;
+  EXPECT_THAT(error_for(odd), HasSubstr("is not a world config field"));
 }
 
 TEST(WorldConfig, NewerOrMalformedVersionsAreRefused) {
   auto j = default_json();
-  j["version"] = 3;
-  EXPECT_THAT(error_for(j), HasSubstr("w.json: format version 3 is newer than this dicestack reads (2); upgrade dicestack"));
+  j["version"] = 4;
+  EXPECT_THAT(error_for(j), HasSubstr("w.json: format version 4 is newer than this dicestack reads (3); upgrade dicestack"));
   j["version"] = 1.5;
   EXPECT_THAT(error_for(j), HasSubstr("field \"version\" must be a positive integer, got 1.5"));
   j = default_json();
@@ -224,19 +233,18 @@ TEST(WorldConfig, AFileThatCannotBeReadIsNamedWithTheSystemsReason) {
 TEST(WorldConfig, TheFieldListIsTheFilesFields) {
   const auto fields = world_config_fields();
   const nlohmann::json file = default_json();
-  std::size_t leaves = 0;
-  for (const auto& [section, values] : file.items())
-    if (values.is_object()) leaves += values.size();
+  std::size_t leaves = 0;  // a section's fields, and the fields outside any section (embodiment)
+  for (const auto& [key, values] : file.items())
+    if (key != "format" && key != "version") leaves += values.is_object() ? values.size() : 1;
   EXPECT_EQ(fields.size(), leaves);
   for (const auto& f : fields) {
     const auto dot = f.path.find('.');
-    ASSERT_NE(dot, std::string::npos) << f.path;
-    const auto& value = file.at(f.path.substr(0, dot)).at(f.path.substr(dot + 1));
+    const auto& value = dot == std::string::npos ? file.at(f.path) : file.at(f.path.substr(0, dot)).at(f.path.substr(dot + 1));
     EXPECT_EQ(f.default_value, value.dump()) << f.path;
     EXPECT_FALSE(f.meaning.empty()) << f.path;
   }
   EXPECT_EQ(fields.front().path, "walls.floor_y");
-  EXPECT_EQ(fields.back().path, "cost.sigma");
+  EXPECT_EQ(fields.back().path, "arm.posture_gain");
 }
 
 TEST(WorldConfig, HashIsTheWorldsIdentityNotItsFileFormat) {

@@ -191,6 +191,12 @@ def world_cases():
         node[path[-1]] = value
         return json.dumps(w, indent=1)
 
+    def short_arm():
+        w = default_world()
+        w["embodiment"] = "arm"
+        w["arm"]["link_lengths"] = [1.0, 1.0, 0.5]
+        return json.dumps(w, indent=1)
+
     def without(path):
         w = default_world()
         node = w
@@ -223,7 +229,9 @@ def world_cases():
         ("walls_crossed", "the left wall right of the right wall", edited(["walls", "left_x"], 9.5), check, "field \"walls.right_x\" must be greater than walls.left_x"),
         ("corner_cut", "corners cut deeper than the die", edited(["dice", "corner_cut"], 0.3), check, "field \"dice.corner_cut\" must be smaller than dice.half_size"),
         ("speed_cap", "Box2D's speed cap below the action limit", edited(["physics", "units_per_metre"], 500.0), check, "field \"physics.units_per_metre\" leaves Box2D's speed cap"),
-        ("newer_version", "a world config of version 3", edited(["version"], 3), check, "format version 3 is newer than this dicestack reads (2)"),
+        ("newer_version", "a world config of version 4", edited(["version"], 4), check, "format version 4 is newer than this dicestack reads (3)"),
+        ("embodiment_unknown", "an embodiment that does not exist", edited(["embodiment"], "robot"), check, "field \"embodiment\" must be \"cup\" or \"arm\""),
+        ("arm_out_of_reach", "an arm too short to hold the cup at its start", short_arm(), rollout, "field \"arm.link_lengths\" cannot reach the cup's start"),
         ("version_fraction", "version 2.5", edited(["version"], 2.5), check, "field \"version\" must be a positive integer"),
         ("wrong_marker", "another format's marker", edited(["format"], "dicestack-model"), check, "field \"format\" must be \"dicestack-world\""),
     ]

@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
@@ -29,6 +30,7 @@ struct Canvas {
 };
 
 const cv::Scalar kBackground(245, 240, 235), kWall(90, 90, 90), kCup(40, 110, 200), kInk(30, 30, 30);
+const cv::Scalar kArm(170, 170, 160), kArmJoint(110, 110, 100);
 const std::array<cv::Scalar, kDiceCount> kDieColour{cv::Scalar(80, 80, 220), cv::Scalar(80, 170, 60),
                                                     cv::Scalar(200, 120, 40)};
 
@@ -84,6 +86,15 @@ void render_state_into(Image& out, const State& s, const WorldConfig& config, co
 
   const CupGeometry cup = cup_geometry(config.cup);
   const Vec2 com{s[si::kCupX], s[si::kCupY]};
+  // The arm behind the scene, in its rest posture for the cup's pose (a state holds the cup and
+  // dice; the arm a world rebuilt at it would take).
+  if (config.embodiment == Embodiment::arm) {
+    const ArmPosture arm = arm_posture(config.arm, com);
+    for (std::size_t i = 0; i < 3; ++i)
+      cv::line(c.img, c.px(arm.joints[i]), c.px(arm.joints[i + 1]), kArm, 2 * c.len(config.arm.link_radius), cv::LINE_AA,
+               Canvas::kShift);
+    for (const Vec2 j : arm.joints) cv::circle(c.img, c.px(j), c.len(1.5 * config.arm.link_radius) << Canvas::kShift, kArmJoint, cv::FILLED, cv::LINE_AA, Canvas::kShift);
+  }
   for (const auto& seg : cup.segments)
     cv::line(c.img, c.px(to_world(com, s[si::kCupAngle], seg.a)), c.px(to_world(com, s[si::kCupAngle], seg.b)), kCup,
              2 * c.len(seg.radius), cv::LINE_AA, Canvas::kShift);

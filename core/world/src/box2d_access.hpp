@@ -1,6 +1,7 @@
 #pragma once
 // Access to the few private members of Box2D 2.4.1 that an exact snapshot must read and write
-// (contact flags, the broad-phase tree, the previous step's inverse time step, body sweeps).
+// (contact flags, the broad-phase tree, the previous step's inverse time step, body sweeps, the
+// arm's joint impulses).
 // Box2D 2.4 has no snapshot API; this uses the standard rule that explicit template
 // instantiation may name private members. Include from exactly one translation unit
 // (snapshot.cpp): each instantiation must appear once in the program.
@@ -41,6 +42,10 @@ DICESTACK_BOX2D_MEMBER(BodySweep, b2Body, b2Sweep, m_sweep);
 DICESTACK_BOX2D_MEMBER(BodyFlags, b2Body, uint16, m_flags);
 DICESTACK_BOX2D_MEMBER(BodySleepTime, b2Body, float, m_sleepTime);
 DICESTACK_BOX2D_MEMBER(FixtureProxies, b2Fixture, b2FixtureProxy*, m_proxies);
+DICESTACK_BOX2D_MEMBER(JointImpulse, b2RevoluteJoint, b2Vec2, m_impulse);
+DICESTACK_BOX2D_MEMBER(JointMotorImpulse, b2RevoluteJoint, float, m_motorImpulse);
+DICESTACK_BOX2D_MEMBER(JointLowerImpulse, b2RevoluteJoint, float, m_lowerImpulse);
+DICESTACK_BOX2D_MEMBER(JointUpperImpulse, b2RevoluteJoint, float, m_upperImpulse);
 
 #undef DICESTACK_BOX2D_MEMBER
 

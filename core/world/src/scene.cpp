@@ -5,6 +5,7 @@
 #include <new>
 #include <vector>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/geometry.hpp>
 
 namespace dicestack::detail {
@@ -155,7 +156,98 @@ void add_dice_bodies(Scene& scene, const WorldConfig& c, const std::array<Pose, 
   }
 }
 
+// In an arm world the links meet only the walls (they move in a plane in front of the dice).
+constexpr uint16 kWallCategory = 0x0001, kLinkCategory = 0x0002, kSceneCategory = 0x0004;
+
+b2Vec2 box2d_point(Vec2 p, double u) { return {box2d_length(p.x, u), box2d_length(p.y, u)}; }
+
+// The arm holding the cup: link bodies in the rest posture for the cup's pose, moving so that
+// the wrist follows the cup's velocity, and the four joints with their limits and motors.
+void add_arm(Scene& scene, const WorldConfig& c, const Pose& cup) {
+  const double u = scene.u;
+  const ArmConfig& arm = c.arm;
+  for (b2Fixture* f : scene.fixtures)
+    if (f->GetBody() != scene.fixtures[0]->GetBody()) {
+      b2Filter filter;
+      filter.categoryBits = kSceneCategory;
+      f->SetFilterData(filter);
+    }
+  const ArmPosture posture = arm_posture(arm, {cup.x, cup.y});
+  const auto rates = arm_link_rates(arm, posture.link_angles, {cup.vx, cup.vy});
+  b2Vec2 joint_velocity(0.0f, 0.0f);  // of the link's near joint, Box2D units
+  for (std::size_t i = 0; i < kArmLinks; ++i) {
+    const double a = posture.link_angles[i], len = arm.link_lengths[i];
+    const Vec2 from = posture.joints[i], to = posture.joints[i + 1];
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position = box2d_point({0.5 * (from.x + to.x), 0.5 * (from.y + to.y)}, u);
+    def.angle = static_cast<float>(a);
+    b2Body* body = scene.world->CreateBody(&def);
+    const double core = 0.1 * arm.link_radius;
+    b2PolygonShape shape;
+    shape.SetAsBox(box2d_length(0.5 * len + core, u), box2d_length(core, u));
+    shape.m_radius = box2d_length(arm.link_radius - core, u);
+    b2FixtureDef fd;
+    fd.shape = &shape;
+    fd.density = 0.0f;
+    fd.friction = static_cast<float>(c.walls.friction * c.walls.friction);
+    fd.filter.categoryBits = kLinkCategory;
+    fd.filter.maskBits = kWallCategory;
+    fd.userData.pointer = static_cast<uintptr_t>(kFirstLinkFixture + static_cast<int>(i) + 1);
+    scene.link_fixtures.push_back(body->CreateFixture(&fd));
+    b2MassData mass;
+    mass.mass = static_cast<float>(arm.link_masses[i]);
+    mass.center.SetZero();
+    mass.I = static_cast<float>(arm.link_masses[i] * len * len / 12.0 * u * u);
+    body->SetMassData(&mass);
+    // The link's centre moves with its near joint plus half its length turning at its rate.
+    const b2Vec2 turn(static_cast<float>(-std::sin(a) * rates[i] * u), static_cast<float>(std::cos(a) * rates[i] * u));
+    body->SetLinearVelocity(joint_velocity + static_cast<float>(0.5 * len) * turn);
+    body->SetAngularVelocity(static_cast<float>(rates[i]));
+    joint_velocity += static_cast<float>(len) * turn;
+    scene.links.push_back(body);
+  }
+  b2Body* ground = scene.fixtures[0]->GetBody();
+  const std::array<b2Body*, kArmJoints + 1> chain{ground, scene.links[0], scene.links[1], scene.links[2], scene.bodies[0]};
+  for (std::size_t j = 0; j < kArmJoints; ++j) {
+    b2RevoluteJointDef def;
+    def.bodyA = chain[j];
+    def.bodyB = chain[j + 1];
+    def.localAnchorA = j == 0 ? box2d_point(arm.base, u) : b2Vec2(box2d_length(0.5 * arm.link_lengths[j - 1], u), 0.0f);
+    def.localAnchorB = j < kArmLinks ? b2Vec2(box2d_length(-0.5 * arm.link_lengths[j], u), 0.0f) : b2Vec2(0.0f, 0.0f);
+    def.referenceAngle = 0.0f;  // a joint's angle is its body's angle minus the previous body's
+    def.enableLimit = true;
+    def.lowerAngle = static_cast<float>(arm.joint_lower[j]);
+    def.upperAngle = static_cast<float>(arm.joint_upper[j]);
+    def.collideConnected = false;
+    scene.joints.push_back(static_cast<b2RevoluteJoint*>(scene.world->CreateJoint(&def)));
+  }
+}
+
 }  // namespace
+
+std::array<double, 3> Scene::link_angles() const {
+  std::array<double, 3> a{};
+  for (std::size_t i = 0; i < links.size(); ++i) a[i] = links[i]->GetAngle();
+  return a;
+}
+
+void Scene::drive_arm(const ArmConfig& arm, const Action& target, double dt, Vec2 gravity) {
+  ArmMotion now;
+  const std::array<b2Body*, 4> chain{links[0], links[1], links[2], bodies[0]};
+  for (std::size_t i = 0; i < 4; ++i) {
+    now.angles[i] = chain[i]->GetAngle();
+    now.rates[i] = chain[i]->GetAngularVelocity();
+  }
+  now.cup_velocity = {bodies[0]->GetLinearVelocity().x / u, bodies[0]->GetLinearVelocity().y / u};
+  now.cup_mass = bodies[0]->GetMass();
+  now.cup_inertia = bodies[0]->GetInertia() / (u * u);
+  torques = arm_torques(arm, now, {target[0], target[1]}, target[2], dt, gravity);
+  // Joint j turns body j by its torque and the body before it back (the ground takes the
+  // shoulder's reaction).
+  for (std::size_t i = 0; i < 4; ++i)
+    chain[i]->ApplyTorque(static_cast<float>((torques[i] - (i + 1 < 4 ? torques[i + 1] : 0.0)) * u * u), true);
+}
 
 std::array<Pose, kBodies> poses_of(const State& s) {
   std::array<Pose, kBodies> p;
@@ -178,6 +270,7 @@ Scene::Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::
   add_wall_fixtures(*this, c, next_id);
   bodies[0] = add_cup_body(*this, c, poses[0], next_id);
   add_dice_bodies(*this, c, poses, next_id);
+  if (c.embodiment == Embodiment::arm) add_arm(*this, c, poses[0]);
 }
 
 }  // namespace dicestack::detail

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include <box2d/box2d.h>
 
@@ -20,8 +21,12 @@ constexpr int kBodies = 4;  // cup, die 0, die 1, die 2 (the static walls carry 
 // Fixture ids, stored as user data (id + 1, so that 0 means "not ours").
 constexpr int kFirstCupFixture = kWallFixtures, kFirstDieFixture = kWallFixtures + kCupFixtures;
 
+// The arm's links come after the dice, one fixture each.
+constexpr int kFirstLinkFixture = kFixtureCount, kArmLinks = 3, kArmJoints = 4;
+
 inline ShapeKind kind_of_fixture(int id) {
   if (id < kWallFixtures) return static_cast<ShapeKind>(id);
+  if (id >= kFirstLinkFixture) return ShapeKind::arm;
   return id < kFirstDieFixture ? ShapeKind::cup : ShapeKind::die;
 }
 
@@ -47,6 +52,11 @@ struct Scene {
   b2World* world = nullptr;               // constructed in caller-owned storage
   std::array<b2Body*, kBodies> bodies{};  // cup, dice
   std::array<b2Fixture*, kFixtureCount> fixtures{};
+  // The arm (empty for the floating cup): links from the shoulder, their fixtures (ids from
+  // kFirstLinkFixture), and the shoulder, elbow, second elbow and wrist joints.
+  std::vector<b2Body*> links;
+  std::vector<b2Fixture*> link_fixtures;
+  std::vector<b2RevoluteJoint*> joints;
 
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;
@@ -55,6 +65,17 @@ struct Scene {
   Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::byte* storage);
 
   b2ContactManager& contacts() const { return const_cast<b2ContactManager&>(world->GetContactManager()); }
+  /// Every fixture by id: walls, cup, dice, then the arm's links.
+  int fixture_count() const { return kFixtureCount + static_cast<int>(link_fixtures.size()); }
+  b2Fixture* fixture(int id) const {
+    return id < kFixtureCount ? fixtures[static_cast<std::size_t>(id)] : link_fixtures[static_cast<std::size_t>(id - kFixtureCount)];
+  }
+  /// The links' absolute directions (rad), from their bodies.
+  std::array<double, 3> link_angles() const;
+  /// Applies, for the next substep of `dt`, the joint torques that bring the cup's velocity to
+  /// `target` (m/s, m/s, rad/s; arm_torques); they are kept in `torques`.
+  void drive_arm(const ArmConfig& arm, const Action& target, double dt, Vec2 gravity);
+  std::array<double, 4> torques{};  // the arm's joint torques in the last substep, N m
 };
 
 }  // namespace dicestack::detail

@@ -42,8 +42,14 @@ struct WorldSnapshot::Data {
     int32 toi_count;
     float toi;
   };
+  // A joint's warm-starting impulses (the rest of it is rebuilt from its bodies each step).
+  struct Joint {
+    b2Vec2 impulse;
+    float motor_impulse, lower_impulse, upper_impulse;
+  };
   State state{};
-  std::array<Body, kBodies> bodies{};
+  std::vector<Body> bodies;    // cup, dice, then the arm's links
+  std::vector<Joint> joints;  // the arm's, shoulder first
   std::vector<b2TreeNode> tree_nodes;
   std::vector<char> tree_leaf;  // node holds a fixture proxy
   int32 tree_root = 0, tree_node_count = 0, tree_free_list = 0, tree_insertions = 0;
@@ -66,7 +72,8 @@ const State& WorldSnapshot::state() const {
 namespace {
 
 constexpr std::uint32_t kSnapshotMarker = 0x44534e50;  // "DSNP"; read back swapped on another byte order
-constexpr std::uint32_t kSnapshotVersion = 1;
+// 1: the cup and the dice. 2: adds the arm's links and joints (none for the floating cup).
+constexpr std::uint32_t kSnapshotVersion = 2;
 constexpr std::int32_t kMaxTreeNodes = 1 << 16;
 
 void put_vec(detail::ByteWriter& w, const b2Vec2& v) {
@@ -152,10 +159,10 @@ void read_broad_phase(detail::ByteReader& r, WorldSnapshot::Data& d) {
 }
 
 // Reads one contact: its fixtures and children, flags, manifold and time of impact.
-WorldSnapshot::Data::Contact read_snapshot_contact(detail::ByteReader& r) {
+WorldSnapshot::Data::Contact read_snapshot_contact(detail::ByteReader& r, int fixtures) {
   WorldSnapshot::Data::Contact c{};
-  c.fixture_a = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
-  c.fixture_b = r.get_in<std::int32_t>(0, kFixtureCount - 1, "contact fixture");
+  c.fixture_a = r.get_in<std::int32_t>(0, fixtures - 1, "contact fixture");
+  c.fixture_b = r.get_in<std::int32_t>(0, fixtures - 1, "contact fixture");
   c.child_a = r.get_in<std::int32_t>(0, 0, "contact child");  // every shape is one polygon
   c.child_b = r.get_in<std::int32_t>(0, 0, "contact child");
   c.flags = r.get<uint32>();
@@ -183,6 +190,7 @@ std::string WorldSnapshot::to_bytes() const {
   w.put(kSnapshotMarker);
   w.put(kSnapshotVersion);
   for (double v : d.state) w.put(v);
+  w.put(static_cast<std::int32_t>(d.bodies.size() - kBodies));
   for (const auto& b : d.bodies) {
     put_vec(w, b.xf.p);
     w.put(b.xf.q.s);
@@ -197,6 +205,12 @@ std::string WorldSnapshot::to_bytes() const {
     w.put(b.angular_velocity);
     w.put(b.flags);
     w.put(b.sleep_time);
+  }
+  for (const auto& j : d.joints) {
+    put_vec(w, j.impulse);
+    w.put(j.motor_impulse);
+    w.put(j.lower_impulse);
+    w.put(j.upper_impulse);
   }
   w.put(static_cast<std::int32_t>(d.tree_nodes.size()));
   for (std::size_t i = 0; i < d.tree_nodes.size(); ++i) {
@@ -248,14 +262,25 @@ WorldSnapshot WorldSnapshot::from_bytes(std::string_view bytes) {
   detail::ByteReader r(bytes, "world snapshot bytes");
   if (r.get<std::uint32_t>() != kSnapshotMarker) r.fail("not a dicestack world snapshot (or another byte order)");
   const auto version = r.get<std::uint32_t>();
-  if (version != kSnapshotVersion)
-    r.fail("version " + std::to_string(version) + ", this dicestack reads " + std::to_string(kSnapshotVersion));
+  if (version < 1 || version > kSnapshotVersion)
+    r.fail("version " + std::to_string(version) + ", this dicestack reads 1 to " + std::to_string(kSnapshotVersion));
   auto d = std::make_shared<Data>();
   for (double& v : d->state) v = r.get_finite<double>("state");
+  const int links = version >= 2 ? r.get_in<std::int32_t>(0, detail::kArmLinks, "arm link count") : 0;
+  if (links != 0 && links != detail::kArmLinks) r.fail("an arm of " + std::to_string(links) + " links");
+  d->bodies.resize(static_cast<std::size_t>(kBodies + links));
   for (auto& b : d->bodies) read_snapshot_body(r, b);
+  d->joints.resize(links == 0 ? 0 : detail::kArmJoints);
+  for (auto& j : d->joints) {
+    j.impulse = get_vec(r, "joint impulse");
+    j.motor_impulse = r.get_finite<float>("joint impulse");
+    j.lower_impulse = r.get_finite<float>("joint impulse");
+    j.upper_impulse = r.get_finite<float>("joint impulse");
+  }
   read_broad_phase(r, *d);
-  const auto contacts = r.get_in<std::int32_t>(0, kFixtureCount * kFixtureCount, "contact count");
-  for (std::int32_t i = 0; i < contacts; ++i) d->contacts.push_back(read_snapshot_contact(r));
+  const int fixtures = kFixtureCount + links;
+  const auto contacts = r.get_in<std::int32_t>(0, fixtures * fixtures, "contact count");
+  for (std::int32_t i = 0; i < contacts; ++i) d->contacts.push_back(read_snapshot_contact(r, fixtures));
   d->inv_dt0 = r.get_finite<float>("inverse time step");
   d->new_contacts = r.get_in<std::uint8_t>(0, 1, "world flag") != 0;
   d->step_complete = r.get_in<std::uint8_t>(0, 1, "world flag") != 0;
@@ -269,11 +294,14 @@ WorldSnapshot World::snapshot() const {
   const Scene& sc = *impl_->scene;
   auto data = std::make_shared<WorldSnapshot::Data>();
   data->state = impl_->state();
-  for (std::size_t i = 0; i < kBodies; ++i) {
-    b2Body& b = *sc.bodies[i];
-    data->bodies[i] = {get<detail::BodyXf>(b), get<detail::BodySweep>(b), b.GetLinearVelocity(),
-                       b.GetAngularVelocity(), get<detail::BodyFlags>(b), get<detail::BodySleepTime>(b)};
+  for (std::size_t i = 0; i < kBodies + sc.links.size(); ++i) {
+    b2Body& b = *(i < kBodies ? sc.bodies[i] : sc.links[i - kBodies]);
+    data->bodies.push_back({get<detail::BodyXf>(b), get<detail::BodySweep>(b), b.GetLinearVelocity(),
+                            b.GetAngularVelocity(), get<detail::BodyFlags>(b), get<detail::BodySleepTime>(b)});
   }
+  for (b2RevoluteJoint* j : sc.joints)
+    data->joints.push_back({get<detail::JointImpulse>(*j), get<detail::JointMotorImpulse>(*j),
+                            get<detail::JointLowerImpulse>(*j), get<detail::JointUpperImpulse>(*j)});
   b2BroadPhase& bp = sc.contacts().m_broadPhase;
   b2DynamicTree& tree = get<detail::BroadPhaseTree>(bp);
   const b2TreeNode* nodes = get<detail::TreeNodes>(tree);
@@ -314,13 +342,23 @@ void World::restore(const WorldSnapshot& snapshot) {
   // A fresh scene has the same body, fixture and proxy order as every scene built from this
   // config; the snapshot then overwrites what history changed.
   Scene* scene = &impl_->rebuild(poses_of(d.state));
-  for (std::size_t i = 0; i < kBodies; ++i) {
-    b2Body& b = *scene->bodies[i];
+  if (d.bodies.size() != kBodies + scene->links.size())
+    throw std::logic_error("world snapshot: taken with another embodiment (the arm's links differ)");
+  const auto body = [&](std::size_t i) -> b2Body& { return *(i < kBodies ? scene->bodies[i] : scene->links[i - kBodies]); };
+  for (std::size_t i = 0; i < d.bodies.size(); ++i) {
+    b2Body& b = body(i);
     const auto& s = d.bodies[i];
     get<detail::BodyXf>(b) = s.xf;
     get<detail::BodySweep>(b) = s.sweep;
     b.SetLinearVelocity(s.velocity);
     b.SetAngularVelocity(s.angular_velocity);
+  }
+  for (std::size_t j = 0; j < d.joints.size(); ++j) {
+    b2RevoluteJoint& joint = *scene->joints[j];
+    get<detail::JointImpulse>(joint) = d.joints[j].impulse;
+    get<detail::JointMotorImpulse>(joint) = d.joints[j].motor_impulse;
+    get<detail::JointLowerImpulse>(joint) = d.joints[j].lower_impulse;
+    get<detail::JointUpperImpulse>(joint) = d.joints[j].upper_impulse;
   }
 
   b2ContactManager& cm = scene->contacts();
@@ -348,8 +386,10 @@ void World::restore(const WorldSnapshot& snapshot) {
   // AddPair prepends, so adding in reverse rebuilds the world's and every body's contact list
   // in the original order (both lists are newest-first in Box2D).
   for (auto it = d.contacts.rbegin(); it != d.contacts.rend(); ++it) {
-    b2Fixture* fa = scene->fixtures[static_cast<std::size_t>(it->fixture_a)];
-    b2Fixture* fb = scene->fixtures[static_cast<std::size_t>(it->fixture_b)];
+    if (it->fixture_a >= scene->fixture_count() || it->fixture_b >= scene->fixture_count())
+      throw std::logic_error("world snapshot: a contact names a fixture this world does not have");
+    b2Fixture* fa = scene->fixture(it->fixture_a);
+    b2Fixture* fb = scene->fixture(it->fixture_b);
     cm.AddPair(get<detail::FixtureProxies>(*fa) + it->child_a, get<detail::FixtureProxies>(*fb) + it->child_b);
     b2Contact* made = cm.m_contactList;
     if (made == nullptr || made->GetFixtureA() != fa || made->GetFixtureB() != fb)
@@ -360,9 +400,9 @@ void World::restore(const WorldSnapshot& snapshot) {
     get<detail::ContactToi>(*made) = it->toi;
   }
   // AddPair wakes bodies; put back the recorded sleep state.
-  for (std::size_t i = 0; i < kBodies; ++i) {
-    get<detail::BodyFlags>(*scene->bodies[i]) = d.bodies[i].flags;
-    get<detail::BodySleepTime>(*scene->bodies[i]) = d.bodies[i].sleep_time;
+  for (std::size_t i = 0; i < d.bodies.size(); ++i) {
+    get<detail::BodyFlags>(body(i)) = d.bodies[i].flags;
+    get<detail::BodySleepTime>(body(i)) = d.bodies[i].sleep_time;
   }
   b2World& w = *scene->world;
   get<detail::WorldInvDt0>(w) = d.inv_dt0;

@@ -40,32 +40,53 @@ void World::set_state(const State& state) {
 bool World::step(const Action& dv) {
   require_finite(dv, "action");
   Scene& sc = *impl_->scene;
+  const WorldConfig& c = impl_->config;
   b2Body* cup = sc.bodies[0];
+  const int vel_it = c.physics.velocity_iterations, pos_it = c.physics.position_iterations;
+  bool wall = false;
+  if (c.embodiment == Embodiment::arm) {
+    // The velocity a floating cup would have after each substep: its own plus dv, then
+    // gravity's pull; the arm's torques drive it there (the dice push it less than they push a
+    // floating cup: the arm holds it).
+    const b2Vec2 v = cup->GetLinearVelocity();
+    const Action start{v.x / sc.u + dv[0], v.y / sc.u + dv[1], cup->GetAngularVelocity() + dv[2]};
+    for (int k = 0; k < c.physics.substeps; ++k) {
+      const double t = (k + 1) * static_cast<double>(impl_->sub_dt);
+      const Action target{start[0] + c.physics.gravity.x * t, start[1] + c.physics.gravity.y * t, start[2]};
+      sc.drive_arm(c.arm, target, impl_->sub_dt, c.physics.gravity);
+      sc.world->Step(impl_->sub_dt, vel_it, pos_it);
+      wall = wall || impl_->touches_wall();
+    }
+    return wall;
+  }
   b2Vec2 v = cup->GetLinearVelocity();
   v.x += static_cast<float>(dv[0] * sc.u);
   v.y += static_cast<float>(dv[1] * sc.u);
   cup->SetLinearVelocity(v);
   cup->SetAngularVelocity(cup->GetAngularVelocity() + static_cast<float>(dv[2]));
-  const int vel_it = impl_->config.physics.velocity_iterations, pos_it = impl_->config.physics.position_iterations;
-  bool wall = false;
-  for (int k = 0; k < impl_->config.physics.substeps; ++k) {
+  for (int k = 0; k < c.physics.substeps; ++k) {
     sc.world->Step(impl_->sub_dt, vel_it, pos_it);
     wall = wall || impl_->touches_wall();
   }
   return wall;
 }
 
+std::array<double, 3> World::arm_link_angles() const { return impl_->scene->link_angles(); }
+
+std::array<double, 4> World::arm_joint_torques() const { return impl_->scene->torques; }
+
 std::vector<ShapeOutline> World::outlines() const {
   const Scene& sc = *impl_->scene;
   std::vector<ShapeOutline> out;
-  for (std::size_t id = 0; id < sc.fixtures.size(); ++id) {
-    const b2Fixture* f = sc.fixtures[id];
+  for (int id = 0; id < sc.fixture_count(); ++id) {
+    const b2Fixture* f = sc.fixture(id);
     const auto* poly = static_cast<const b2PolygonShape*>(f->GetShape());
     const b2Transform& xf = f->GetBody()->GetTransform();
     ShapeOutline o;
-    o.kind = kind_of_fixture(static_cast<int>(id));
-    o.index = o.kind == ShapeKind::cup ? static_cast<int>(id) - kFirstCupFixture
-              : o.kind == ShapeKind::die ? static_cast<int>(id) - kFirstDieFixture
+    o.kind = kind_of_fixture(id);
+    o.index = o.kind == ShapeKind::cup   ? id - kFirstCupFixture
+              : o.kind == ShapeKind::die ? id - kFirstDieFixture
+              : o.kind == ShapeKind::arm ? id - detail::kFirstLinkFixture
                                          : 0;
     o.radius = poly->m_radius / sc.u;
     for (int32 i = 0; i < poly->m_count; ++i) {
@@ -89,6 +110,8 @@ std::string World::first_overlap(double tolerance) {
   auto name = [&](const b2Body* b) -> std::string {
     for (std::size_t i = 0; i < sc.bodies.size(); ++i)
       if (sc.bodies[i] == b) return i == 0 ? "the cup" : "die " + std::to_string(i - 1);
+    for (std::size_t i = 0; i < sc.links.size(); ++i)
+      if (sc.links[i] == b) return "arm link " + std::to_string(i);
     return "the walls";
   };
   for (b2Contact* c = sc.world->GetContactList(); c; c = c->GetNext()) {

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/geometry.hpp>
@@ -38,9 +39,15 @@ constexpr Bounds kAcceleration{-100.0, 100.0};
 
 constexpr const char* kFormat = "dicestack-world";
 // 1: no marker, every field of WorldConfig required. 2: adds "format" and "version"; same fields.
-// A field added in a later version gets, in files of older versions, the value those versions
-// implied (documented in docs/formats.md), never a new default.
-constexpr int kVersion = 2;
+// 3: adds "embodiment" and the "arm" section. A field added in a later version gets, in files of
+// older versions, the value those versions implied (documented in docs/formats.md), never a new
+// default: a file before version 3 is the floating cup.
+constexpr int kVersion = 3;
+
+// The version a field first appeared in.
+int added_in(std::string_view path) { return path == "embodiment" || path.starts_with("arm.") ? 3 : 1; }
+
+constexpr const char* kEmbodimentNames[] = {"cup", "arm"};
 
 std::string number_text(double v) {
   std::ostringstream os;
@@ -111,6 +118,16 @@ void visit_fields(Config& c, Visitor&& v) {
   v("cost.gamma", c.cost.gamma, Bounds{0.0, 1.0});
   v("cost.goal_x", c.cost.goal_x, kCoordinate);
   v("cost.sigma", c.cost.sigma, Bounds{0.0, 1e6, true});
+  v("embodiment", c.embodiment, kAny);
+  v("arm.base", c.arm.base, kCoordinate);
+  v("arm.link_lengths", c.arm.link_lengths, Bounds{0.05, 100.0});
+  v("arm.link_masses", c.arm.link_masses, kMass);
+  v("arm.link_radius", c.arm.link_radius, Bounds{0.005, 1.0});
+  v("arm.joint_lower", c.arm.joint_lower, Bounds{-100.0, 100.0});
+  v("arm.joint_upper", c.arm.joint_upper, Bounds{-100.0, 100.0});
+  v("arm.torque_limit", c.arm.torque_limit, Bounds{0.0, 1e7, true});
+  v("arm.speed_limit", c.arm.speed_limit, Bounds{0.0, 1000.0, true});
+  v("arm.posture_gain", c.arm.posture_gain, Bounds{0.0, 1000.0});
 }
 
 // What each field is, for the reference page (world_config_fields); keyed by the paths
@@ -166,6 +183,16 @@ constexpr Meaning kMeanings[] = {
     {"cost.gamma", "discount of the optimisers' cost: step j weighs gamma^(T - j) (paper eq. 6)"},
     {"cost.goal_x", "x of the goal stack, m"},
     {"cost.sigma", "per state number scale of the cost's distance (the human recordings' spreads)"},
+    {"embodiment", "what moves the cup: \"cup\" (the paper's floating cup: an action adds to its velocity) or \"arm\" (a planar arm holds it; docs/arm.md)"},
+    {"arm.base", "the arm's shoulder joint, m (x, y)"},
+    {"arm.link_lengths", "the three links' lengths, shoulder first, m"},
+    {"arm.link_masses", "the three links' masses, kg"},
+    {"arm.link_radius", "the links' radius (they meet the walls, the table and the ceiling), m"},
+    {"arm.joint_lower", "lower limit of each joint (shoulder, elbow, second elbow, wrist), rad, relative to the previous body"},
+    {"arm.joint_upper", "upper limit of each joint, rad"},
+    {"arm.torque_limit", "largest torque each joint's motor gives, N m"},
+    {"arm.speed_limit", "largest speed each joint is driven at, rad/s"},
+    {"arm.posture_gain", "rate at which the spare degree of freedom returns to the rest posture, 1/s"},
 };
 
 [[noreturn]] void fail(std::string_view source, std::string_view path, const std::string& what) {
@@ -184,6 +211,7 @@ struct RangeChecker {
   void operator()(std::string_view p, const double& v, const Bounds& b) const { check_number(source, p, v, b); }
   void operator()(std::string_view p, const int& v, const Bounds& b) const { check_number(source, p, v, b); }
   void operator()(std::string_view, const bool&, const Bounds&) const {}
+  void operator()(std::string_view, const Embodiment&, const Bounds&) const {}
   void operator()(std::string_view p, const Vec2& v, const Bounds& b) const {
     check_number(source, std::string(p) + "[0]", v.x, b);
     check_number(source, std::string(p) + "[1]", v.y, b);
@@ -216,6 +244,9 @@ struct JsonWriter {
   template <class T>
   void operator()(std::string_view p, const T& v, const Bounds&) const { slot(p) = v; }
   void operator()(std::string_view p, const Vec2& v, const Bounds&) const { slot(p) = {v.x, v.y}; }
+  void operator()(std::string_view p, const Embodiment& e, const Bounds&) const {
+    slot(p) = kEmbodimentNames[static_cast<int>(e)];
+  }
 };
 
 struct JsonReader {
@@ -249,6 +280,15 @@ struct JsonReader {
     if (!j.is_boolean()) fail(source, p, "must be true or false, got " + excerpt(j.dump()));
     v = j.get<bool>();
   }
+  void operator()(std::string_view p, Embodiment& e, const Bounds&) const {
+    const json& j = find(p);
+    for (int k = 0; k < 2; ++k)
+      if (j.is_string() && j.get<std::string>() == kEmbodimentNames[k]) {
+        e = static_cast<Embodiment>(k);
+        return;
+      }
+    fail(source, p, "must be \"cup\" or \"arm\", got " + excerpt(j.dump()));
+  }
   template <std::size_t N>
   void read_array(std::string_view p, std::array<double, N>& a) const {
     const json& j = find(p);
@@ -281,6 +321,9 @@ struct FieldLister {
   void operator()(std::string_view p, const double& v, const Bounds& b) const { add(p, "number", v, b); }
   void operator()(std::string_view p, const int& v, const Bounds& b) const { add(p, "integer", v, b); }
   void operator()(std::string_view p, const bool& v, const Bounds& b) const { add(p, "boolean", v, b); }
+  void operator()(std::string_view p, const Embodiment& e, const Bounds& b) const {
+    add(p, "\"cup\" or \"arm\"", kEmbodimentNames[static_cast<int>(e)], b);
+  }
   void operator()(std::string_view p, const Vec2& v, const Bounds& b) const {
     add(p, "2 numbers", json::array({v.x, v.y}), b);
   }
@@ -367,6 +410,38 @@ void validate_start_region(const WorldConfig& c, std::string_view source) {
   }
 }
 
+// The arm's joints are ordered, and it holds the cup at every start: the shoulder inside the
+// walls, and the rest posture reaching the cup's centre at the start's extremes with every joint
+// inside the walls and within its limits.
+void validate_arm(const WorldConfig& c, std::string_view source) {
+  const ArmConfig& arm = c.arm;
+  for (std::size_t j = 0; j < 4; ++j)
+    if (!(arm.joint_lower[j] < arm.joint_upper[j]))
+      fail(source, "arm.joint_upper[" + std::to_string(j) + "]", "must be greater than arm.joint_lower[" + std::to_string(j) + "]");
+  const Inside in{c.walls.left_x + c.walls.radius, c.walls.right_x - c.walls.radius, table_height(c.walls),
+                  c.walls.ceiling_y - c.walls.radius};
+  const auto inside = [&](Vec2 p) {
+    return p.x - arm.link_radius > in.left && p.x + arm.link_radius < in.right && p.y - arm.link_radius > in.bottom &&
+           p.y + arm.link_radius < in.top;
+  };
+  if (!inside(arm.base)) fail(source, "arm.base", "must lie inside the walls, clear of them by arm.link_radius");
+  const CupGeometry cup = cup_geometry(c.cup);
+  const Vec2 centre{c.cup.start_anchor.x + cup.com_from_anchor.x, c.cup.start_anchor.y + cup.com_from_anchor.y};
+  const auto& r = c.randomization;
+  for (double dx : {-r.shift, 0.0, r.shift})
+    for (double dy : {0.0, r.cup_lift}) {
+      const Vec2 at{centre.x + dx, centre.y + dy};
+      const ArmPosture p = arm_posture(arm, at);
+      if (!p.reached)
+        fail(source, "arm.link_lengths",
+             "cannot reach the cup's start at (" + number_text(at.x) + ", " + number_text(at.y) + ") m from arm.base");
+      for (const Vec2 j : p.joints)
+        if (!inside(j))
+          fail(source, "arm.base", "puts a joint of the arm outside the walls holding the cup at (" + number_text(at.x) +
+                                       ", " + number_text(at.y) + ") m");
+    }
+}
+
 void validate_relations(const WorldConfig& c, std::string_view source) {
   if (!(c.walls.left_x + c.walls.radius < c.walls.right_x - c.walls.radius))
     fail(source, "walls.right_x", "must be greater than walls.left_x + 2 * walls.radius");
@@ -380,6 +455,7 @@ void validate_relations(const WorldConfig& c, std::string_view source) {
     fail(source, "physics.units_per_metre",
          "leaves Box2D's speed cap at " + number_text(speed_cap) + " m/s, not above the action limit");
   validate_start_region(c, source);
+  if (c.embodiment == Embodiment::arm) validate_arm(c, source);
 }
 
 // The version a config's JSON object declares: 1 without a marker, else its "version".
@@ -441,14 +517,17 @@ WorldConfig world_config_from_json(std::string_view text, std::string_view sourc
     throw ConfigError("world config " + std::string(source) + ": not valid JSON: " + e.what());
   }
   if (!root.is_object()) throw ConfigError("world config " + std::string(source) + ": must be a JSON object");
-  // Versions 1 and 2 hold the same fields; a later version's new field will be read here only
-  // when declared_version() says the file has it.
-  declared_version(root, source);
+  // A field is read only from files of the version that added it and later; older files keep
+  // the value their version implied.
+  const int version = declared_version(root, source);
   root.erase("format");
   root.erase("version");
   WorldConfig config;
   std::set<std::string> seen;
-  visit_fields(config, JsonReader{root, source, &seen});
+  const JsonReader reader{root, source, &seen};
+  visit_fields(config, [&](std::string_view p, auto& v, const Bounds& b) {
+    if (added_in(p) <= version) reader(p, v, b);
+  });
   std::vector<std::string> leaves;
   collect_leaves(root, "", leaves);
   for (const auto& leaf : leaves)
@@ -465,7 +544,14 @@ std::string to_json(const WorldConfig& config) {
   return root.dump(2) + "\n";
 }
 
-std::uint64_t world_hash(const WorldConfig& config) { return fnv1a(fields_json(config).dump(2) + "\n"); }
+std::uint64_t world_hash(const WorldConfig& config) {
+  json fields = fields_json(config);
+  if (config.embodiment == Embodiment::cup) {  // as before the arm existed: a cup world's identity is unchanged
+    fields.erase("embodiment");
+    fields.erase("arm");
+  }
+  return fnv1a(fields.dump(2) + "\n");
+}
 
 WorldConfig load_world_config(const std::filesystem::path& path) {
   return world_config_from_json(read_file(path, kMaxSettingsFileBytes), path.string());

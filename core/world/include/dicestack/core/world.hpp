@@ -1,6 +1,7 @@
 #pragma once
 // The Box2D scene of the dice-stacking task and one control step of it. Box2D types never leave
 // core/: everything here is SI and our own types (STYLE 9).
+#include <array>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -45,12 +46,12 @@ class WorldSnapshot {
 };
 
 /// Which solid a shape belongs to, for drawing and for the outcome judge.
-enum class ShapeKind { floor, left_wall, right_wall, ceiling, cup, die };
+enum class ShapeKind { floor, left_wall, right_wall, ceiling, cup, die, arm };
 
 /// One shape in world coordinates: a convex polygon, rounded by `radius`, in metres.
 struct ShapeOutline {
   ShapeKind kind = ShapeKind::floor;
-  int index = 0;  ///< segment index for the cup (0 left, 1 base, 2 right), die index for dice
+  int index = 0;  ///< segment index for the cup (0 left, 1 base, 2 right), die index for dice, link index for the arm
   std::vector<Vec2> points;
   double radius = 0.0;
 };
@@ -76,7 +77,8 @@ class World {
 
   /// Rebuilds the scene at a bare 24-number state. Contacts start without warm-starting
   /// impulses, so the continuation can differ slightly from a run that reached this state by
-  /// itself (measured in docs/world.md). state() afterwards returns `state` exactly.
+  /// itself (measured in docs/world.md). state() afterwards returns `state` exactly. An arm
+  /// takes its rest posture (arm_posture) and the link rates that move the cup as the state says.
   /// Throws InputError if a value is not finite.
   void set_state(const State& state);
 
@@ -88,8 +90,10 @@ class World {
   void restore(const WorldSnapshot& snapshot);
 
   /// One control step: adds `dv` (m/s, m/s, rad/s) to the cup's velocity, then runs the
-  /// configured substeps. Returns true if the cup or a die touched a side wall or the ceiling
-  /// during the step. Throws InputError if `dv` is not finite. Does not clip.
+  /// configured substeps. With the arm, the joints' motors drive the cup at the velocity a
+  /// floating cup would have (its velocity plus dv, then gravity's pull over the step), within
+  /// their torque limits. Returns true if the cup, a die or a link touched a side wall or the
+  /// ceiling during the step. Throws InputError if `dv` is not finite. Does not clip.
   bool step(const Action& dv);
 
   /// Every shape, in world coordinates, for drawing.
@@ -102,6 +106,11 @@ class World {
   /// The first overlap deeper than `tolerance`, named ("die 1 and die 2 overlap by 0.150 m",
   /// "the cup and the walls ..."), or empty. Like has_overlaps, for probe worlds.
   std::string first_overlap(double tolerance = 0.005);
+
+  /// The arm's link directions now (absolute, rad); zeros for the floating cup.
+  std::array<double, 3> arm_link_angles() const;
+  /// The torque each joint's motor gave in the last substep, N m; zeros for the floating cup.
+  std::array<double, 4> arm_joint_torques() const;
 
   /// True if the cup or a die is within judge.wall_contact_distance of a side wall or the
   /// ceiling now. Like has_overlaps, for probe worlds (e.g. judging recorded states).

@@ -49,6 +49,32 @@ struct DiceConfig {
   bool operator==(const DiceConfig&) const = default;
 };
 
+/// What moves the cup: the paper's floating cup (each action adds to its velocity directly) or a
+/// planar arm holding it (the action is turned into joint motions under torque limits).
+enum class Embodiment { cup, arm };
+
+/// The planar arm of the paper's future work: three links and a wrist, four revolute joints,
+/// the cup's centre of mass held by the wrist. The arm moves in a plane in front of the scene:
+/// its links meet the walls, the table and the ceiling, not the dice or the cup. Joint angles
+/// are relative (a link's angle minus the previous one's; the shoulder's is absolute, the
+/// wrist's is the cup's angle minus the last link's).
+struct ArmConfig {
+  Vec2 base{4.50, 6.20};  ///< the shoulder joint, fixed to the ceiling's mount, m
+  std::array<double, 3> link_lengths{2.40, 2.40, 1.60};  ///< m
+  std::array<double, 3> link_masses{6.0, 4.0, 3.0};      ///< kg (the cup is 15 kg: Box2D wants ratios under 10)
+  double link_radius = 0.06;  ///< m
+  std::array<double, 4> joint_lower{-6.3, -2.9, -2.9, -12.6};  ///< rad
+  std::array<double, 4> joint_upper{6.3, 2.9, 2.9, 12.6};      ///< rad
+  /// N m per joint: the 99th percentile of what the human recordings' cup paths ask of each joint
+  /// (`dicestack bench arm`, docs/arm.md).
+  std::array<double, 4> torque_limit{7500.0, 6500.0, 1700.0, 700.0};
+  std::array<double, 4> speed_limit{20.0, 20.0, 20.0, 20.0};  ///< rad/s per joint
+  /// Rate (1/s) at which the spare degree of freedom is pulled back to the rest posture: the
+  /// last link along the line from the shoulder to the wrist.
+  double posture_gain = 5.0;
+  bool operator==(const ArmConfig&) const = default;
+};
+
 /// Integration and simulation settings.
 struct PhysicsConfig {
   Vec2 gravity{0.0, -4.0};        ///< m/s^2 (paper eq. 1)
@@ -122,6 +148,8 @@ struct WorldConfig {
   JudgeConfig judge;
   EpisodeConfig episode;
   CostConfig cost = default_cost();
+  Embodiment embodiment = Embodiment::cup;
+  ArmConfig arm;  ///< read only with embodiment arm
 
   /// The cost defaults, with the measured per-dimension sigma.
   static CostConfig default_cost();
@@ -134,8 +162,9 @@ struct WorldConfig {
 void validate(const WorldConfig& config);
 
 /// Parses JSON text; every field must be present, of the right type, finite and in range, and
-/// the start must fit inside the walls. Reads format versions 1 (no marker) and 2 ("format":
-/// "dicestack-world", "version": 2); docs/formats.md. `source` names the text in messages (a
+/// the start must fit inside the walls. Reads format versions 1 (no marker), 2 ("format":
+/// "dicestack-world", "version": 2) and 3 (adds "embodiment" and "arm"; older files are the
+/// floating cup); docs/formats.md. `source` names the text in messages (a
 /// path, or "<string>"). Throws ConfigError.
 WorldConfig world_config_from_json(std::string_view text, std::string_view source = "<string>");
 
@@ -143,7 +172,8 @@ WorldConfig world_config_from_json(std::string_view text, std::string_view sourc
 std::string to_json(const WorldConfig& config);
 
 /// FNV-1a of the fields alone (not the format version): the world's identity in cache names,
-/// checkpoints and snapshots, unchanged when only the file format moves on.
+/// checkpoints and snapshots, unchanged when only the file format moves on (a floating-cup
+/// world's arm fields, which it never reads, are left out).
 std::uint64_t world_hash(const WorldConfig& config);
 
 /// One field of the world config file, as its reference page lists it.

@@ -1,0 +1,55 @@
+#pragma once
+// The planar arm that holds the cup in a world whose embodiment is arm: its rest posture for a
+// cup pose (what a world rebuilt at a state, and a drawing, use) and the operational-space
+// controller that turns a wanted cup velocity into joint torques within the arm's limits.
+// docs/arm.md.
+#include <array>
+
+#include <dicestack/core/vec2.hpp>
+#include <dicestack/core/world_config.hpp>
+
+namespace dicestack {
+
+/// Where the arm's links lie.
+struct ArmPosture {
+  std::array<double, 3> link_angles{};  ///< each link's absolute direction, shoulder link first, rad
+  std::array<Vec2, 4> joints{};         ///< shoulder, elbow, second elbow, wrist (the cup's centre), m
+  bool reached = true;                  ///< false: the wrist is out of reach; the arm is stretched towards it
+};
+
+/// The rest posture holding the wrist at `wrist`: the last link's near end at three quarters of
+/// the first two links' reach from the shoulder (as near to that as the last link allows), so
+/// the elbow is neither folded nor stretched; the elbow always bent the same way (clockwise from
+/// the shoulder's line to that end). The same for the same point, so a world rebuilt at a state
+/// holds the same arm.
+ArmPosture arm_posture(const ArmConfig& arm, Vec2 wrist);
+
+/// The posture of `link_angles` (joints by forward kinematics from the shoulder).
+ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& link_angles);
+
+/// The links' absolute rates (rad/s) that move the wrist at `velocity` (m/s): the least-norm
+/// rates (damped near a stretched arm), plus a motion the wrist does not feel that returns the
+/// last link to its rest posture's direction at arm.posture_gain.
+std::array<double, 3> arm_link_rates(const ArmConfig& arm, const std::array<double, 3>& link_angles, Vec2 velocity);
+
+/// The arm and the cup it holds as one chain: each body's absolute angle and rate (the three
+/// links, then the cup), the cup's velocity, and its mass and inertia about its centre.
+struct ArmMotion {
+  std::array<double, 4> angles{};
+  std::array<double, 4> rates{};
+  Vec2 cup_velocity;
+  double cup_mass = 0.0;
+  double cup_inertia = 0.0;
+};
+
+/// Operational-space control: the four joint torques (N m; shoulder, elbows, wrist; each acting
+/// on its body and back on the one before) that bring the cup's velocity to `velocity` and its
+/// turn to `angular_velocity` within `dt`, from the chain's own dynamics (mass matrix,
+/// centripetal terms, gravity), with the spare degree of freedom pulled to the rest posture in
+/// the task's null space; no joint driven past its arm.speed_limit, and each torque clipped to
+/// its arm.torque_limit. Loads the model does
+/// not know (dice in the cup) are left to the next call's velocity error.
+std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
+                                  double dt, Vec2 gravity);
+
+}  // namespace dicestack

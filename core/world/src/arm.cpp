@@ -1,0 +1,172 @@
+#include <dicestack/core/arm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Dense>
+
+namespace dicestack {
+namespace {
+
+// Damping of the least-norm rates, m: near a stretched arm the rates stay bounded.
+constexpr double kDamping = 0.05;
+// Where the rest posture puts the last link's near end: this fraction of the first two links'
+// reach from the shoulder.
+constexpr double kComfort = 0.75;
+
+Vec2 direction(double angle) { return {std::cos(angle), std::sin(angle)}; }
+
+double wrap_angle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
+
+}  // namespace
+
+ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& link_angles) {
+  ArmPosture p;
+  p.link_angles = link_angles;
+  p.joints[0] = arm.base;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Vec2 u = direction(link_angles[i]);
+    p.joints[i + 1] = {p.joints[i].x + arm.link_lengths[i] * u.x, p.joints[i].y + arm.link_lengths[i] * u.y};
+  }
+  return p;
+}
+
+ArmPosture arm_posture(const ArmConfig& arm, Vec2 wrist) {
+  const auto& l = arm.link_lengths;
+  const double dx = arm.base.x - wrist.x, dy = arm.base.y - wrist.y, reach = std::hypot(dx, dy);
+  const double up = reach > 1e-12 ? std::atan2(dy, dx) : 0.5 * std::numbers::pi;  // from the wrist to the shoulder
+  // The last link's near end at kComfort of the first two links' reach from the shoulder (as
+  // near as the last link allows): the elbow stays far from folded and from stretched. It lies
+  // turned by `beta` from the wrist's line to the shoulder (law of cosines).
+  const double lo = std::abs(l[0] - l[1]), hi = l[0] + l[1];
+  const double want = std::clamp(kComfort * hi, std::abs(reach - l[2]), reach + l[2]);
+  const double cb = reach > 1e-12 ? (reach * reach + l[2] * l[2] - want * want) / (2.0 * reach * l[2]) : 1.0;
+  const double beta = std::acos(std::clamp(cb, -1.0, 1.0));
+  const double to_near = up + beta;
+  const Vec2 near{wrist.x + l[2] * std::cos(to_near), wrist.y + l[2] * std::sin(to_near)};
+  const double last = to_near + std::numbers::pi;  // the last link points from its near end to the wrist
+  const double nx = near.x - arm.base.x, ny = near.y - arm.base.y, d = std::hypot(nx, ny);
+  const double towards = d > 1e-12 ? std::atan2(ny, nx) : last;
+  const double clamped = std::clamp(d, lo, hi);
+  // Law of cosines: the shoulder link turns from the line to the near end by `bend`.
+  const double c = (l[0] * l[0] + clamped * clamped - l[1] * l[1]) / (2.0 * l[0] * std::max(clamped, 1e-12));
+  const double bend = std::acos(std::clamp(c, -1.0, 1.0));
+  const double a0 = towards - bend;
+  const Vec2 elbow{arm.base.x + l[0] * std::cos(a0), arm.base.y + l[0] * std::sin(a0)};
+  const double a1 = std::atan2(near.y - elbow.y, near.x - elbow.x);
+  ArmPosture p = arm_posture_of(arm, {a0, a1, wrap_angle(last)});
+  p.reached = d >= lo - 1e-9 && d <= hi + 1e-9;
+  return p;
+}
+
+std::array<double, 3> arm_link_rates(const ArmConfig& arm, const std::array<double, 3>& link_angles, Vec2 velocity) {
+  // The wrist moves by L_i (-sin a_i, cos a_i) per unit rate of link i: J is 2 x 3.
+  std::array<double, 3> jx{}, jy{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    jx[i] = -arm.link_lengths[i] * std::sin(link_angles[i]);
+    jy[i] = arm.link_lengths[i] * std::cos(link_angles[i]);
+  }
+  // Damped least norm: J^T (J J^T + k^2 I)^-1 v.
+  double a = kDamping * kDamping, b = 0.0, d = kDamping * kDamping;
+  for (std::size_t i = 0; i < 3; ++i) {
+    a += jx[i] * jx[i];
+    b += jx[i] * jy[i];
+    d += jy[i] * jy[i];
+  }
+  const double det = a * d - b * b;
+  const double sx = (d * velocity.x - b * velocity.y) / det, sy = (a * velocity.y - b * velocity.x) / det;
+  std::array<double, 3> rates{};
+  for (std::size_t i = 0; i < 3; ++i) rates[i] = jx[i] * sx + jy[i] * sy;
+  // The null space of J: the cross product of its rows. Moving along it leaves the wrist where
+  // it is; it turns the last link towards the shoulder-wrist line.
+  const std::array<double, 3> n{jx[1] * jy[2] - jx[2] * jy[1], jx[2] * jy[0] - jx[0] * jy[2], jx[0] * jy[1] - jx[1] * jy[0]};
+  if (std::abs(n[2]) > 1e-6) {
+    const double rest = arm_posture(arm, arm_posture_of(arm, link_angles).joints[3]).link_angles[2];
+    const double step = arm.posture_gain * wrap_angle(rest - link_angles[2]) / n[2];
+    for (std::size_t i = 0; i < 3; ++i) rates[i] += step * n[i];
+  }
+  return rates;
+}
+
+std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
+                                  double dt, Vec2 gravity) {
+  using Vec4 = Eigen::Vector4d;
+  const auto& a = now.angles;
+  const auto& w = now.rates;
+  // Each body's centre and its derivative by each angle: a link's centre lies half its length
+  // along it from its near joint; the cup's centre is the wrist, at the last link's far end.
+  std::array<double, 4> mass{arm.link_masses[0], arm.link_masses[1], arm.link_masses[2], now.cup_mass};
+  std::array<double, 4> inertia{}, along{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    inertia[i] = arm.link_masses[i] * arm.link_lengths[i] * arm.link_lengths[i] / 12.0;
+    along[i] = 0.5 * arm.link_lengths[i];
+  }
+  inertia[3] = now.cup_inertia;
+  // dp_i/da_j = reach_ij * (-sin a_j, cos a_j); the centripetal acceleration of p_i is
+  // -sum_j reach_ij * (cos a_j, sin a_j) * w_j^2.
+  const auto reach = [&](std::size_t i, std::size_t j) { return j < i ? arm.link_lengths[j] : j == i ? along[i] : 0.0; };
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  Vec4 bias = Vec4::Zero();  // what the centripetal terms and gravity ask of the angles' forces
+  for (std::size_t i = 0; i < 4; ++i) {
+    Eigen::Matrix<double, 2, 4> jv = Eigen::Matrix<double, 2, 4>::Zero();
+    Eigen::Vector2d centripetal = Eigen::Vector2d::Zero();
+    for (std::size_t j = 0; j <= i && j < 4; ++j) {
+      const double r = reach(i, j);
+      jv(0, static_cast<Eigen::Index>(j)) = -r * std::sin(a[j]);
+      jv(1, static_cast<Eigen::Index>(j)) = r * std::cos(a[j]);
+      centripetal -= r * w[j] * w[j] * Eigen::Vector2d(std::cos(a[j]), std::sin(a[j]));
+    }
+    m += mass[i] * jv.transpose() * jv;
+    m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) += inertia[i];
+    bias += mass[i] * jv.transpose() * (centripetal - Eigen::Vector2d(gravity.x, gravity.y));
+  }
+  // The task: the cup's centre (the wrist) and its angle.
+  Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
+  Eigen::Vector3d drift = Eigen::Vector3d::Zero();  // the task's acceleration at zero angular acceleration
+  for (std::size_t j = 0; j < 3; ++j) {
+    const double l = arm.link_lengths[j];
+    task(0, static_cast<Eigen::Index>(j)) = -l * std::sin(a[j]);
+    task(1, static_cast<Eigen::Index>(j)) = l * std::cos(a[j]);
+    drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
+    drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
+  }
+  task(2, 3) = 1.0;
+  // The cup's own velocity, not the links' rates through the chain: what the joints let drift
+  // is corrected too.
+  const Eigen::Vector3d cup_rate(now.cup_velocity.x, now.cup_velocity.y, w[3]);
+  const Eigen::Vector3d wanted = (Eigen::Vector3d(velocity.x, velocity.y, angular_velocity) - cup_rate) / dt - drift;
+  // Damped least-norm angular accelerations for the task, plus the posture's in its null space.
+  const Eigen::Matrix3d tt = task * task.transpose() + kDamping * kDamping * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix<double, 4, 3> pinv = task.transpose() * tt.inverse();
+  Vec4 accel = pinv * wanted;
+  const std::array<double, 3> links{a[0], a[1], a[2]};
+  const double rest = arm_posture(arm, arm_posture_of(arm, links).joints[3]).link_angles[2];
+  Vec4 posture = Vec4::Zero();
+  posture(2) = arm.posture_gain * arm.posture_gain * wrap_angle(rest - a[2]) - 2.0 * arm.posture_gain * w[2];
+  accel += (Eigen::Matrix4d::Identity() - pinv * task) * posture;
+  // No joint faster than its speed limit by the end of the substep: the relative rates it would
+  // reach, clipped, give back the accelerations.
+  std::array<double, 4> next{}, relative{};
+  for (std::size_t i = 0; i < 4; ++i) next[i] = w[i] + accel(static_cast<Eigen::Index>(i)) * dt;
+  for (std::size_t i = 0; i < 4; ++i)
+    relative[i] = std::clamp(next[i] - (i > 0 ? next[i - 1] : 0.0), -arm.speed_limit[i], arm.speed_limit[i]);
+  double absolute = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    absolute += relative[i];
+    accel(static_cast<Eigen::Index>(i)) = (absolute - w[i]) / dt;
+  }
+  // Generalised forces on the absolute angles, then the joint torques: the force on body j is
+  // its joint's torque less the next joint's (which acts back on it).
+  const Vec4 force = m * accel + bias;
+  std::array<double, 4> torque{};
+  double after = 0.0;
+  for (int j = 3; j >= 0; --j) {
+    after += force(j);
+    torque[static_cast<std::size_t>(j)] = after;
+  }
+  for (std::size_t j = 0; j < 4; ++j) torque[j] = std::clamp(torque[j], -arm.torque_limit[j], arm.torque_limit[j]);
+  return torque;
+}
+
+}  // namespace dicestack

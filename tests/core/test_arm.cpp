@@ -1,0 +1,171 @@
+// The arm embodiment: a planar three-link arm with a wrist holds the cup; its rest posture, the
+// cup controller that makes it move the cup as a floating cup would move, exact snapshots, wall
+// contact by its links, and the world file that names it.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include <dicestack/core/arm.hpp>
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/hash.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/world.hpp>
+
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+namespace si = state_index;
+
+WorldConfig arm_world() {
+  WorldConfig c;
+  c.embodiment = Embodiment::arm;
+  return c;
+}
+
+TEST(Arm, TheRestPostureHoldsTheWristWhereAsked) {
+  const ArmConfig arm;
+  for (const Vec2 wrist : {Vec2{4.5, 1.5}, Vec2{2.0, 2.5}, Vec2{7.0, 4.0}, Vec2{4.5, 5.0}}) {
+    const ArmPosture p = arm_posture(arm, wrist);
+    ASSERT_TRUE(p.reached) << wrist.x << ", " << wrist.y;
+    EXPECT_NEAR(p.joints[3].x, wrist.x, 1e-9);
+    EXPECT_NEAR(p.joints[3].y, wrist.y, 1e-9);
+    EXPECT_NEAR(p.joints[0].x, arm.base.x, 0.0);
+    // Neither folded nor stretched: every elbow within its limits, with room.
+    for (std::size_t j = 1; j < 3; ++j) {
+      const double bend = std::remainder(p.link_angles[j] - p.link_angles[j - 1], 2 * M_PI);
+      EXPECT_LT(std::abs(bend), arm.joint_upper[j] - 0.3) << wrist.x << ", " << wrist.y << ", joint " << j;
+    }
+    EXPECT_EQ(arm_posture(arm, wrist).link_angles, p.link_angles);  // the same arm each time
+  }
+  EXPECT_FALSE(arm_posture(arm, {4.5, -20.0}).reached);
+}
+
+// The link rates move the wrist at the velocity asked (the damping aside).
+TEST(Arm, LinkRatesMoveTheWristAtTheVelocityAsked) {
+  const ArmConfig arm;
+  const ArmPosture p = arm_posture(arm, {4.0, 2.0});
+  const Vec2 v{0.7, -0.4};
+  const auto rates = arm_link_rates(arm, p.link_angles, v);
+  double vx = 0.0, vy = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    vx -= arm.link_lengths[i] * std::sin(p.link_angles[i]) * rates[i];
+    vy += arm.link_lengths[i] * std::cos(p.link_angles[i]) * rates[i];
+  }
+  EXPECT_NEAR(vx, v.x, 1e-3);
+  EXPECT_NEAR(vy, v.y, 1e-3);
+}
+
+TEST(Arm, TheArmWorldStartsWhereTheStateSaysWithTheLinksClearOfTheWalls) {
+  const WorldConfig c = arm_world();
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const State start = random_start_state(c, seed);
+    World w(c, start);
+    EXPECT_TRUE(test::bit_equal(w.state(), World(WorldConfig{}, start).state()));  // the cup and dice as without the arm
+    EXPECT_FALSE(w.touching_walls()) << "seed " << seed;
+    int links = 0;
+    for (const auto& o : w.outlines()) links += o.kind == ShapeKind::arm;
+    EXPECT_EQ(links, 3);
+  }
+}
+
+// Without contacts, the arm moves the cup as a floating cup moves: its velocity plus the action,
+// then gravity's pull.
+TEST(Arm, InFreeSpaceTheCupMovesAsTheFloatingCupDoes) {
+  State lifted = paper_start_state(WorldConfig{});
+  lifted[si::kCupY] += 1.5;  // clear of the dice
+  World floating(WorldConfig{}, lifted), held(arm_world(), lifted);
+  for (int t = 0; t < 20; ++t) {
+    const Action a{0.3 * std::sin(0.3 * t), 0.2, 0.4 * std::cos(0.2 * t)};
+    floating.step(a);
+    held.step(a);
+    for (std::size_t k : {si::kCupX, si::kCupY, si::kCupAngle, si::kCupVx, si::kCupVy, si::kCupW})
+      EXPECT_NEAR(held.state()[k], floating.state()[k], 0.02) << "step " << t << ", number " << k;
+  }
+  for (double torque : held.arm_joint_torques()) EXPECT_TRUE(std::isfinite(torque));
+}
+
+TEST(Arm, RestoringASnapshotContinuesBitForBit) {
+  const WorldConfig c = arm_world();
+  const auto actions = test::random_actions(c, 5, 80);
+  World run(c, random_start_state(c, 5));
+  std::vector<State> states{run.state()};
+  WorldSnapshot at30;
+  for (int t = 0; t < 80; ++t) {
+    if (t == 30) at30 = WorldSnapshot::from_bytes(run.snapshot().to_bytes());
+    run.step(actions[static_cast<std::size_t>(t)]);
+    states.push_back(run.state());
+  }
+  World restored(c);
+  restored.restore(at30);
+  for (int t = 30; t < 80; ++t) {
+    restored.step(actions[static_cast<std::size_t>(t)]);
+    ASSERT_TRUE(test::bit_equal(restored.state(), states[static_cast<std::size_t>(t + 1)])) << "step " << t + 1;
+  }
+  // A snapshot of one embodiment does not restore into the other.
+  World cup(WorldConfig{});
+  EXPECT_ANY_THROW(cup.restore(at30));
+}
+
+// A floating cup's snapshot record of version 1 (before the arm: no link count) still restores.
+TEST(Arm, AVersionOneSnapshotRecordOfTheFloatingCupIsRead) {
+  const WorldConfig c;
+  World run(c, random_start_state(c, 4));
+  for (int t = 0; t < 10; ++t) run.step({0.2, 0.1, 0.0});
+  const std::string v2 = run.snapshot().to_bytes();
+  // Marker, version, 24 numbers, the link count (0): version 1 is the same less the count.
+  const std::size_t count_at = 4 + 4 + 24 * 8;
+  std::string v1 = v2.substr(0, count_at) + v2.substr(count_at + 4, v2.size() - 8 - count_at - 4);
+  const std::uint32_t one = 1;
+  v1.replace(4, 4, reinterpret_cast<const char*>(&one), 4);
+  const std::uint64_t sum = fnv1a(v1);
+  v1.append(reinterpret_cast<const char*>(&sum), 8);
+  World restored(c);
+  restored.restore(WorldSnapshot::from_bytes(v1));
+  run.step({0.1, 0.0, 0.1});
+  restored.step({0.1, 0.0, 0.1});
+  EXPECT_TRUE(test::bit_equal(restored.state(), run.state()));
+}
+
+TEST(Arm, ALinkOnAWallIsWallContact) {
+  WorldConfig c = arm_world();
+  State s = paper_start_state(c);
+  s[si::kCupX] = 1.2;  // the arm leans left: drive the cup into the left wall
+  World w(c, s);
+  bool wall = false;
+  for (int t = 0; t < 60 && !wall; ++t) wall = w.step({-1.0, 0.4, 0.0});
+  EXPECT_TRUE(wall);
+}
+
+TEST(Arm, TheWorldFileNamesTheEmbodimentAndOlderFilesAreTheFloatingCup) {
+  const WorldConfig c = arm_world();
+  const WorldConfig back = world_config_from_json(to_json(c));
+  EXPECT_EQ(back, c);
+  EXPECT_NE(world_hash(c), world_hash(WorldConfig{}));
+  // A version 2 file has neither field: the floating cup.
+  std::string v2 = to_json(WorldConfig{});
+  v2.replace(v2.find("\"version\": 3"), 12, "\"version\": 2");
+  const auto drop = [&](const std::string& key) {
+    const auto at = v2.find("\"" + key + "\"");
+    const auto end = key == "arm" ? v2.find('}', at) + 1 : v2.find('\n', at) - 1;
+    v2.erase(at, end - at + 1);
+  };
+  drop("arm");
+  drop("embodiment");
+  EXPECT_EQ(world_config_from_json(v2).embodiment, Embodiment::cup);
+  // Out of reach, or an unknown embodiment: refused, naming the field.
+  WorldConfig short_arm = c;
+  short_arm.arm.link_lengths = {1.0, 1.0, 0.5};
+  EXPECT_THAT(test::error_of([&] { validate(short_arm); }), HasSubstr("arm.link_lengths"));
+  std::string text = to_json(c);
+  text.replace(text.find("\"arm\","), 6, "\"robot\",");
+  EXPECT_THAT(test::error_of([&] { world_config_from_json(text); }), HasSubstr("must be \"cup\" or \"arm\""));
+}
+
+}  // namespace
+}  // namespace dicestack
