@@ -17,6 +17,10 @@ namespace dicestack::cli {
 void WorldOption::add_to(CLI::App& app, bool starts) {
   app.add_option("--world", path, "World config JSON (defaults: the paper's world; see `dicestack config`)")
       ->check(CLI::ExistingFile);
+  app.add_option("--embodiment", embodiment,
+                 "What moves the cup: cup (the paper's floating cup) or arm (a planar arm holds it; docs/arm.md). "
+                 "Default: the world config's")
+      ->check(CLI::IsMember({"cup", "arm"}));
   if (starts)
     app.add_option("--start", start,
                    "Where episodes start: random (the world's randomization) or paper (the paper's start at rest, the "
@@ -26,7 +30,15 @@ void WorldOption::add_to(CLI::App& app, bool starts) {
 }
 
 WorldConfig WorldOption::load() const {
-  return with_starts(path.empty() ? WorldConfig{} : load_world_config(path), start);
+  WorldConfig config = with_starts(path.empty() ? WorldConfig{} : load_world_config(path), start);
+  if (embodiment.empty()) return config;
+  config.embodiment = embodiment == "arm" ? Embodiment::arm : Embodiment::cup;
+  try {
+    validate(config);
+  } catch (const ConfigError& e) {
+    throw ConfigError(std::string("--embodiment ") + embodiment + ": " + e.what());
+  }
+  return config;
 }
 
 void TrackerOption::add_to(CLI::App& app) {

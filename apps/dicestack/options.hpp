@@ -18,10 +18,11 @@ namespace dicestack::cli {
 struct WorldOption {
   std::filesystem::path path;
   std::string start = "random";
+  std::string embodiment;  ///< `--embodiment`: empty for the file's (the floating cup by default)
   /// `starts`: also bind `--start`.
   void add_to(CLI::App& app, bool starts = false);
   /// The config from the file, or the defaults when no file was given, with `--start`'s
-  /// distribution.
+  /// distribution and `--embodiment` when given (checked: an arm must reach the cup's start).
   WorldConfig load() const;
 };
 

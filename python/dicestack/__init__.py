@@ -37,6 +37,7 @@ __all__ = [
 ]
 
 ENV_ID = "dicestack/DiceStack-v0"
+ARM_ENV_ID = "dicestack/DiceStackArm-v0"  # the same task, the cup held by a planar arm (docs/arm.md)
 
 
 def _register_with_gymnasium():
@@ -44,14 +45,16 @@ def _register_with_gymnasium():
         from gymnasium.envs.registration import register, registry
     except ImportError:
         return
-    if ENV_ID not in registry:
-        # The environment ends its own episodes at the world's time limit: no TimeLimit wrapper.
-        register(
-            id=ENV_ID,
-            entry_point="dicestack.env:DiceStackEnv",
-            vector_entry_point="dicestack.vector_env:DiceStackVectorEnv",
-            max_episode_steps=None,
-        )
+    # The environment ends its own episodes at the world's time limit: no TimeLimit wrapper.
+    for env_id, kwargs in ((ENV_ID, {}), (ARM_ENV_ID, {"embodiment": "arm"})):
+        if env_id not in registry:
+            register(
+                id=env_id,
+                entry_point="dicestack.env:DiceStackEnv",
+                vector_entry_point="dicestack.vector_env:DiceStackVectorEnv",
+                max_episode_steps=None,
+                kwargs=kwargs,
+            )
 
 
 _register_with_gymnasium()

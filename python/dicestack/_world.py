@@ -6,14 +6,23 @@ import os
 from . import _dicestack
 
 
-def resolve_world(world=None, start="random"):
+def resolve_world(world=None, start="random", embodiment=None):
     """The _dicestack.WorldConfig for `world`, its episodes starting from `start`: "random" (the
     world's randomization) or "paper" (the paper's start at rest, the whole scene shifted in x by
-    U(-2 cm, 2 cm) per episode). ValueError names a bad field or start, FileNotFoundError a
+    U(-2 cm, 2 cm) per episode); `embodiment` "cup" or "arm" (docs/arm.md) replaces the world's
+    (None: keep it). ValueError names a bad field, start or embodiment, FileNotFoundError a
     missing file."""
     if not isinstance(start, str):
         raise TypeError(f"start must be 'random' or 'paper', got {type(start).__name__}")
-    return _resolve_config(world).with_starts(start)
+    config = _resolve_config(world)
+    if embodiment is not None:
+        if embodiment not in ("cup", "arm"):
+            shown = repr(embodiment)
+            raise ValueError(f"embodiment must be 'cup' or 'arm', got {shown if len(shown) <= 40 else shown[:40] + '...'}")
+        fields = json.loads(config.to_json())
+        fields["embodiment"] = embodiment
+        config = _dicestack.WorldConfig.from_json(json.dumps(fields), "<embodiment>")
+    return config.with_starts(start)
 
 
 def _resolve_config(world):

@@ -85,14 +85,18 @@ class DiceStackEnv(_EnvBase):
     factors each observation is the estimate of a Kalman filter whose motion model is the
     simulator, as `dicestack evaluate --estimator kalman` shows a policy (docs/robustness.md,
     "The estimator").
+
+    embodiment: None (the world's), "cup" (the paper's floating cup) or "arm": a planar arm holds
+    the cup and the same actions drive it through its joints (docs/arm.md); the observation stays
+    the 24 numbers. `dicestack/DiceStackArm-v0` is this environment with embodiment="arm".
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
-    def __init__(self, world=None, render_mode=None, perturb=None, start="random", estimator="none"):
+    def __init__(self, world=None, render_mode=None, perturb=None, start="random", estimator="none", embodiment=None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
-        self._world = resolve_world(world, start)
+        self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
             raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
         self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world), estimator)

@@ -39,13 +39,14 @@ class DiceStackVectorEnv(_VectorBase):
     spec = None
     closed = False
 
-    def __init__(self, num_envs, world=None, threads=None, perturb=None, start="random", estimator="none"):
+    def __init__(self, num_envs, world=None, threads=None, perturb=None, start="random", estimator="none",
+                 embodiment=None):
         if isinstance(num_envs, bool) or not isinstance(num_envs, numbers.Integral) or num_envs < 1:
             raise ValueError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
         if num_envs >= 2**63:
             raise ValueError(f"DiceStackVectorEnv: {num_envs} environments would need more memory than any machine has")
         self.num_envs = int(num_envs)
-        self._world = resolve_world(world, start)
+        self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
             raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
         self._vec = _dicestack.VectorEnv(self._world, self.num_envs, threads, resolve_perturbation(perturb, self._world),

@@ -141,6 +141,27 @@ TEST(Cli, BadWorldConfigIsReportedWithTheField) {
   std::filesystem::remove(bad);
 }
 
+// `--embodiment arm` puts the arm under any world; a world whose arm cannot hold the cup at its
+// start is refused naming the field, and an unknown embodiment naming the choices.
+TEST(Cli, TheEmbodimentIsChosenOnAnyWorld) {
+  const Process held = run("rollout --steps 5 --embodiment arm --json", false);
+  EXPECT_EQ(held.status, 0) << held.output;
+  EXPECT_EQ(run("rollout --steps 5 --json", false).output.size() > 0, true);
+  const auto file = test::scratch_path("dicestack_cli_short_arm.json");
+  ASSERT_EQ(run("config --out " + file.string()).status, 0);
+  auto j = nlohmann::json::parse(std::ifstream(file));
+  j["arm"]["link_lengths"] = {1.0, 1.0, 0.5};
+  std::ofstream(file) << j.dump();
+  EXPECT_EQ(run("rollout --steps 5 --world " + file.string()).status, 0);  // a cup world never reads its arm
+  const Process short_arm = run("rollout --steps 5 --embodiment arm --world " + file.string());
+  EXPECT_EQ(short_arm.status, 1);
+  EXPECT_THAT(short_arm.output, HasSubstr("--embodiment arm: world config <value>: field \"arm.link_lengths\" cannot reach"));
+  const Process unknown = run("rollout --steps 5 --embodiment robot");
+  EXPECT_NE(unknown.status, 0);
+  EXPECT_THAT(unknown.output, HasSubstr("robot not in {cup,arm}"));
+  std::filesystem::remove(file);
+}
+
 // Every file a user names goes through one checked reader: a FIFO (which would block at its
 // open) or a device (which never ends) is refused at once, naming the file, by every command.
 TEST(CliInput, AFifoOrADeviceGivenForAnyFileIsRefusedAtOnce) {
