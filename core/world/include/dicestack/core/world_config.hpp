@@ -69,8 +69,8 @@ struct ArmConfig {
   /// (`dicestack bench arm`, docs/arm.md).
   std::array<double, 4> torque_limit{7500.0, 6500.0, 1700.0, 700.0};
   std::array<double, 4> speed_limit{20.0, 20.0, 20.0, 20.0};  ///< rad/s per joint
-  /// Rate (1/s) at which the spare degree of freedom is pulled back to the rest posture: the
-  /// last link along the line from the shoulder to the wrist.
+  /// Rate (1/s) at which the spare degree of freedom is pulled back to the rest posture
+  /// (arm_posture in arm.hpp).
   double posture_gain = 5.0;
   bool operator==(const ArmConfig&) const = default;
 };
