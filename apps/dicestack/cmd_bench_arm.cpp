@@ -55,7 +55,7 @@ double world_episodes_per_second(const WorldConfig& config, int episodes, int st
 // step's last substep, over every step of every recording, with no torque limit (the demand,
 // to set the limits from), and how far the cup strays from the path.
 struct Demand {
-  std::array<std::vector<double>, 4> peaks;
+  std::array<std::vector<double>, 4> torques;
   double position_error = 0.0;  // mean |cup position - recorded|, m
   long long steps = 0;
 };
@@ -82,7 +82,7 @@ Demand torque_demand(WorldConfig arm, const std::vector<Episode>& recordings) {
       }
       w.step(a);  // the torques of the last substep stand for the step
       const auto torque = w.arm_joint_torques();
-      for (std::size_t j = 0; j < 4; ++j) d.peaks[j].push_back(std::abs(torque[j]));
+      for (std::size_t j = 0; j < 4; ++j) d.torques[j].push_back(std::abs(torque[j]));
       d.position_error += std::hypot(w.state()[si::kCupX] - next[si::kCupX], w.state()[si::kCupY] - next[si::kCupY]);
       ++d.steps;
     }
@@ -95,6 +95,24 @@ double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   return v[static_cast<std::size_t>(std::min<double>(q * static_cast<double>(v.size()), static_cast<double>(v.size() - 1)))];
+}
+
+// One joint's line of the demand table.
+struct JointDemand {
+  const char* joint;
+  double p50, p95, p99, largest, limit, within;  // within: the fraction of steps under the limit
+};
+
+std::array<JointDemand, 4> demand_rows(const Demand& d, const ArmConfig& arm) {
+  const std::array<const char*, 4> names{"shoulder", "elbow", "second elbow", "wrist"};
+  std::array<JointDemand, 4> rows{};
+  for (std::size_t j = 0; j < 4; ++j) {
+    const auto& p = d.torques[j];
+    const auto under = std::count_if(p.begin(), p.end(), [&](double v) { return v < arm.torque_limit[j] - 1e-6; });
+    rows[j] = {names[j],           quantile(p, 0.5), quantile(p, 0.95), quantile(p, 0.99), quantile(p, 1.0),
+               arm.torque_limit[j], static_cast<double>(under) / static_cast<double>(std::max<std::size_t>(p.size(), 1))};
+  }
+  return rows;
 }
 
 int run_arm_bench(const ArmBenchOptions& opt) {
@@ -112,16 +130,12 @@ int run_arm_bench(const ArmBenchOptions& opt) {
   // The recordings are read in the floating cup's world (their own); the arm follows their cups.
   const auto recordings = read_demo_set(resolve_demo_set(opt.demos, cup)).episodes;
   const Demand d = torque_demand(arm, recordings);
-  const std::array<const char*, 4> names{"shoulder", "elbow", "second elbow", "wrist"};
+  const auto rows = demand_rows(d, arm.arm);
   if (opt.json) {
     nlohmann::json joints = nlohmann::json::array();
-    for (std::size_t j = 0; j < 4; ++j) {
-      const auto& p = d.peaks[j];
-      const double within = static_cast<double>(std::count_if(p.begin(), p.end(), [&](double v) { return v < arm.arm.torque_limit[j] - 1e-6; })) /
-                            static_cast<double>(std::max<std::size_t>(p.size(), 1));
-      joints.push_back({{"joint", names[j]}, {"p50", quantile(p, 0.5)}, {"p95", quantile(p, 0.95)}, {"p99", quantile(p, 0.99)},
-                        {"max", quantile(p, 1.0)}, {"limit", arm.arm.torque_limit[j]}, {"within_limit", within}});
-    }
+    for (const JointDemand& r : rows)
+      joints.push_back({{"joint", r.joint}, {"p50", r.p50}, {"p95", r.p95}, {"p99", r.p99}, {"max", r.largest},
+                        {"limit", r.limit}, {"within_limit", r.within}});
     print_line(nlohmann::json{{"arm_episodes_per_second", median(held)},
                               {"bare_episodes_per_second", median(bare)},
                               {"floating_cup_episodes_per_second", median(floating)},
@@ -143,13 +157,9 @@ int run_arm_bench(const ArmBenchOptions& opt) {
               "feasible\n\n| joint | median | 95th | 99th | largest | limit | steps within |\n"
               "|---|---:|---:|---:|---:|---:|---:|\n",
               recordings.size(), opt.demos.string().c_str(), d.steps, d.position_error);
-  for (std::size_t j = 0; j < 4; ++j) {
-    const auto& p = d.peaks[j];
-    const double within = 100.0 * static_cast<double>(std::count_if(p.begin(), p.end(), [&](double v) { return v < arm.arm.torque_limit[j] - 1e-6; })) /
-                          static_cast<double>(std::max<std::size_t>(p.size(), 1));
-    std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f %% |\n", names[j], quantile(p, 0.5), quantile(p, 0.95),
-                quantile(p, 0.99), quantile(p, 1.0), arm.arm.torque_limit[j], within);
-  }
+  for (const JointDemand& r : rows)
+    std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f %% |\n", r.joint, r.p50, r.p95, r.p99, r.largest, r.limit,
+                100.0 * r.within);
   return 0;
 }
 

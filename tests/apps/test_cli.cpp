@@ -383,6 +383,26 @@ TEST(CliLearning, SavedRolloutsBehindAnEstimatorAreRefusedUnderSensingFactors) {
   std::filesystem::remove(model);
 }
 
+// A policy trained with perturb= behind the estimator runs behind it by default: evaluate and
+// robustness take the model's own unless --estimator says otherwise.
+TEST(CliLearning, APolicyTrainedBehindTheEstimatorIsEvaluatedBehindIt) {
+  const auto model = test::scratch_path("dicestack_cli_behind.dsm");
+  ASSERT_EQ(run("train --demos " + kTinyDemos + " --regressor knn --set k=2 --split none --learner dart --option expert=scripted "
+                "--option episodes=2 --option successes_only=false --option perturb=medium --out " + model.string())
+                .status,
+            0);
+  const std::string base = "evaluate --model " + model.string() + " --episodes 2 --perturb medium --json";
+  const auto own = nlohmann::json::parse(run(base, false).output), asked = nlohmann::json::parse(run(base + " --estimator kalman", false).output),
+             raw = nlohmann::json::parse(run(base + " --estimator none", false).output);
+  EXPECT_EQ(own.value("estimator", ""), "kalman");
+  EXPECT_EQ(own["dice_in_cup_mean"], asked["dice_in_cup_mean"]);
+  EXPECT_EQ(own["mean_episode_length"], asked["mean_episode_length"]);
+  EXPECT_FALSE(raw.contains("estimator"));
+  const Process table = run("robustness --model " + model.string() + " --episodes 1 --factors observation_delay", false);
+  EXPECT_THAT(table.output, HasSubstr("the kalman estimator's estimate"));
+  std::filesystem::remove(model);
+}
+
 TEST(CliLearning, PaperStartsAreNamedWhereTheyAreUsedAndAnotherNameIsRefused) {
   const auto model = test::scratch_path("dicestack_cli_start.dsm");
   const auto rollouts = test::scratch_path("dicestack_cli_start_rollouts");

@@ -19,6 +19,13 @@ Vec2 direction(double angle) { return {std::cos(angle), std::sin(angle)}; }
 
 double wrap_angle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
+// How far the last link is from its rest direction for where the wrist is now (rad, wrapped):
+// what the posture term in the Jacobian's null space closes.
+double posture_error(const ArmConfig& arm, const std::array<double, 3>& link_angles) {
+  const double rest = arm_posture(arm, arm_posture_of(arm, link_angles).joints[3]).link_angles[2];
+  return wrap_angle(rest - link_angles[2]);
+}
+
 }  // namespace
 
 ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& link_angles) {
@@ -79,11 +86,10 @@ std::array<double, 3> arm_link_rates(const ArmConfig& arm, const std::array<doub
   std::array<double, 3> rates{};
   for (std::size_t i = 0; i < 3; ++i) rates[i] = jx[i] * sx + jy[i] * sy;
   // The null space of J: the cross product of its rows. Moving along it leaves the wrist where
-  // it is; it turns the last link towards the shoulder-wrist line.
+  // it is; it turns the last link towards its rest direction.
   const std::array<double, 3> n{jx[1] * jy[2] - jx[2] * jy[1], jx[2] * jy[0] - jx[0] * jy[2], jx[0] * jy[1] - jx[1] * jy[0]};
   if (std::abs(n[2]) > 1e-6) {
-    const double rest = arm_posture(arm, arm_posture_of(arm, link_angles).joints[3]).link_angles[2];
-    const double step = arm.posture_gain * wrap_angle(rest - link_angles[2]) / n[2];
+    const double step = arm.posture_gain * posture_error(arm, link_angles) / n[2];
     for (std::size_t i = 0; i < 3; ++i) rates[i] += step * n[i];
   }
   return rates;
@@ -111,7 +117,7 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   for (std::size_t i = 0; i < 4; ++i) {
     Eigen::Matrix<double, 2, 4> jv = Eigen::Matrix<double, 2, 4>::Zero();
     Eigen::Vector2d centripetal = Eigen::Vector2d::Zero();
-    for (std::size_t j = 0; j <= i && j < 4; ++j) {
+    for (std::size_t j = 0; j <= i; ++j) {
       const double r = reach(i, j);
       jv(0, static_cast<Eigen::Index>(j)) = -r * std::sin(a[j]);
       jv(1, static_cast<Eigen::Index>(j)) = r * std::cos(a[j]);
@@ -140,10 +146,8 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   const Eigen::Matrix3d tt = task * task.transpose() + kDamping * kDamping * Eigen::Matrix3d::Identity();
   const Eigen::Matrix<double, 4, 3> pinv = task.transpose() * tt.inverse();
   Vec4 accel = pinv * wanted;
-  const std::array<double, 3> links{a[0], a[1], a[2]};
-  const double rest = arm_posture(arm, arm_posture_of(arm, links).joints[3]).link_angles[2];
-  Vec4 posture = Vec4::Zero();
-  posture(2) = arm.posture_gain * arm.posture_gain * wrap_angle(rest - a[2]) - 2.0 * arm.posture_gain * w[2];
+  Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
+  posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];
   accel += (Eigen::Matrix4d::Identity() - pinv * task) * posture;
   // No joint faster than its speed limit by the end of the substep: the relative rates it would
   // reach, clipped, give back the accelerations.
