@@ -90,6 +90,9 @@ int main(int argc, char** argv) {
       write(out / "model_file" / "version1.dsm", header.dump() + file.substr(newline));
     }
     write(out / "world_config" / "default.json", to_json(WorldConfig{}));
+    WorldConfig arm;
+    arm.embodiment = Embodiment::arm;
+    write(out / "world_config" / "arm.json", to_json(arm));
 
     DemoSet set;
     set.description = "fuzz seed";
