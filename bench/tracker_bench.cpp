@@ -3,16 +3,18 @@
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
 //   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
 //       [--recordings K [--subset-seed S]] [--preset plain|distill] [--set NAME=VALUE]... [--probes P] [--paths N] [--no-optimise]
-//       [--noise F [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path] [--json]
+//       [--noise F|X,Y,W [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path [--ranked]] [--json]
 //       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv] [--retry]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
 // The tracker is the preset (tracker_preset, default plain) with each setting on top, in order:
 // --set NAME=VALUE for any (tracker_setting_names), and --probes, --paths, ... for the same
 // names with dashes.
-// --noise F adds DART's executed-action noise (std F x action.scale) to the episode that follows
+// --noise F adds DART's executed-action noise (std F x action.scale; X,Y,W: per axis, as DART's
+// default with the tracker, 0.1,0.5,0.2) to the episode that follows
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
-// from each start instead, with and without that noise, and lists them by successes.
+// from each start instead, with and without that noise, and lists them by successes; with
+// --ranked, the paths of the ranked recordings (the variants and a refined path among them).
 // --rescue N runs the tracker expert with rescue N (closed loop on the dice) instead of
 // the chosen path's follower; --retry runs it trying again once a failed attempt has come to rest
 // (ExpertConfig::retry). --robust K makes robust choices (TrackerConfig::robust);
@@ -45,8 +47,10 @@ struct Options {
   std::string preset = "plain";        // --preset: tracker_preset's name
   std::vector<std::string> settings;   // NAME=VALUE on top, in the order given
   TrackerConfig tracker;               // the preset with the settings
-  double noise = 0.0, noise_from = 0.0, noise_to = 1e9;
-  bool per_path = false, json = false, retry = false;
+  Action noise{};  // per axis, x action.scale
+  double noise_from = 0.0, noise_to = 1e9;
+  bool noisy() const { return noise[0] > 0.0 || noise[1] > 0.0 || noise[2] > 0.0; }
+  bool per_path = false, ranked = false, json = false, retry = false;
   std::string choices;  // --choices FILE: one CSV line per start
 };
 
@@ -75,11 +79,17 @@ Options parse(int argc, char** argv) {
       std::replace(name.begin(), name.end(), '-', '_');  // the setting's own name
       o.settings.push_back(name + "=" + next());
     }
-    else if (a == "--noise") o.noise = std::stod(next());
+    else if (a == "--noise") {
+      const std::string v = next();
+      const int n = std::sscanf(v.c_str(), "%lf,%lf,%lf", &o.noise[0], &o.noise[1], &o.noise[2]);
+      if (n == 1) o.noise[1] = o.noise[2] = o.noise[0];
+      else if (n != 3) throw std::runtime_error("--noise F or X,Y,W");
+    }
     else if (a == "--noise-window") {
       const std::string v = next();
       if (std::sscanf(v.c_str(), "%lf,%lf", &o.noise_from, &o.noise_to) != 2) throw std::runtime_error("--noise-window FROM,TO");
     } else if (a == "--per-path") o.per_path = true;
+    else if (a == "--ranked") o.ranked = true;
     else if (a == "--json") o.json = true;
     else if (a == "--choices") o.choices = next();
     else throw std::runtime_error("unknown argument " + a);
@@ -99,7 +109,7 @@ Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std
     Action a = expert ? expert->act(env) : follower.act(env.get_state(), env.t());
     const double at = static_cast<double>(env.t() - first) / std::max(1, follower.length());
     if (noisy && at >= o.noise_from && at < o.noise_to)
-      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += o.noise * env.config().action.scale[k] * rng.normal();
+      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += o.noise[k] * env.config().action.scale[k] * rng.normal();
     if (env.step(a).terminated) break;
   }
   return env.outcome();
@@ -108,7 +118,7 @@ Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std
 int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, const Options& o) {
   TrackerConfig unranked = o.tracker;  // the paths as the tracker follows them (smoothed), no ranking
   unranked.probes = 0;
-  const Recordings recordings(cup_paths(episodes), world, unranked, 0, o.threads);
+  const Recordings recordings(cup_paths(episodes), world, o.ranked ? o.tracker : unranked, 0, o.threads);
   const auto& paths = recordings.paths();
   const auto n = static_cast<std::size_t>(o.starts);
   std::vector<int> ok(paths.size() * n), ok_noisy(paths.size() * n);
@@ -130,7 +140,8 @@ int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, con
     rows.emplace_back(a, b, both, paths[p].name);
   }
   std::sort(rows.rbegin(), rows.rend());
-  std::printf("recording: realistic successes of %d starts as recorded, with noise %.3f, and both\n", o.starts, o.noise);
+  std::printf("recording: realistic successes of %d starts as recorded, with noise %g,%g,%g, and both\n", o.starts,
+              o.noise[0], o.noise[1], o.noise[2]);
   for (const auto& [a, b, both, name] : rows) std::printf("%s %d %d %d\n", name.c_str(), a, b, both);
   return 0;
 }
@@ -171,7 +182,7 @@ int main(int argc, char** argv) try {
                                 o.tracker.gain, o.tracker.keep_extremes);
     Expert* expert = o.tracker.rescue > 0 || o.retry ? experts[static_cast<std::size_t>(w)].get() : nullptr;
     if (expert) expert->reset(s);
-    r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noise > 0.0, expert);
+    r.outcome = follow(env, follower, o, derive_seed(s, 2), o.noisy(), expert);
   });
   const double seconds = std::chrono::duration<double>(clock::now() - t1).count();
   if (!o.choices.empty()) {
@@ -205,19 +216,20 @@ int main(int argc, char** argv) try {
   std::sort(by_count.rbegin(), by_count.rend());
   const double ms = 1e3 * seconds / o.starts;
   if (o.json) {
-    std::printf("{\"demos\": \"%s\", \"recordings\": %zu, \"starts\": %d, \"seed\": %llu, \"threads\": %d, \"noise\": %g, "
+    std::printf("{\"demos\": \"%s\", \"recordings\": %zu, \"starts\": %d, \"seed\": %llu, \"threads\": %d, \"noise\": [%g, %g, %g], "
                 "\"realistic_success\": %d, \"wall_contact\": %d, \"search_found\": %d, \"warped\": %d, "
                 "\"distinct_paths\": %zu, \"simulations_mean\": %.2f, \"simulations_max\": %d, \"rank_seconds\": %.3f, "
                 "\"seconds\": %.3f, \"ms_per_start\": %.2f}\n",
                 o.demos.c_str(), episodes.size(), o.starts, static_cast<unsigned long long>(o.seed),
-                resolve_threads(o.threads), o.noise, success, wall, found, warped, chosen.size(),
+                resolve_threads(o.threads), o.noise[0], o.noise[1], o.noise[2], success, wall, found, warped, chosen.size(),
                 static_cast<double>(sims_total) / o.starts, sims_max, rank_seconds, seconds, ms);
     return 0;
   }
-  std::printf("tracker on %s (%zu recordings), %d starts from evaluation seed %llu, %d threads, noise %g\n",
+  std::printf("tracker on %s (%zu recordings), %d starts from evaluation seed %llu, %d threads, noise %g,%g,%g\n",
               o.demos.c_str(), episodes.size(), o.starts, static_cast<unsigned long long>(o.seed),
-              resolve_threads(o.threads), o.noise);
-  std::printf("ranking: %d probe starts per recording, %.2f s\n", o.tracker.probes, rank_seconds);
+              resolve_threads(o.threads), o.noise[0], o.noise[1], o.noise[2]);
+  std::printf("ranking: %d probe starts per recording, %.2f s; followed: %s\n", o.tracker.probes, rank_seconds,
+              followed_recordings(*recordings).c_str());
   std::printf("realistic success %d / %d, wall contact %d; the search found a success for %d, %d of them warped\n",
               success, o.starts, wall, found, warped);
   std::printf("simulations per start: mean %.2f, max %d; %.3f s in all (%.2f ms per start)\n",

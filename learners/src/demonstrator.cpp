@@ -102,7 +102,14 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: when no recording succeeds as recorded, first narrow the swing in this many even steps, then CMA-ES (0: CMA-ES only)", {}},
           {"tracker_variants", ParamType::boolean, d.variants.empty() ? "false" : "true", 0, 1,
            "tracker: also rank the 8 best-ranked recordings smoothed by each of 0, 1, 2, 3, 4, 6 and 8 steps, score "
-           "the 4 best paths again from 4 x tracker_probes more probe starts, and follow the best", {}}};
+           "the 4 best paths again from 4 x tracker_probes more probe starts, and follow the best", {}},
+          {"tracker_refine", ParamType::integer, std::to_string(d.refine), 0, 10000,
+           "tracker: CMA-ES generations that move the leading path by smooth offsets to succeed from the most "
+           "starts, clean and under DART's noise; it leads if it beats its original from fresh starts (0: off)", {}},
+          {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
+           "tracker: starts per generation of tracker_refine", {}},
+          {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 10,
+           "tracker: tracker_refine also moves the path's timing, by at most this many seconds (0: not)", {}}};
 }
 
 std::string followed_recordings(const Recordings& recordings) {

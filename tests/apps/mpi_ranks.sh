@@ -61,7 +61,8 @@ case "$mode" in
       ranks "$1" record --expert tracker --demos "$work/demos" --episodes 5 --seed 3 --noise 0.1 --threads "$2" \
         --out "$work/rec-$1" "${world[@]}" > /dev/null
       ranks "$1" train --regressor knn --learner dart --option expert=tracker --option episodes=5 \
-        --option successes_only=false --option tracker_probes=2 --option tracker_robust=2 --demos "$work/demos" --seed 4 --threads "$2" \
+        --option successes_only=false --option tracker_probes=2 --option tracker_robust=2 \
+        --option tracker_refine=1 --option tracker_refine_probes=2 --demos "$work/demos" --seed 4 --threads "$2" \
         --out "$work/dart-$1.dsm" "${world[@]}" > /dev/null
     done
     grep -q 'expert tracker' "$work/rec-1/meta.json" || fail "the set does not name its expert"

@@ -759,7 +759,7 @@ TEST(CliLearning, RecordThroughATrackerPresetWithSettingsSaysSoAndABadSettingIsR
   const auto dir = test::scratch_path("dicestack_cli_tracker_preset");
   std::filesystem::remove_all(dir);
   const Process p = run("record --expert tracker --demos " + kTinyDemos +
-                            " --tracker-preset distill --tracker smooth=2 --tracker probes=2 --episodes 1 --out " + dir.string(),
+                            " --tracker-preset distill --tracker smooth=2 --tracker probes=2 --tracker refine=0 --episodes 1 --out " + dir.string(),
                         false);
   ASSERT_EQ(p.status, 0) << p.output;
   std::ifstream meta(dir / "meta.json");
@@ -786,12 +786,12 @@ TEST(CliLearning, RecordThroughATrackerPresetWithSettingsSaysSoAndABadSettingIsR
 
 TEST(CliLearning, LeaderboardRowsCanBeLearnersWithOptions) {
   const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr "
-                        "--learners bc,dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1 "
+                        "--learners bc,dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1:tracker_refine=0 "
                         "--episodes 1 --format json", false);
   ASSERT_EQ(p.status, 0) << p.output;
   const auto rows = nlohmann::json::parse(p.output)["rows"];
   ASSERT_EQ(rows.size(), 3u);  // bc, dart through the tracker, playback
-  EXPECT_EQ(rows[1]["learner"], "dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1");
+  EXPECT_EQ(rows[1]["learner"], "dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1:tracker_refine=0");
   const Process bad = run("leaderboard --demos " + kTinyDemos + " --learners dart:expert=oracle --episodes 1");
   EXPECT_EQ(bad.status, 1);
   EXPECT_THAT(bad.output, HasSubstr("learner \"dart:expert=oracle\""));

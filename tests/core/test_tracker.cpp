@@ -258,6 +258,60 @@ TEST(TrackerRecordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScore
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"variants\""), std::string::npos);
 }
 
+TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnlyWhenItBeatsItsOriginal) {
+  const WorldConfig w = test::short_world(200);
+  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  TrackerConfig c;
+  c.probes = 4;
+  const Recordings plain(paths, w, c, 7, 1);
+  c.refine = 2;
+  c.refine_probes = 3;
+  c.refine_knots = 2;
+  const Recordings r(paths, w, c, 7, 1);
+  ASSERT_EQ(r.paths().size(), 4u);
+  const CupPath& leader = paths[plain.order()[0]];
+  const CupPath& refined = r.paths()[3];
+  EXPECT_EQ(refined.name, leader.name + " (refined)");
+  EXPECT_EQ(r.probe_trials()[3], 2 * 4 * 3) << "its validation: 4 x refine_probes fresh starts, clean and noisy";
+  EXPECT_EQ(std::count(r.order().begin(), r.order().end(), 3u), 1);
+  EXPECT_TRUE(r.order().front() == 3u || r.order().back() == 3u);
+  if (r.order().front() != 3u) {
+    EXPECT_EQ(std::vector<std::size_t>(r.order().begin(), r.order().end() - 1), plain.order());
+  }
+  // Its actions are folded into its velocities; the dice stay as recorded.
+  for (std::size_t t = 0; t < refined.states.size(); ++t) {
+    EXPECT_EQ(refined.actions[t], Action{});
+    EXPECT_EQ(refined.states[t][si::die(1)], leader.states[t][si::die(1)]);
+  }
+  // The same on any number of threads.
+  const Recordings two(paths, w, c, 7, 2);
+  EXPECT_EQ(two.order(), r.order());
+  EXPECT_EQ(two.probe_successes(), r.probe_successes());
+  EXPECT_EQ(two.paths()[3].states, refined.states);
+  // With no room to move, the refined path is the leader as followed.
+  c.refine_range = {0.0, 0.0, 0.0, 0.0};
+  const Recordings still(paths, w, c, 7, 1);
+  for (std::size_t t = 0; t < leader.states.size(); ++t) {
+    EXPECT_EQ(still.paths()[3].states[t][si::kCupX], leader.states[t][si::kCupX]);
+    EXPECT_DOUBLE_EQ(still.paths()[3].states[t][si::kCupVy], leader.states[t][si::kCupVy] + leader.actions[t][1]);
+  }
+  // With the timing axis alone, the path is played at other times: every pose lies on the path.
+  c.refine_range = {0.0, 0.0, 0.0, 0.3};
+  const Recordings timed(paths, w, c, 7, 1);
+  const auto [lo, hi] = std::minmax_element(leader.states.begin(), leader.states.end(),
+                                            [](const State& a, const State& b) { return a[si::kCupY] < b[si::kCupY]; });
+  bool moved = false;
+  for (std::size_t t = 0; t < leader.states.size(); ++t) {
+    const double y = timed.paths()[3].states[t][si::kCupY];
+    EXPECT_GE(y, (*lo)[si::kCupY]);
+    EXPECT_LE(y, (*hi)[si::kCupY]);
+    moved = moved || y != leader.states[t][si::kCupY];
+  }
+  EXPECT_TRUE(moved);
+  c.refine_probes = 0;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_probes\""), std::string::npos);
+}
+
 TEST(TrackerExpert, ChoosesOnceAndFollows) {
   const WorldConfig w;
   std::vector<CupPath> paths{scripted_path(5)};
@@ -443,6 +497,8 @@ TEST(TrackerPresets, PlainIsTheBareTrackerAndDistillTheLearnersTuning) {
   EXPECT_EQ(distill.robust_warp, 0.02);
   EXPECT_EQ(distill.shrink, 5);
   EXPECT_EQ(distill.variants.size(), kTrackerVariantWidths.size());
+  EXPECT_EQ(distill.refine, 60);
+  EXPECT_EQ(plain.refine, 0);
   EXPECT_NO_THROW(validate(distill));
   EXPECT_THAT(test::error_of([] { tracker_preset("tuned"); }),
               HasSubstr("tracker preset \"tuned\": unknown; presets: plain, distill"));

@@ -62,7 +62,7 @@ TEST(HonestLearning, DartFromRecordingsBuildsNoHandMadeExpert) {
   const LearnContext c = recordings_context();
   const auto learned = LearnerRegistry::global()
                            .create("dart", {"expert=tracker", "episodes=3", "successes_only=false", "tracker_probes=1",
-                                            "tracker_optimise=false"})
+                                            "tracker_optimise=false", "tracker_refine=0"})
                            ->learn(c);
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
   EXPECT_EQ(learned.model->record.at("learner"), "dart");
@@ -88,7 +88,8 @@ TEST(HonestLearning, DadAndDartFromThreeRecordingsBuildNoHandMadeExpertAndNameTh
   LearnContext c = recordings_context();
   c.demos.resize(3);
   c.features = "state+clock+start_state@dice+retry/position";
-  const std::vector<std::string> tracker{"tracker_probes=1", "tracker_robust=1", "tracker_variants=false"};
+  const std::vector<std::string> tracker{"tracker_probes=1", "tracker_robust=1", "tracker_variants=false",
+                                         "tracker_refine=0"};
   std::vector<std::string> dad{"starts=training", "episodes=2", "windows=1", "iterations=1", "corrector=track"};
   dad.insert(dad.end(), tracker.begin(), tracker.end());
   const auto from_dad = LearnerRegistry::global().create("dad", dad)->learn(c);
@@ -113,7 +114,7 @@ TEST(HonestLearning, TheTrackerFollowsAnotherSetsTrainingEpisodesWhenToldTo) {
   LearnContext c = recordings_context();
   c.demos.clear();  // the run's own set holds nothing the tracker could follow
   const std::vector<std::string> options{"expert=tracker", "episodes=2", "successes_only=false", "tracker_probes=1",
-                                         "tracker_optimise=false", "tracker_variants=false"};
+                                         "tracker_optimise=false", "tracker_variants=false", "tracker_refine=0"};
   EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dart", options)->learn(c); }),
               HasSubstr("no demonstrations to follow"));
   std::vector<std::string> other = options;
@@ -132,7 +133,7 @@ TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
   const LearnContext c = recordings_context();
   const auto learned = LearnerRegistry::global()
                            .create("dagger", {"expert=tracker", "iterations=1", "rollouts=2", "tracker_probes=0",
-                                              "tracker_optimise=false"})
+                                              "tracker_optimise=false", "tracker_refine=0"})
                            ->learn(c);
   EXPECT_EQ(learned.model->record.at("expert"), "tracker");
   EXPECT_THAT(learned.model->record.at("tracker_followed"), HasSubstr(" (not ranked)")) << "no probes, no ranking";
@@ -142,7 +143,7 @@ TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
   const LearnContext c = recordings_context();
   const auto learned = LearnerRegistry::global()
                            .create("dart", {"expert=tracker", "episodes=2", "successes_only=false", "tracker_probes=0",
-                                            "tracker_optimise=false"})
+                                            "tracker_optimise=false", "tracker_refine=0"})
                            ->learn(c);
   const fs::path path = test::scratch_path("dicestack_tracker_model.dsm");
   save_model(*learned.model, path);

@@ -148,7 +148,8 @@ def test_tracker_needs_recordings_and_the_others_read_none():
 def test_the_trackers_preset_and_settings_go_by_the_learners_names(builtin_episodes):
     # The tracker of record and robustness is "plain"; the learners' is "distill"; settings on top.
     few = builtin_episodes[:3]
-    expert = dicestack.expert("tracker", demos=few, preset="distill", settings={"smooth": 2, "probes": 2, "variants": False})
+    settings = {"smooth": 2, "probes": 2, "variants": False, "refine": 0}
+    expert = dicestack.expert("tracker", demos=few, preset="distill", settings=settings)
     env = dicestack.DiceStackEnv()
     env.reset(seed=3)
     assert len(expert(env)) == 3

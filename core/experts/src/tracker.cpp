@@ -15,9 +15,58 @@
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/core/rng.hpp>
 
+#include "path_refine.hpp"
+#include "path_trial.hpp"
+
 namespace dicestack {
+namespace tracker_detail {
+
+namespace si = state_index;
+
+Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps, const Action& noise,
+               std::uint64_t noise_seed) {
+  sim.restore(start);
+  Rng rng(noise_seed);
+  const Action& scale = sim.config().action.scale;
+  const bool noisy = noise[0] > 0.0 || noise[1] > 0.0 || noise[2] > 0.0;
+  const bool clean = !sim.outcome().wall_contact;
+  const int end = sim.t() + follower.length() + hold_steps;
+  State s = sim.get_state();
+  Trial trial;
+  while (sim.t() < sim.config().episode.max_steps && sim.t() < end) {
+    Action a = follower.act(s, sim.t());
+    if (noisy)
+      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += noise[k] * scale[k] * rng.normal();
+    const StepResult r = sim.step(a);
+    s = r.observation;
+    if (r.terminated) {
+      trial.success = true;
+      trial.score = 1.0 + 1.0 / (1.0 + r.info.t);  // the earlier success ranks higher
+      return trial;
+    }
+    if (clean && r.info.outcome.wall_contact) break;
+  }
+  trial.score = -stack_shortfall(s, sim.config()) - (sim.outcome().wall_contact ? 1000.0 : 0.0);
+  return trial;
+}
+
+CupPath folded(const CupPath& path) {
+  CupPath out = path;
+  for (std::size_t t = 0; t < out.states.size(); ++t) {
+    out.states[t][si::kCupVx] += out.actions[t][0];
+    out.states[t][si::kCupVy] += out.actions[t][1];
+    out.states[t][si::kCupW] += out.actions[t][2];
+    out.actions[t] = Action{};
+  }
+  return out;
+}
+
+}  // namespace tracker_detail
+
 namespace {
 
+using tracker_detail::simulate;
+using tracker_detail::Trial;
 namespace si = state_index;
 
 constexpr std::uint64_t kProbeStream = 0x70726f6265ULL;  // "probe"
@@ -71,39 +120,6 @@ CupPath smoothed(const CupPath& path, double sigma) {
   return out;
 }
 
-// One simulated episode of a follower: higher is better; only a realistic success scores above 0.
-struct Trial {
-  double score = -1e300;
-  bool success = false;
-};
-
-// `noise` > 0 adds executed-action noise of that std (x action.scale) drawn from `noise_seed`.
-Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps,
-               double noise = 0.0, std::uint64_t noise_seed = 0) {
-  sim.restore(start);
-  Rng rng(noise_seed);
-  const Action& scale = sim.config().action.scale;
-  const bool clean = !sim.outcome().wall_contact;
-  const int end = sim.t() + follower.length() + hold_steps;
-  State s = sim.get_state();
-  Trial trial;
-  while (sim.t() < sim.config().episode.max_steps && sim.t() < end) {
-    Action a = follower.act(s, sim.t());
-    if (noise > 0.0)
-      for (std::size_t k = 0; k < kActionDim; ++k) a[k] += noise * scale[k] * rng.normal();
-    const StepResult r = sim.step(a);
-    s = r.observation;
-    if (r.terminated) {
-      trial.success = true;
-      trial.score = 1.0 + 1.0 / (1.0 + r.info.t);  // the earlier success ranks higher
-      return trial;
-    }
-    if (clean && r.info.outcome.wall_contact) break;
-  }
-  trial.score = -stack_shortfall(s, sim.config()) - (sim.outcome().wall_contact ? 1000.0 : 0.0);
-  return trial;
-}
-
 // One noisy trial of a candidate, as a learner would play it: executed-action noise on every
 // step and, with robust_warp, the whole path a little off (time scale, offset, amplitude drawn
 // once). 1 if it still ends in a realistic success.
@@ -117,7 +133,8 @@ int robust_trial(const CupPath& path, const PathWarp& warp, const State& frame, 
     jittered.amplitude *= 1.0 + c.robust_warp * rng.normal();
   }
   const PathFollower follower(path, jittered, frame, start_step, c.gain, c.keep_extremes);
-  return simulate(follower, sim, start, c.hold_steps, c.robust_noise, seed).success ? 1 : 0;
+  const Action noise{c.robust_noise, c.robust_noise, c.robust_noise};
+  return simulate(follower, sim, start, c.hold_steps, noise, seed).success ? 1 : 0;
 }
 
 // x in [-1, 1]^3 (clipped) to a warp of `base` inside the config's bounds.
@@ -298,6 +315,11 @@ void validate(const TrackerConfig& c) {
   require(c.offset_range >= 0.0 && c.offset_range <= 10.0, "offset_range", "in [0, 10]", c.offset_range);
   require(c.amplitude_range >= 0.0 && c.amplitude_range < 1.0, "amplitude_range", "in [0, 1)", c.amplitude_range);
   require(c.hold_steps >= 0 && c.hold_steps <= 100000, "hold_steps", "in [0, 100000]", c.hold_steps);
+  require(c.refine >= 0 && c.refine <= 10000, "refine", "in [0, 10000]", c.refine);
+  require(c.refine_probes >= 1 && c.refine_probes <= 100000, "refine_probes", "in [1, 100000]", c.refine_probes);
+  require(c.refine_knots >= 1 && c.refine_knots <= 100, "refine_knots", "in [1, 100]", c.refine_knots);
+  for (const double r : c.refine_range) require(r >= 0.0 && r <= 10.0, "refine_range", "in [0, 10] per axis", r);
+  for (const double n : c.refine_noise) require(n >= 0.0 && n <= 10.0, "refine_noise", "in [0, 10] per axis", n);
   require(c.smooth >= 0.0 && c.smooth <= 1000.0, "smooth", "in [0, 1000]", c.smooth);
   require(c.rescue >= 0 && c.rescue <= 100000, "rescue", "in [0, 100000]",
           c.rescue);
@@ -411,8 +433,19 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
     std::erase_if(order_, [&](std::size_t p) { return std::find(finalists.begin(), finalists.end(), p) != finalists.end(); });
     order_.insert(order_.begin(), finalists.begin(), finalists.end());
   }
+  if (config_.refine > 0) refine_leader(world, threads, cluster);
   if (config_.paths > 0 && static_cast<std::size_t>(config_.paths) < order_.size())
     order_.resize(static_cast<std::size_t>(config_.paths));
+}
+
+void Recordings::refine_leader(const WorldConfig& world, int threads, Cluster& cluster) {
+  auto refined = tracker_detail::refine_path(paths_[order_.front()], world, config_, seed_, threads, cluster);
+  paths_.push_back(std::move(refined.path));
+  probe_successes_.push_back(refined.refined);
+  probe_trials_.push_back(refined.trials);
+  const std::size_t added = paths_.size() - 1;
+  if (refined.refined > refined.original) order_.insert(order_.begin(), added);
+  else order_.push_back(added);
 }
 
 std::vector<std::size_t> Recordings::ranked(std::size_t count) const {

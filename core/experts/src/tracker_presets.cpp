@@ -54,6 +54,7 @@ TrackerConfig tracker_preset(std::string_view name) {
     c.robust_warp = 0.02;
     c.shrink = 5;
     c.variants.assign(kTrackerVariantWidths.begin(), kTrackerVariantWidths.end());
+    c.refine = 60;
     return c;
   }
   throw ConfigError("tracker preset \"" + std::string(name) + "\": unknown; presets: " + joined(tracker_preset_names()));
@@ -63,7 +64,7 @@ std::vector<std::string> tracker_preset_names() { return {"plain", "distill"}; }
 
 std::vector<std::string> tracker_setting_names() {
   return {"probes", "optimise", "paths", "smooth", "rescue", "robust", "robust_noise", "robust_warp", "keep_extremes",
-          "shrink", "variants"};
+          "shrink", "variants", "refine", "refine_probes", "refine_timing"};
 }
 
 void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_view value) {
@@ -88,6 +89,12 @@ void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_vi
     c.keep_extremes = yes_or_no(name, value);
   } else if (name == "shrink") {
     c.shrink = whole_number(name, value);
+  } else if (name == "refine") {
+    c.refine = whole_number(name, value);
+  } else if (name == "refine_probes") {
+    c.refine_probes = whole_number(name, value);
+  } else if (name == "refine_timing") {
+    c.refine_range[3] = real_number(name, value);
   } else if (name == "variants") {
     c.variants.clear();
     if (yes_or_no(name, value)) c.variants.assign(kTrackerVariantWidths.begin(), kTrackerVariantWidths.end());
@@ -114,6 +121,9 @@ std::string tracker_setting_text(const TrackerConfig& c, std::string_view name) 
   if (name == "keep_extremes") return flag(c.keep_extremes);
   if (name == "shrink") return std::to_string(c.shrink);
   if (name == "variants") return flag(!c.variants.empty());
+  if (name == "refine") return std::to_string(c.refine);
+  if (name == "refine_probes") return std::to_string(c.refine_probes);
+  if (name == "refine_timing") return number(c.refine_range[3]);
   throw ConfigError("tracker setting \"" + std::string(name) + "\": unknown; settings: " + joined(tracker_setting_names()));
 }
 

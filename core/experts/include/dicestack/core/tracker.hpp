@@ -83,6 +83,20 @@ struct TrackerConfig {
   int variant_recordings = 8;  ///< >= 1
   int finalists = 4;           ///< >= 1
   int finalist_probes = 64;    ///< >= 0
+  /// Paths robust by construction: the leading path's cup pose (and timing) is moved by smooth
+  /// offsets (refine_knots bumps per axis over its length, each at most refine_range) that CMA-ES
+  /// chooses, this many generations, to succeed from the most starts as followed, with and
+  /// without executed-action noise of std refine_noise x action.scale. The refined path leads
+  /// the order when it beats its original from fresh starts. A recorded path's success is a
+  /// lottery in details below what a person controls; a learner distilling the tracker succeeds
+  /// about as often as its path does under its noise. 0: off. In [0, 10000].
+  int refine = 0;
+  int refine_probes = 32;  ///< starts per generation (each played clean and noisy), in [1, 100000]
+  int refine_knots = 6;    ///< Gaussian bumps per axis, evenly spaced over the path, in [1, 100]
+  /// Largest offset per axis: x m, y m, angle rad, and timing s (0: the path keeps its timing).
+  std::array<double, 4> refine_range{0.2, 0.2, 0.2, 0.0};
+  /// The noise of a refinement's noisy trials: DART's default with the tracker (0.1, 0.5, 0.2).
+  Action refine_noise{0.1, 0.5, 0.2};
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
@@ -96,16 +110,18 @@ inline constexpr std::array<double, 7> kTrackerVariantWidths{0.0, 1.0, 2.0, 3.0,
 ///  - "distill": tuned for a learner distilling it (the learners' default): the 3 best-ranked
 ///    recordings, smoothed by 4 steps, chosen robust to a learner's errors (5 noisy trials,
 ///    warps of std 0.02), narrowed in 5 steps before warped, each recording's smoothing chosen
-///    among kTrackerVariantWidths. Measured in docs/notebook/2026-11-27-learners-page-history.md
-///    ("Policies from the human recordings"); the recipe: docs/learners.md.
+///    among kTrackerVariantWidths, the leading path refined for 60 generations (refine). Measured
+///    in docs/notebook/2026-11-27-learners-page-history.md ("Policies from the human recordings")
+///    and docs/notebook/2026-11-28-refined-paths.md; the recipe: docs/learners.md.
 /// Throws ConfigError for another name, listing the presets.
 TrackerConfig tracker_preset(std::string_view name);
 /// The presets' names, in listing order.
 std::vector<std::string> tracker_preset_names();
 
 /// The settings a user may give by name ("NAME=VALUE"), each a TrackerConfig field: probes,
-/// optimise, paths, smooth, rescue, robust, robust_noise, robust_warp, keep_extremes, shrink and
-/// variants (true: kTrackerVariantWidths, false: none). `probes` also sets finalist_probes to 4
+/// optimise, paths, smooth, rescue, robust, robust_noise, robust_warp, keep_extremes, shrink,
+/// variants (true: kTrackerVariantWidths, false: none), refine, refine_probes and refine_timing
+/// (refine_range's timing axis). `probes` also sets finalist_probes to 4
 /// times it (finalists are scored from four times the ranking's starts).
 std::vector<std::string> tracker_setting_names();
 /// Sets one of them from text. Throws ConfigError naming the setting and what it takes.
@@ -164,7 +180,8 @@ class Recordings {
   /// only the first config.paths of them when paths > 0 (the others are never followed).
   const std::vector<std::size_t>& order() const { return order_; }
   /// Probe score per path (index as in paths()): its successes from the probe starts, and with
-  /// robust, 1 more for each noisy trial of such a success that also succeeds.
+  /// robust, 1 more for each noisy trial of such a success that also succeeds. A refined path's
+  /// is its successes in its validation trials.
   const std::vector<int>& probe_successes() const { return probe_successes_; }
   /// The trials each probe score counts: probes x (1 + robust), more for a finalist.
   const std::vector<int>& probe_trials() const { return probe_trials_; }
@@ -174,6 +191,9 @@ class Recordings {
  private:
   /// The first `count` paths by probe score, most successes first, then by index.
   std::vector<std::size_t> ranked(std::size_t count) const;
+  /// Refines the path that leads the order (TrackerConfig::refine), adds it to paths() with its
+  /// validation successes as its probe score, and puts it first if it beats its original there.
+  void refine_leader(const WorldConfig& world, int threads, Cluster& cluster);
   /// Probe scores of paths [from, to) from probe starts [first_probe, first_probe + probes).
   std::vector<int> probe_scores(const WorldConfig& world, int threads, Cluster& cluster, std::size_t from, std::size_t to,
                                 int first_probe, int probes, bool variants) const;
