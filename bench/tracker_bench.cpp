@@ -1,11 +1,12 @@
 // Measures the tracker, the demonstrator made of demonstrations (docs/learners.md):
 // realistic success, wall contact, which recordings it chose and how many simulations its
 // search took, over random starts (evaluation_start_seed(seed, i)). Usage:
-//   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--threads N]
+//   dicestack_tracker_bench [--demos builtin|human|DIR] [--starts N] [--seed S] [--tracker-seed T] [--threads N]
 //       [--recordings K [--subset-seed S]] [--preset plain|distill] [--set NAME=VALUE]... [--probes P] [--paths N] [--no-optimise]
 //       [--noise F|X,Y,W [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path [--ranked]] [--json]
 //       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv] [--retry]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
+// --tracker-seed T seeds the ranking and the refinement (0 by default; a learner gives its own seed).
 // The tracker is the preset (tracker_preset, default plain) with each setting on top, in order:
 // --set NAME=VALUE for any (tracker_setting_names), and --probes, --paths, ... for the same
 // names with dashes.
@@ -43,7 +44,7 @@ namespace {
 struct Options {
   std::string demos = "human";
   int starts = 100, threads = 0, recordings = 0;
-  std::uint64_t seed = 1000, subset_seed = 0;
+  std::uint64_t seed = 1000, subset_seed = 0, tracker_seed = 0;
   std::string preset = "plain";        // --preset: tracker_preset's name
   std::vector<std::string> settings;   // NAME=VALUE on top, in the order given
   TrackerConfig tracker;               // the preset with the settings
@@ -68,6 +69,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--threads") o.threads = std::stoi(next());
     else if (a == "--recordings") o.recordings = std::stoi(next());
     else if (a == "--subset-seed") o.subset_seed = std::stoull(next());
+    else if (a == "--tracker-seed") o.tracker_seed = std::stoull(next());
     else if (a == "--preset") o.preset = next();
     else if (a == "--set") o.settings.push_back(next());
     else if (a == "--no-optimise") o.settings.push_back("optimise=false");
@@ -118,7 +120,7 @@ Outcome follow(DiceEnv& env, const PathFollower& follower, const Options& o, std
 int per_path(const std::vector<Episode>& episodes, const WorldConfig& world, const Options& o) {
   TrackerConfig unranked = o.tracker;  // the paths as the tracker follows them (smoothed), no ranking
   unranked.probes = 0;
-  const Recordings recordings(cup_paths(episodes), world, o.ranked ? o.tracker : unranked, 0, o.threads);
+  const Recordings recordings(cup_paths(episodes), world, o.ranked ? o.tracker : unranked, o.tracker_seed, o.threads);
   const auto& paths = recordings.paths();
   const auto n = static_cast<std::size_t>(o.starts);
   std::vector<int> ok(paths.size() * n), ok_noisy(paths.size() * n);
@@ -157,7 +159,7 @@ int main(int argc, char** argv) try {
 
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
-  const auto recordings = make_recordings(episodes, world, o.tracker, 0, o.threads);
+  const auto recordings = make_recordings(episodes, world, o.tracker, o.tracker_seed, o.threads);
   const double rank_seconds = std::chrono::duration<double>(clock::now() - t0).count();
 
   struct Result {

@@ -113,14 +113,14 @@ std::vector<ParamSpec> tracker_param_specs() {
 }
 
 std::string followed_recordings(const Recordings& recordings) {
-  const TrackerConfig& c = recordings.config();
-  const int most = c.probes * (1 + c.robust);  // each probe, and each of its noisy trials
   std::string out;
   for (const std::size_t p : recordings.order()) {
+    // A path with trials was ranked by them (or, refined, validated); without, it was not ranked.
+    const int trials = recordings.probe_trials()[p];
     out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;
-    out += most > 0 ? " (" + std::to_string(recordings.probe_successes()[p]) + " of " +
-                          std::to_string(recordings.probe_trials()[p]) + " probe trials)"
-                    : " (not ranked)";
+    out += trials > 0 ? " (" + std::to_string(recordings.probe_successes()[p]) + " of " + std::to_string(trials) +
+                            " probe trials)"
+                      : " (not ranked)";
   }
   return out;
 }
