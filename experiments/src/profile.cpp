@@ -10,8 +10,8 @@ std::vector<Profile> make_profiles() {
   quick.name = "quick";
   quick.rollouts = 20;
   // The tracker's gbt row with dart's own defaults (1200 episodes: 66 s of the main job) but
-  // the refined path: refining the leading human recording costs about 100 s, more than the main
-  // job's minutes allow, and its row stacks in 20 of 20 without.
+  // without refining the path: that costs about 100 s, more than the main job's minutes allow,
+  // and its row stacks in 20 of 20 without.
   quick.learner_options = {{"dagger", {"iterations=2", "rollouts=10"}},
                            {"dad", {"windows=2", "iterations=1", "corrector_iterations=10"}},
                            {"dart:expert=tracker", {"tracker_demos=human", "tracker_refine=0"}}};
@@ -31,9 +31,10 @@ std::vector<Profile> make_profiles() {
   // Every regressor learns the tracker's row: at DART's 300 episodes, not its 1200 (a kernel
   // SVR's fit grows with the square of the rows), and so with no narrowing, which pays only with
   // more episodes (built-in set, gbt: 36 / 37 % narrowed, 55 / 47 % not;
-  // docs/notebook/2026-11-27-learners-page-history.md, "The paper profile").
+  // docs/notebook/2026-11-27-learners-page-history.md, "The paper profile"), and unrefined:
+  // refining costs about 100 s per row, and the paper profile trains one row per regressor and map.
   paper.learner_options = {{"dagger", {"iterations=5", "rollouts=20"}},  // dad: its defaults
-                           {"dart:expert=tracker", {"episodes=300", "tracker_shrink=0"}}};
+                           {"dart:expert=tracker", {"episodes=300", "tracker_shrink=0", "tracker_refine=0"}}};
   paper.learners = {"bc", "dagger", "dart", "dart:expert=tracker"};
   paper.every_feature_map = true;
   paper.optimiser_evaluations = 5000;

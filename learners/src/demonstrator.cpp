@@ -108,8 +108,8 @@ std::vector<ParamSpec> tracker_param_specs() {
            "starts, clean and under DART's noise; it leads if it beats its original from fresh starts (0: off)", {}},
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
-          {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 10,
-           "tracker: tracker_refine also moves the path's timing, by at most this many seconds (0: not)", {}}};
+          {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 1,
+           "tracker: tracker_refine also moves the path's timing, each bump by at most this many seconds (0: not)", {}}};
 }
 
 std::string followed_recordings(const Recordings& recordings) {

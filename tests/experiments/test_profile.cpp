@@ -35,11 +35,13 @@ TEST(Profile, QuickAndPaperAreDataAndOtherNamesAreRefused) {
   EXPECT_TRUE(paper.left_out.empty());
   EXPECT_EQ(quick.learner_options.at("dagger"), (std::vector<std::string>{"iterations=2", "rollouts=10"}));
   // A row spec's own defaults: the quick profile's tracker row follows the human recordings
-  // whatever --demos names, unrefined (the main job's minutes); the paper profile's tracker rows keep a kernel SVR's fit in bounds.
+  // whatever --demos names; the paper profile's tracker rows keep a kernel SVR's fit in bounds;
+  // neither refines its path (the main job's minutes, a row per regressor and map).
   EXPECT_EQ(quick.learner_options.at("dart:expert=tracker"),
             (std::vector<std::string>{"tracker_demos=human", "tracker_refine=0"}));
-  EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), (std::vector<std::string>{"episodes=300", "tracker_shrink=0"}));
-  EXPECT_EQ(paper.options_for("dart", "dart:expert=tracker"), (std::vector<std::string>{"episodes=300", "tracker_shrink=0"}));
+  const std::vector<std::string> paper_tracker{"episodes=300", "tracker_shrink=0", "tracker_refine=0"};
+  EXPECT_EQ(paper.learner_options.at("dart:expert=tracker"), paper_tracker);
+  EXPECT_EQ(paper.options_for("dart", "dart:expert=tracker"), paper_tracker);
   EXPECT_EQ(quick.options_for("dart", "dart:expert=tracker"),
             (std::vector<std::string>{"tracker_demos=human", "tracker_refine=0"}));
   EXPECT_TRUE(quick.options_for("dart", "dart").empty());

@@ -95,6 +95,11 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   tracked["run"]["learner_options"]["tracker_paths"] = "-1";
   tracked["run"]["learner_options"].erase("tracker_shrink");
   EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_shrink \"(absent)\" in the checkpoint, \"5\" in this run"));
+  // Written before tracker_refine existed, when the tracker never refined a path.
+  EXPECT_EQ(saved["run"]["learner_options"]["tracker_refine"], "60");
+  tracked["run"]["learner_options"]["tracker_shrink"] = "5";
+  tracked["run"]["learner_options"].erase("tracker_refine");
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_refine \"(absent)\" in the checkpoint, \"60\" in this run"));
   // Written before retry existed: its absence meant no retries, which auto means for this map
   // (state) and is saved as; "false" and "auto" mean the same, "true" does not.
   EXPECT_EQ(saved["run"]["learner_options"]["retry"], "false");

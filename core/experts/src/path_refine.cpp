@@ -28,7 +28,7 @@ constexpr std::uint64_t kRefineSearchStream = 0x726566696e43ULL; // "refinC"
 // path, each of height clip(x) x refine_range. Axes x, y and angle move the cup's pose, and the
 // velocities get the offsets' rates, so the follower's feed-forward and its pose target agree;
 // the timing axis (when its range is above 0) plays step t of the path at time t + its offset,
-// the velocities scaled by the local speed.
+// never earlier than the step before, the velocities scaled by the local speed.
 CupPath offset_path(const CupPath& base, const Eigen::VectorXd& x, const TrackerConfig& c, double dt) {
   constexpr std::size_t pose[3] = {si::kCupX, si::kCupY, si::kCupAngle};
   constexpr std::size_t velocity[3] = {si::kCupVx, si::kCupVy, si::kCupW};
@@ -49,6 +49,7 @@ CupPath offset_path(const CupPath& base, const Eigen::VectorXd& x, const Tracker
   };
   const bool timed = c.refine_range[3] > 0.0;
   CupPath out = base;
+  double played = 0.0;  // the latest point of the path played so far: time never runs backwards
   for (std::size_t t = 0; t < n; ++t) {
     double u = static_cast<double>(t), speed = 1.0;
     if (timed) {
@@ -59,8 +60,9 @@ CupPath offset_path(const CupPath& base, const Eigen::VectorXd& x, const Tracker
         shift += height(3, j) / dt * b;
         shift_rate += height(3, j) / dt * rate;
       }
-      u = std::clamp(u + shift, 0.0, last);
+      u = std::max(played, std::clamp(u + shift, 0.0, last));
       speed = std::max(0.2, 1.0 + shift_rate);
+      played = u;
     }
     const auto i = static_cast<std::size_t>(u);
     const std::size_t next = std::min(i + 1, n - 1);

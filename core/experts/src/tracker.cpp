@@ -318,7 +318,9 @@ void validate(const TrackerConfig& c) {
   require(c.refine >= 0 && c.refine <= 10000, "refine", "in [0, 10000]", c.refine);
   require(c.refine_probes >= 1 && c.refine_probes <= 100000, "refine_probes", "in [1, 100000]", c.refine_probes);
   require(c.refine_knots >= 1 && c.refine_knots <= 100, "refine_knots", "in [1, 100]", c.refine_knots);
-  for (const double r : c.refine_range) require(r >= 0.0 && r <= 10.0, "refine_range", "in [0, 10] per axis", r);
+  for (std::size_t k = 0; k < 3; ++k)
+    require(c.refine_range[k] >= 0.0 && c.refine_range[k] <= 10.0, "refine_range", "in [0, 10] per axis", c.refine_range[k]);
+  require(c.refine_range[3] >= 0.0 && c.refine_range[3] <= 1.0, "refine_timing", "in [0, 1]", c.refine_range[3]);
   for (const double n : c.refine_noise) require(n >= 0.0 && n <= 10.0, "refine_noise", "in [0, 10] per axis", n);
   require(c.smooth >= 0.0 && c.smooth <= 1000.0, "smooth", "in [0, 1000]", c.smooth);
   require(c.rescue >= 0 && c.rescue <= 100000, "rescue", "in [0, 100000]",

@@ -93,7 +93,8 @@ struct TrackerConfig {
   int refine = 0;
   int refine_probes = 32;  ///< starts per generation (each played clean and noisy), in [1, 100000]
   int refine_knots = 6;    ///< Gaussian bumps per axis, evenly spaced over the path, in [1, 100]
-  /// Largest offset per axis: x m, y m, angle rad, and timing s (0: the path keeps its timing).
+  /// Largest height of one bump per axis: x m, y m, angle rad, and timing s (0: the path keeps
+  /// its timing). Neighbouring bumps overlap: together they move a step up to ~2.5 times this.
   std::array<double, 4> refine_range{0.2, 0.2, 0.2, 0.0};
   /// The noise of a refinement's noisy trials: DART's default with the tracker (0.1, 0.5, 0.2).
   Action refine_noise{0.1, 0.5, 0.2};
@@ -183,7 +184,8 @@ class Recordings {
   /// robust, 1 more for each noisy trial of such a success that also succeeds. A refined path's
   /// is its successes in its validation trials.
   const std::vector<int>& probe_successes() const { return probe_successes_; }
-  /// The trials each probe score counts: probes x (1 + robust), more for a finalist.
+  /// The trials each probe score counts: probes x (1 + robust), more for a finalist; a refined
+  /// path's, its validation trials (8 x refine_probes).
   const std::vector<int>& probe_trials() const { return probe_trials_; }
   const TrackerConfig& config() const { return config_; }
   std::uint64_t seed() const { return seed_; }
