@@ -139,6 +139,19 @@ TEST(HonestLearning, DaggerFromRecordingsBuildsNoHandMadeExpert) {
   EXPECT_THAT(learned.model->record.at("tracker_followed"), HasSubstr(" (not ranked)")) << "no probes, no ranking";
 }
 
+TEST(HonestLearning, ARefinedPathIsNamedWithItsValidationTrialsEvenWhenTheRankingRanNoProbes) {
+  const LearnContext c = recordings_context();
+  const auto learned = LearnerRegistry::global()
+                           .create("dart", {"expert=tracker", "episodes=2", "successes_only=false", "tracker_probes=0",
+                                            "tracker_optimise=false", "tracker_refine=1", "tracker_refine_probes=1",
+                                            "tracker_paths=0"})
+                           ->learn(c);
+  const std::string followed = learned.model->record.at("tracker_followed");
+  // 4 x 1 fresh starts, each played clean and noisy; the recordings themselves were not ranked.
+  EXPECT_THAT(followed, testing::ContainsRegex(" \\(refined\\) \\([0-8] of 8 probe trials\\)")) << followed;
+  EXPECT_THAT(followed, HasSubstr(" (not ranked)")) << followed;
+}
+
 TEST(HonestLearning, AModelLearnedFromRecordingsActsWithNoExpertAtAll) {
   const LearnContext c = recordings_context();
   const auto learned = LearnerRegistry::global()

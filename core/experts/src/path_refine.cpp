@@ -1,7 +1,6 @@
 #include "path_refine.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -109,16 +108,8 @@ std::vector<double> start_values(const std::vector<CupPath>& paths, const WorldC
         }
         return value;
       },
-      [](const double& v) {
-        char text[32];
-        const auto r = std::to_chars(text, text + sizeof text, v);
-        return std::string(text, r.ptr);
-      },
-      [](std::string_view b) {
-        double v = 0.0;
-        std::from_chars(b.data(), b.data() + b.size(), v);
-        return v;
-      });
+      [](const double& v) { return Packer().put(v).take(); },
+      [](std::string_view b) { return Unpacker(b, "refinement value").get<double>(); });
   return values;
 }
 
