@@ -232,6 +232,12 @@ int main(int argc, char** argv) try {
               resolve_threads(o.threads), o.noise[0], o.noise[1], o.noise[2]);
   std::printf("ranking: %d probe starts per recording, %.2f s; followed: %s\n", o.tracker.probes, rank_seconds,
               followed_recordings(*recordings).c_str());
+  std::string refined;  // every refinement, with its validation successes
+  for (std::size_t p = 0; p < recordings->paths().size(); ++p)
+    if (recordings->paths()[p].name.ends_with("(refined)"))
+      refined += (refined.empty() ? "" : ", ") + recordings->paths()[p].name + " " +
+                 std::to_string(recordings->probe_successes()[p]) + "/" + std::to_string(recordings->probe_trials()[p]);
+  if (!refined.empty()) std::printf("refined: %s\n", refined.c_str());
   std::printf("realistic success %d / %d, wall contact %d; the search found a success for %d, %d of them warped\n",
               success, o.starts, wall, found, warped);
   std::printf("simulations per start: mean %.2f, max %d; %.3f s in all (%.2f ms per start)\n",

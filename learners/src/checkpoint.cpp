@@ -63,10 +63,11 @@ std::map<std::string, std::string> saved_options(const json& saved) {
 // What a learner's option meant in checkpoints written before the option existed: the behaviour
 // then, which is its default unless listed here (DaD corrected towards whole states before it
 // had "target"; the tracker did not narrow a path before it had "tracker_shrink", nor refine one
-// before "tracker_refine").
+// before "tracker_refine", and refined one path once before "tracker_refine_restarts").
 std::string value_before(const std::string& learner, const std::string& key) {
   if (learner == "dad" && key == "target") return "state";
   if (key == "tracker_shrink" || key == "tracker_refine") return "0";
+  if (key == "tracker_refine_restarts") return "1";
   for (const auto& p : LearnerRegistry::global().info(learner).params)
     if (p.name == key) return p.default_value;
   return "";

@@ -108,6 +108,8 @@ std::vector<ParamSpec> tracker_param_specs() {
            "starts, clean and under DART's noise; it leads if it beats its original from fresh starts (0: off)", {}},
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
+          {"tracker_refine_restarts", ParamType::integer, std::to_string(d.refine_restarts), 1, 100,
+           "tracker: refinements, each of the next-ranked path from a seed of its own; the best from the same fresh starts leads", {}},
           {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 1,
            "tracker: tracker_refine also moves the path's timing, each bump by at most this many seconds (0: not)", {}}};
 }

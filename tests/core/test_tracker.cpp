@@ -312,6 +312,40 @@ TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnly
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_probes\""), std::string::npos);
 }
 
+TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnAndTheBestByTheSameValidationLeads) {
+  const WorldConfig w = test::short_world(200);
+  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  TrackerConfig c;
+  c.probes = 4;
+  const Recordings plain(paths, w, c, 7, 1);
+  c.refine = 2;
+  c.refine_probes = 3;
+  c.refine_knots = 2;
+  const Recordings one(paths, w, c, 7, 1);
+  c.refine_restarts = 4;  // more than the paths: the fourth refines the leader again, from another seed
+  const Recordings r(paths, w, c, 7, 1);
+  ASSERT_EQ(r.paths().size(), 7u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(r.paths()[3 + i].name, paths[plain.order()[i % 3]].name + " (refined)");
+    EXPECT_EQ(r.probe_trials()[3 + i], 2 * 4 * 3);
+  }
+  EXPECT_EQ(r.paths()[3].states, one.paths()[3].states) << "the first restart is the single refinement";
+  EXPECT_NE(r.paths()[6].states, r.paths()[3].states) << "the same path from another seed";
+  // The best refined path (the first of equals) leads if it beats the leader as followed; every
+  // other refined path follows the order as it was.
+  const auto& s = r.probe_successes();
+  const auto best = static_cast<std::size_t>(std::max_element(s.begin() + 3, s.end()) - s.begin());
+  std::vector<std::size_t> rest(r.order().begin(), r.order().end());
+  if (rest.front() == best) rest.erase(rest.begin());
+  else EXPECT_EQ(std::count(rest.begin(), rest.end(), best), 1);
+  EXPECT_EQ(std::vector<std::size_t>(rest.begin(), rest.begin() + 3), plain.order());
+  const Recordings two(paths, w, c, 7, 2);
+  EXPECT_EQ(two.order(), r.order());
+  EXPECT_EQ(two.probe_successes(), r.probe_successes());
+  c.refine_restarts = 0;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_restarts\""), std::string::npos);
+}
+
 TEST(TrackerExpert, ChoosesOnceAndFollows) {
   const WorldConfig w;
   std::vector<CupPath> paths{scripted_path(5)};

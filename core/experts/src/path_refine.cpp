@@ -22,6 +22,7 @@ namespace {
 constexpr std::uint64_t kRefineStartStream = 0x726566696e53ULL;  // "refinS"
 constexpr std::uint64_t kRefineNoiseStream = 0x726566696e4eULL;  // "refinN"
 constexpr std::uint64_t kRefineSearchStream = 0x726566696e43ULL; // "refinC"
+constexpr std::uint64_t kValidationStream = 0x726566696e56ULL;   // "refinV"
 
 // `base` (folded) moved by x: per axis, refine_knots Gaussian bumps evenly spaced over the
 // path, each of height clip(x) x refine_range. Axes x, y and angle move the cup's pose, and the
@@ -115,8 +116,8 @@ std::vector<double> start_values(const std::vector<CupPath>& paths, const WorldC
 
 }  // namespace
 
-RefinedPath refine_path(const CupPath& path, const WorldConfig& world, const TrackerConfig& c, std::uint64_t seed,
-                        int threads, Cluster& cluster) {
+CupPath refine_path(const CupPath& path, const WorldConfig& world, const TrackerConfig& c, std::uint64_t seed, int threads,
+                    Cluster& cluster) {
   const CupPath base = folded(path);
   const double dt = world.physics.control_dt;
   const auto probes = static_cast<std::size_t>(c.refine_probes);
@@ -138,15 +139,19 @@ RefinedPath refine_path(const CupPath& path, const WorldConfig& world, const Tra
     es.tell(loss);
     ++generation;
   }
-  RefinedPath out;
-  out.path = offset_path(base, es.mean(), c, dt);
-  out.path.name = path.name + " (refined)";
-  const std::vector<CupPath> both{base, out.path};
-  const std::size_t first = generation * probes, count = 4 * probes;
-  const auto values = start_values(both, world, c, seed, first, count, threads, cluster);
-  for (std::size_t item = 0; item < values.size(); ++item)
-    (item < count ? out.original : out.refined) += static_cast<int>(std::floor(values[item]));
-  out.trials = static_cast<int>(2 * count);
+  CupPath out = offset_path(base, es.mean(), c, dt);
+  out.name = path.name + " (refined)";
+  return out;
+}
+
+std::vector<int> validation_successes(const std::vector<CupPath>& paths, const WorldConfig& world, const TrackerConfig& c,
+                                      std::uint64_t seed, int threads, Cluster& cluster) {
+  std::vector<CupPath> played;
+  for (const auto& p : paths) played.push_back(folded(p));
+  const std::size_t count = 4 * static_cast<std::size_t>(c.refine_probes);
+  const auto values = start_values(played, world, c, derive_seed(seed, kValidationStream), 0, count, threads, cluster);
+  std::vector<int> out(paths.size(), 0);
+  for (std::size_t item = 0; item < values.size(); ++item) out[item / count] += static_cast<int>(std::floor(values[item]));
   return out;
 }
 

@@ -55,6 +55,7 @@ TrackerConfig tracker_preset(std::string_view name) {
     c.shrink = 5;
     c.variants.assign(kTrackerVariantWidths.begin(), kTrackerVariantWidths.end());
     c.refine = 60;
+    c.refine_restarts = 4;
     return c;
   }
   throw ConfigError("tracker preset \"" + std::string(name) + "\": unknown; presets: " + joined(tracker_preset_names()));
@@ -64,7 +65,7 @@ std::vector<std::string> tracker_preset_names() { return {"plain", "distill"}; }
 
 std::vector<std::string> tracker_setting_names() {
   return {"probes", "optimise", "paths", "smooth", "rescue", "robust", "robust_noise", "robust_warp", "keep_extremes",
-          "shrink", "variants", "refine", "refine_probes", "refine_timing"};
+          "shrink", "variants", "refine", "refine_probes", "refine_restarts", "refine_timing"};
 }
 
 void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_view value) {
@@ -93,6 +94,8 @@ void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_vi
     c.refine = whole_number(name, value);
   } else if (name == "refine_probes") {
     c.refine_probes = whole_number(name, value);
+  } else if (name == "refine_restarts") {
+    c.refine_restarts = whole_number(name, value);
   } else if (name == "refine_timing") {
     c.refine_range[3] = real_number(name, value);
   } else if (name == "variants") {
@@ -123,6 +126,7 @@ std::string tracker_setting_text(const TrackerConfig& c, std::string_view name) 
   if (name == "variants") return flag(!c.variants.empty());
   if (name == "refine") return std::to_string(c.refine);
   if (name == "refine_probes") return std::to_string(c.refine_probes);
+  if (name == "refine_restarts") return std::to_string(c.refine_restarts);
   if (name == "refine_timing") return number(c.refine_range[3]);
   throw ConfigError("tracker setting \"" + std::string(name) + "\": unknown; settings: " + joined(tracker_setting_names()));
 }

@@ -92,6 +92,9 @@ struct TrackerConfig {
   /// about as often as its path does under its noise. 0: off. In [0, 10000].
   int refine = 0;
   int refine_probes = 32;  ///< starts per generation (each played clean and noisy), in [1, 100000]
+  /// Refinements, each of the next path of the order (wrapping) from a seed of its own; the one
+  /// with most successes from the same fresh starts leads if it beats the leader. In [1, 100].
+  int refine_restarts = 1;
   int refine_knots = 6;    ///< Gaussian bumps per axis, evenly spaced over the path, in [1, 100]
   /// Largest height of one bump per axis: x m, y m, angle rad, and timing s (0: the path keeps
   /// its timing). Neighbouring bumps overlap: together they move a step up to ~2.5 times this.
@@ -111,7 +114,8 @@ inline constexpr std::array<double, 7> kTrackerVariantWidths{0.0, 1.0, 2.0, 3.0,
 ///  - "distill": tuned for a learner distilling it (the learners' default): the 3 best-ranked
 ///    recordings, smoothed by 4 steps, chosen robust to a learner's errors (5 noisy trials,
 ///    warps of std 0.02), narrowed in 5 steps before warped, each recording's smoothing chosen
-///    among kTrackerVariantWidths, the leading path refined for 60 generations (refine). Measured
+///    among kTrackerVariantWidths, the 4 leading paths refined for 60 generations each (refine,
+///    refine_restarts), the best by validation leading. Measured
 ///    in docs/notebook/2026-11-27-learners-page-history.md ("Policies from the human recordings")
 ///    and docs/notebook/2026-11-28-refined-paths.md; the recipe: docs/learners.md.
 /// Throws ConfigError for another name, listing the presets.
@@ -121,8 +125,8 @@ std::vector<std::string> tracker_preset_names();
 
 /// The settings a user may give by name ("NAME=VALUE"), each a TrackerConfig field: probes,
 /// optimise, paths, smooth, rescue, robust, robust_noise, robust_warp, keep_extremes, shrink,
-/// variants (true: kTrackerVariantWidths, false: none), refine, refine_probes and refine_timing
-/// (refine_range's timing axis). `probes` also sets finalist_probes to 4
+/// variants (true: kTrackerVariantWidths, false: none), refine, refine_probes, refine_restarts and
+/// refine_timing (refine_range's timing axis). `probes` also sets finalist_probes to 4
 /// times it (finalists are scored from four times the ranking's starts).
 std::vector<std::string> tracker_setting_names();
 /// Sets one of them from text. Throws ConfigError naming the setting and what it takes.
@@ -193,9 +197,10 @@ class Recordings {
  private:
   /// The first `count` paths by probe score, most successes first, then by index.
   std::vector<std::size_t> ranked(std::size_t count) const;
-  /// Refines the path that leads the order (TrackerConfig::refine), adds it to paths() with its
-  /// validation successes as its probe score, and puts it first if it beats its original there.
-  void refine_leader(const WorldConfig& world, int threads, Cluster& cluster);
+  /// Refines the paths that lead the order (TrackerConfig::refine, refine_restarts), adds them
+  /// to paths() with their validation successes as their probe scores, and puts the best first
+  /// if it beats the leader there; the others go last.
+  void refine_leaders(const WorldConfig& world, int threads, Cluster& cluster);
   /// Probe scores of paths [from, to) from probe starts [first_probe, first_probe + probes).
   std::vector<int> probe_scores(const WorldConfig& world, int threads, Cluster& cluster, std::size_t from, std::size_t to,
                                 int first_probe, int probes, bool variants) const;
