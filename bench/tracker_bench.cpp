@@ -6,7 +6,7 @@
 //       [--noise F|X,Y,W [--noise-window FROM,TO]] [--rescue N] [--smooth S] [--per-path [--ranked]] [--json]
 //       [--robust K] [--robust-noise F] [--robust-warp W] [--keep-extremes] [--choices FILE.csv] [--retry]
 // --recordings K keeps K recordings drawn with --subset-seed from the set (all by default).
-// --tracker-seed T seeds the ranking and the refinement (0 by default; a learner gives its own seed).
+// --tracker-seed T seeds the ranking and the refinements (0 by default; a learner gives its own seed).
 // The tracker is the preset (tracker_preset, default plain) with each setting on top, in order:
 // --set NAME=VALUE for any (tracker_setting_names), and --probes, --paths, ... for the same
 // names with dashes.
@@ -15,7 +15,7 @@
 // the choice (between FROM and TO, as fractions of the chosen path's length): how robust the
 // choices are to a learner's errors. --per-path follows every recording as recorded (no search)
 // from each start instead, with and without that noise, and lists them by successes; with
-// --ranked, the paths of the ranked recordings (the variants and a refined path among them).
+// --ranked, the paths of the ranked recordings (the variants and the refined paths among them).
 // --rescue N runs the tracker expert with rescue N (closed loop on the dice) instead of
 // the chosen path's follower; --retry runs it trying again once a failed attempt has come to rest
 // (ExpertConfig::retry). --robust K makes robust choices (TrackerConfig::robust);
@@ -54,6 +54,16 @@ struct Options {
   bool per_path = false, ranked = false, json = false, retry = false;
   std::string choices;  // --choices FILE: one CSV line per start
 };
+
+// Every refined path (TrackerConfig::refine_restarts of them), with its validation successes.
+std::string refinements(const Recordings& recordings) {
+  std::string out;
+  for (std::size_t p = 0; p < recordings.paths().size(); ++p)
+    if (recordings.paths()[p].name.find(" (refined") != std::string::npos)
+      out += (out.empty() ? "" : ", ") + recordings.paths()[p].name + " " + std::to_string(recordings.probe_successes()[p]) +
+             "/" + std::to_string(recordings.probe_trials()[p]);
+  return out;
+}
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -232,12 +242,7 @@ int main(int argc, char** argv) try {
               resolve_threads(o.threads), o.noise[0], o.noise[1], o.noise[2]);
   std::printf("ranking: %d probe starts per recording, %.2f s; followed: %s\n", o.tracker.probes, rank_seconds,
               followed_recordings(*recordings).c_str());
-  std::string refined;  // every refinement, with its validation successes
-  for (std::size_t p = 0; p < recordings->paths().size(); ++p)
-    if (recordings->paths()[p].name.ends_with("(refined)"))
-      refined += (refined.empty() ? "" : ", ") + recordings->paths()[p].name + " " +
-                 std::to_string(recordings->probe_successes()[p]) + "/" + std::to_string(recordings->probe_trials()[p]);
-  if (!refined.empty()) std::printf("refined: %s\n", refined.c_str());
+  if (const std::string refined = refinements(*recordings); !refined.empty()) std::printf("refined: %s\n", refined.c_str());
   std::printf("realistic success %d / %d, wall contact %d; the search found a success for %d, %d of them warped\n",
               success, o.starts, wall, found, warped);
   std::printf("simulations per start: mean %.2f, max %d; %.3f s in all (%.2f ms per start)\n",

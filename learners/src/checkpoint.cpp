@@ -318,8 +318,10 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
       };
       const json expert_now = value.value("expert", json());
       const bool tracker_run = option_then("expert") == "tracker" || expert_now == "tracker";
+      const bool refined = option_then("tracker_refine") != "0" || value.value("tracker_refine", json("0")) != "0";
       for (const auto& [k, v] : value.items()) {
         if (!tracker_run && k.starts_with("tracker_")) continue;  // nothing to a run of another expert
+        if (!refined && k.starts_with("tracker_refine_")) continue;  // nothing when neither run refines
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
         const std::string then = option_then(k);

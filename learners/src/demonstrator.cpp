@@ -105,11 +105,12 @@ std::vector<ParamSpec> tracker_param_specs() {
            "the 4 best paths again from 4 x tracker_probes more probe starts, and follow the best", {}},
           {"tracker_refine", ParamType::integer, std::to_string(d.refine), 0, 10000,
            "tracker: CMA-ES generations that move the leading path by smooth offsets to succeed from the most "
-           "starts, clean and under DART's noise; it leads if it beats its original from fresh starts (0: off)", {}},
+           "starts, clean and under DART's noise; the refined path leads if it beats the leading path from fresh starts (0: off)", {}},
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
           {"tracker_refine_restarts", ParamType::integer, std::to_string(d.refine_restarts), 1, 100,
-           "tracker: refinements, each of the next-ranked path from a seed of its own; the best from the same fresh starts leads", {}},
+           "tracker: refinements at most, each of the next-ranked path from a seed of its own, until one succeeds in 80 % "
+           "of its validation trials; the best from the same fresh starts leads if it beats the leading path", {}},
           {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 1,
            "tracker: tracker_refine also moves the path's timing, each bump by at most this many seconds (0: not)", {}}};
 }

@@ -291,6 +291,7 @@ TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnly
   // With no room to move, the refined path is the leader as followed.
   c.refine_range = {0.0, 0.0, 0.0, 0.0};
   const Recordings still(paths, w, c, 7, 1);
+  EXPECT_EQ(still.order().back(), 3u) << "a tie with the leader as followed does not lead";
   for (std::size_t t = 0; t < leader.states.size(); ++t) {
     EXPECT_EQ(still.paths()[3].states[t][si::kCupX], leader.states[t][si::kCupX]);
     EXPECT_DOUBLE_EQ(still.paths()[3].states[t][si::kCupVy], leader.states[t][si::kCupVy] + leader.actions[t][1]);
@@ -312,7 +313,7 @@ TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnly
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_probes\""), std::string::npos);
 }
 
-TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnAndTheBestByTheSameValidationLeads) {
+TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnUntilOneIsEnoughAndTheBestByTheSameValidationLeads) {
   const WorldConfig w = test::short_world(200);
   std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
   TrackerConfig c;
@@ -326,7 +327,8 @@ TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnAndTheBestByThe
   const Recordings r(paths, w, c, 7, 1);
   ASSERT_EQ(r.paths().size(), 7u);
   for (std::size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(r.paths()[3 + i].name, paths[plain.order()[i % 3]].name + " (refined)");
+    EXPECT_EQ(r.paths()[3 + i].name,
+              paths[plain.order()[i % 3]].name + (i == 0 ? " (refined)" : " (refined, restart " + std::to_string(i) + ")"));
     EXPECT_EQ(r.probe_trials()[3 + i], 2 * 4 * 3);
   }
   EXPECT_EQ(r.paths()[3].states, one.paths()[3].states) << "the first restart is the single refinement";
@@ -339,9 +341,21 @@ TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnAndTheBestByThe
   if (rest.front() == best) rest.erase(rest.begin());
   else EXPECT_EQ(std::count(rest.begin(), rest.end(), best), 1);
   EXPECT_EQ(std::vector<std::size_t>(rest.begin(), rest.begin() + 3), plain.order());
+  std::vector<std::size_t> others{3, 4, 5, 6};  // the refined paths behind the order, in restart order
+  if (r.order().front() == best) std::erase(others, best);
+  EXPECT_EQ(std::vector<std::size_t>(rest.begin() + 3, rest.end()), others);
+  for (std::size_t i = 3; i < 7; ++i) EXPECT_LT(s[i], c.refine_enough * 24) << "none was enough to stop the restarts";
   const Recordings two(paths, w, c, 7, 2);
   EXPECT_EQ(two.order(), r.order());
   EXPECT_EQ(two.probe_successes(), r.probe_successes());
+  // A refined path that succeeds in refine_enough of its trials ends the restarts.
+  c.refine_enough = 0.0;
+  const Recordings enough(paths, w, c, 7, 1);
+  ASSERT_EQ(enough.paths().size(), 4u);
+  EXPECT_EQ(enough.paths()[3].states, one.paths()[3].states);
+  c.refine_enough = 1.5;
+  EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_enough\""), std::string::npos);
+  c.refine_enough = 0.8;
   c.refine_restarts = 0;
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_restarts\""), std::string::npos);
 }

@@ -50,9 +50,11 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   std::ifstream(path) >> saved;
   EXPECT_EQ(saved.at("version"), 5);
   c.resume = true;
-  auto resume_with = [&](const nlohmann::json& state) {
+  auto resume_with = [&](const nlohmann::json& state, const std::vector<std::string>& more = {}) {
     { std::ofstream(path) << state.dump(); }
-    return test::error_of([&] { LearnerRegistry::global().create("dagger", options)->learn(c); });
+    std::vector<std::string> given = options;
+    given.insert(given.end(), more.begin(), more.end());
+    return test::error_of([&] { LearnerRegistry::global().create("dagger", given)->learn(c); });
   };
   auto edited = [&](const std::string& pointer, const nlohmann::json& value) {
     nlohmann::json j = saved;
@@ -100,6 +102,15 @@ TEST(Checkpoint, EditedStatesAreRefusedNamingTheFieldAndVersionOneResumes) {
   tracked["run"]["learner_options"]["tracker_shrink"] = "5";
   tracked["run"]["learner_options"].erase("tracker_refine");
   EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_refine \"(absent)\" in the checkpoint, \"60\" in this run"));
+  // Written before tracker_refine_restarts existed, when a refinement ran once.
+  EXPECT_EQ(saved["run"]["learner_options"]["tracker_refine_restarts"], "4");
+  tracked["run"]["learner_options"]["tracker_refine"] = "60";
+  tracked["run"]["learner_options"].erase("tracker_refine_restarts");
+  EXPECT_THAT(resume_with(tracked), HasSubstr("option tracker_refine_restarts \"(absent)\" in the checkpoint, \"4\" in this run"));
+  // When neither run refines, the refinement's settings mean nothing.
+  nlohmann::json unrefined = tracked;
+  unrefined["run"]["learner_options"]["tracker_refine"] = "0";
+  EXPECT_THAT(resume_with(unrefined, {"tracker_refine=0"}), Not(HasSubstr("tracker_refine")));
   // Written before retry existed: its absence meant no retries, which auto means for this map
   // (state) and is saved as; "false" and "auto" mean the same, "true" does not.
   EXPECT_EQ(saved["run"]["learner_options"]["retry"], "false");

@@ -318,6 +318,7 @@ void validate(const TrackerConfig& c) {
   require(c.refine >= 0 && c.refine <= 10000, "refine", "in [0, 10000]", c.refine);
   require(c.refine_probes >= 1 && c.refine_probes <= 100000, "refine_probes", "in [1, 100000]", c.refine_probes);
   require(c.refine_restarts >= 1 && c.refine_restarts <= 100, "refine_restarts", "in [1, 100]", c.refine_restarts);
+  require(c.refine_enough >= 0.0 && c.refine_enough <= 1.0, "refine_enough", "in [0, 1]", c.refine_enough);
   require(c.refine_knots >= 1 && c.refine_knots <= 100, "refine_knots", "in [1, 100]", c.refine_knots);
   for (std::size_t k = 0; k < 3; ++k)
     require(c.refine_range[k] >= 0.0 && c.refine_range[k] <= 10.0, "refine_range", "in [0, 10] per axis", c.refine_range[k]);
@@ -443,23 +444,32 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
 
 void Recordings::refine_leaders(const WorldConfig& world, int threads, Cluster& cluster) {
   // Restart i refines the order's i-th path (wrapping) from a seed of its own: one refinement's
-  // answer varies with its seed and its path as much as between recordings.
-  std::vector<CupPath> played{paths_[order_.front()]};
+  // answer varies with its seed and its path as much as between recordings. Each is validated
+  // on the same fresh starts as the leader as followed.
+  const auto validated = [&](const CupPath& p) {
+    return tracker_detail::validation_successes({p}, world, config_, seed_, threads, cluster).front();
+  };
+  const int leader = validated(paths_[order_.front()]);
+  const int trials = tracker_detail::validation_trials(config_);
+  std::vector<CupPath> refined;
+  std::vector<int> successes;
   for (int i = 0; i < config_.refine_restarts; ++i) {
     const std::size_t from = order_[static_cast<std::size_t>(i) % order_.size()];
     const std::uint64_t seed = i == 0 ? seed_ : derive_seed(seed_, static_cast<std::uint64_t>(i));
-    played.push_back(tracker_detail::refine_path(paths_[from], world, config_, seed, threads, cluster));
+    refined.push_back(tracker_detail::refine_path(paths_[from], world, config_, seed, threads, cluster));
+    if (i > 0) refined.back().name = paths_[from].name + " (refined, restart " + std::to_string(i) + ")";
+    successes.push_back(validated(refined.back()));
+    if (successes.back() >= config_.refine_enough * trials) break;
   }
-  const std::vector<int> successes = tracker_detail::validation_successes(played, world, config_, seed_, threads, cluster);
-  // The best refined path (the first of equals) leads if it beats the leader as followed; the
-  // others follow every path of the order.
-  const auto best = static_cast<std::size_t>(std::max_element(successes.begin() + 1, successes.end()) - successes.begin());
-  for (std::size_t i = 1; i < played.size(); ++i) {
-    paths_.push_back(std::move(played[i]));
+  // The best refined path (the first of equals) leads if it beats the leader; the others follow
+  // every path of the order.
+  const auto best = static_cast<std::size_t>(std::max_element(successes.begin(), successes.end()) - successes.begin());
+  for (std::size_t i = 0; i < refined.size(); ++i) {
+    paths_.push_back(std::move(refined[i]));
     probe_successes_.push_back(successes[i]);
-    probe_trials_.push_back(tracker_detail::validation_trials(config_));
+    probe_trials_.push_back(trials);
     const std::size_t added = paths_.size() - 1;
-    if (i == best && successes[i] > successes[0]) order_.insert(order_.begin(), added);
+    if (i == best && successes[i] > leader) order_.insert(order_.begin(), added);
     else order_.push_back(added);
   }
 }
