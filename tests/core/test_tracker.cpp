@@ -258,15 +258,23 @@ TEST(TrackerRecordings, VariantsOfTheBestRecordingsAreRankedAndTheFinalistsScore
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"variants\""), std::string::npos);
 }
 
-TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnlyWhenItBeatsItsOriginal) {
-  const WorldConfig w = test::short_world(200);
-  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
-  TrackerConfig c;
-  c.probes = 4;
-  const Recordings plain(paths, w, c, 7, 1);
+// The scripted expert's episodes from random starts 1, 2 and 3, as recorded cup paths.
+std::vector<CupPath> three_scripted_paths(const WorldConfig& w) { return {scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)}; }
+
+// A refinement small enough for a unit test: 2 generations of 3 starts, 2 bumps per axis.
+void small_refinement(TrackerConfig& c) {
   c.refine = 2;
   c.refine_probes = 3;
   c.refine_knots = 2;
+}
+
+TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnlyWhenItBeatsItsOriginal) {
+  const WorldConfig w = test::short_world(200);
+  const std::vector<CupPath> paths = three_scripted_paths(w);
+  TrackerConfig c;
+  c.probes = 4;
+  const Recordings plain(paths, w, c, 7, 1);
+  small_refinement(c);
   const Recordings r(paths, w, c, 7, 1);
   ASSERT_EQ(r.paths().size(), 4u);
   const CupPath& leader = paths[plain.order()[0]];
@@ -315,13 +323,11 @@ TEST(TrackerRecordings, RefineAddsTheLeadersPathMovedBySmoothOffsetsAndLeadsOnly
 
 TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnUntilOneIsEnoughAndTheBestByTheSameValidationLeads) {
   const WorldConfig w = test::short_world(200);
-  std::vector<CupPath> paths{scripted_path(1, w), scripted_path(2, w), scripted_path(3, w)};
+  const std::vector<CupPath> paths = three_scripted_paths(w);
   TrackerConfig c;
   c.probes = 4;
   const Recordings plain(paths, w, c, 7, 1);
-  c.refine = 2;
-  c.refine_probes = 3;
-  c.refine_knots = 2;
+  small_refinement(c);
   const Recordings one(paths, w, c, 7, 1);
   c.refine_restarts = 4;  // more than the paths: the fourth refines the leader again, from another seed
   const Recordings r(paths, w, c, 7, 1);
