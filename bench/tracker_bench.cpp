@@ -55,7 +55,7 @@ struct Options {
   std::string choices;  // --choices FILE: one CSV line per start
 };
 
-// Every refined path (TrackerConfig::refine_restarts of them), with its validation successes.
+// Every refined path (up to TrackerConfig::refine_restarts of them), with its validation successes.
 std::string refinements(const Recordings& recordings) {
   std::string out;
   for (std::size_t p = 0; p < recordings.paths().size(); ++p)

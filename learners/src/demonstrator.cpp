@@ -109,8 +109,9 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
           {"tracker_refine_restarts", ParamType::integer, std::to_string(d.refine_restarts), 1, 100,
-           "tracker: refinements at most, each of the next-ranked path from a seed of its own, until one succeeds in 80 % "
-           "of its validation trials; the best from the same fresh starts leads if it beats the leading path", {}},
+           "tracker: refinements at most, each of the next path of the ranking (the leader first, wrapping) from a seed "
+           "of its own, until one succeeds in " + number_text(100.0 * d.refine_enough) + " % of its validation trials; "
+           "the best from the same fresh starts leads if it beats the leading path", {}},
           {"tracker_refine_timing", ParamType::real, number_text(d.refine_range[3]), 0, 1,
            "tracker: tracker_refine also moves the path's timing, each bump by at most this many seconds (0: not)", {}}};
 }

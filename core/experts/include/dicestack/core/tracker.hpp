@@ -120,8 +120,8 @@ inline constexpr std::array<double, 7> kTrackerVariantWidths{0.0, 1.0, 2.0, 3.0,
 ///  - "distill": tuned for a learner distilling it (the learners' default): the 3 best-ranked
 ///    recordings, smoothed by 4 steps, chosen robust to a learner's errors (5 noisy trials,
 ///    warps of std 0.02), narrowed in 5 steps before warped, each recording's smoothing chosen
-///    among kTrackerVariantWidths, the 4 leading paths refined for 60 generations each (refine,
-///    refine_restarts), the best by validation leading. Measured
+///    among kTrackerVariantWidths, up to the 4 leading paths refined for 60 generations each
+///    (refine, refine_restarts) until one passes refine_enough, the best by validation leading. Measured
 ///    in docs/notebook/2026-11-27-learners-page-history.md ("Policies from the human recordings")
 ///    and docs/notebook/2026-11-28-refined-paths.md; the recipe: docs/learners.md.
 /// Throws ConfigError for another name, listing the presets.
