@@ -88,9 +88,9 @@ struct TrackerConfig {
   /// chooses, this many generations, to succeed from the most starts as followed, with and
   /// without executed-action noise of std refine_noise x action.scale. The refined path (the
   /// best of refine_restarts) leads the order when it beats the leading path from the same
-  /// fresh starts. A recorded path's success is a
-  /// lottery in details below what a person controls; a learner distilling the tracker succeeds
-  /// about as often as its path does under its noise. 0: off. In [0, 10000].
+  /// fresh starts. A recorded path's success is a lottery in details below what a person
+  /// controls; a learner distilling the tracker succeeds about as often as its path does under
+  /// its noise. 0: off. In [0, 10000].
   int refine = 0;
   int refine_probes = 32;  ///< starts per generation (each played clean and noisy), in [1, 100000]
   /// Refinements, each of the next path of the order (wrapping) from a seed of its own, until
