@@ -2,7 +2,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <optional>
 
 #include <dicestack/core/cost.hpp>
@@ -17,70 +16,12 @@
 #include <dicestack/learners/record.hpp>
 
 #include "checkpoint.hpp"
+#include "dad_code.hpp"
 
 namespace dicestack {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Where the paper's code (leonidk/cupdice, its DaD routine) differs from DaD as the paper
-// describes it. `faithful` switches them on, all ("true") or some ("start+label").
-struct CodeParts {
-  bool start = false;       // every rollout from the one fixed start
-  bool label = false;       // a one-step correction at every step, aimed at the recording's next state
-  bool cost = false;        // that state's dice (poses, velocities) and the cup's velocity
-  bool schedule = false;    // growing prefixes of each recording, several refits each; the last refit kept
-  bool search = false;      // CMA-ES from a random point, wide, to a budget of evaluations; its best always kept
-  bool duplicates = false;  // every refit appends every correction so far again
-  bool units = false;       // its units: the policy's actions applied 100, 10, 0.5 times over, labels the optimiser's x
-  bool any() const { return start || label || cost || schedule || search || duplicates || units; }
-};
-
-constexpr const char* kCodePartNames[] = {"start", "label", "cost", "schedule", "search", "duplicates", "units"};
-
-// The paper's code applied the policy's output (in the recordings' units) times the optimiser's
-// scale again, and stored the optimiser's x (action / scale, unitless) beside the recordings'
-// actions: in SI, rollouts run actions 100, 10 and 0.5 times the policy's, and corrections are
-// labelled 0.01, 0.1 and 2 times the actions they found.
-constexpr Action kCodeRolloutUnits{100.0, 10.0, 0.5}, kCodeLabelUnits{0.01, 0.1, 2.0};
-
-Action scaled(Action a, const Action& by) {
-  for (std::size_t k = 0; k < kActionDim; ++k) a[k] *= by[k];
-  return a;
-}
-
-// A policy acting with the paper's code's units.
-class CodeUnitsPolicy final : public Policy {
- public:
-  explicit CodeUnitsPolicy(std::shared_ptr<const Model> model) : inner_(std::move(model)) {}
-  Action act(const History& history) override { return scaled(inner_.act(history), kCodeRolloutUnits); }
-  std::string name() const override { return inner_.name() + " in the paper's code's units"; }
-
- private:
-  ModelPolicy inner_;
-};
-
-// The code's constants: 10 prefixes x 5 sub-iterations; CMA-ES sigma0 0.8, maxfevals 5000.
-constexpr int kCodeWindows = 10, kCodeRefits = 5, kCodeEvaluations = 5000;
-constexpr double kCodeSigma0 = 0.8;
-
-CodeParts code_parts(const std::string& text) {
-  CodeParts p;
-  if (text == "false") return p;
-  if (text == "true") return {true, true, true, true, true, true, true};
-  bool* fields[] = {&p.start, &p.label, &p.cost, &p.schedule, &p.search, &p.duplicates, &p.units};
-  for (std::size_t from = 0; from <= text.size();) {
-    const std::size_t plus = std::min(text.find('+', from), text.size());
-    const std::string part = text.substr(from, plus - from);
-    const auto* it = std::find(std::begin(kCodePartNames), std::end(kCodePartNames), part);
-    if (it == std::end(kCodePartNames))
-      throw ConfigError("dad: parameter \"faithful\": unknown part \"" + part.substr(0, 40) + (part.size() > 40 ? "...\"" : "\"") +
-                        "; expected true, false, or parts joined by '+': start, label, cost, schedule, search, duplicates, units");
-    *fields[it - std::begin(kCodePartNames)] = true;
-    from = plus + 1;
-  }
-  return p;
-}
 
 // Everything a run does, resolved from its options once, before any work (make_plan); the
 // model records it as "dad_settings".
