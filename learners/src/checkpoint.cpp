@@ -62,12 +62,10 @@ std::map<std::string, std::string> saved_options(const json& saved) {
 
 // What a learner's option meant in checkpoints written before the option existed: the behaviour
 // then, which is its default unless listed here (DaD corrected towards whole states before it
-// had "target", and kept corrections the teacher could not finish from before "recover"; the
-// tracker did not narrow a path before it had "tracker_shrink", nor refine one before
-// "tracker_refine", and refined one path once before "tracker_refine_restarts").
+// had "target"; the tracker did not narrow a path before it had "tracker_shrink", nor refine one
+// before "tracker_refine", and refined one path once before "tracker_refine_restarts").
 std::string value_before(const std::string& learner, const std::string& key) {
   if (learner == "dad" && key == "target") return "state";
-  if (learner == "dad" && key == "recover") return "false";
   if (key == "tracker_shrink" || key == "tracker_refine") return "0";
   if (key == "tracker_refine_restarts") return "1";
   for (const auto& p : LearnerRegistry::global().info(learner).params)
@@ -318,12 +316,6 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
         const auto it = before.find(k);
         return it != before.end() ? it->second : value_before(learner, k);
       };
-      // DaD's recover=auto means true from training starts, false from demonstrations.
-      const std::string starts_now = value.value("starts", json("demos")).get<std::string>();
-      const auto recover = [&](const std::string& k, const std::string& text, const std::string& starts) {
-        if (learner != "dad" || k != "recover" || text != "auto") return text;
-        return std::string(starts == "training" ? "true" : "false");
-      };
       const json expert_now = value.value("expert", json());
       const bool tracker_run = option_then("expert") == "tracker" || expert_now == "tracker";
       const bool refined = option_then("tracker_refine") != "0" || value.value("tracker_refine", json("0")) != "0";
@@ -333,8 +325,7 @@ std::optional<CheckpointState> load_checkpoint_state(const LearnContext& c, cons
         const std::string now = v.get<std::string>();
         const auto it = before.find(k);
         const std::string then = option_then(k);
-        if (resolved_option(k, recover(k, then, option_then("starts")), run_features(saved_run)) !=
-            resolved_option(k, recover(k, now, starts_now), run_features(run)))
+        if (resolved_option(k, then, run_features(saved_run)) != resolved_option(k, now, run_features(run)))
           differ("option " + k, it != before.end() ? json(then) : json("(absent)"), json(now));
       }
     }

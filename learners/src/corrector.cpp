@@ -33,22 +33,6 @@ double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::ve
   return cost;
 }
 
-bool finishes(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions, const CupPath& rest,
-              double gain) {
-  if (rest.states.empty() || rest.states.size() != rest.actions.size())
-    throw InputError("finishes: the path to follow after the window needs as many states as actions, and one at least");
-  env.restore(problem.start);
-  const PathFollower follower(rest, {}, rest.states.front(), env.t(), gain);
-  for (const Action& a : actions) {
-    const StepResult r = env.step(a);
-    if (r.terminated || r.truncated) return r.terminated;
-  }
-  for (;;) {
-    const StepResult r = env.step(follower.act(env.get_state(), env.t()));
-    if (r.terminated || r.truncated) return r.terminated;
-  }
-}
-
 namespace {
 
 constexpr std::uint64_t kRandomStartStream = 0x78307374617274ULL;  // "x0start"

@@ -32,9 +32,7 @@ struct DadPlan {
   std::string corrector;
   CorrectorOptions search;
   bool filter = true, keep_best = true;
-  bool recover = false;        // keep a correction only if the teacher can still finish from it
   bool from_training = false;  // targets: the tracker's episodes from training starts, else demonstrations
-  bool noisy_targets = false;  // those episodes under DART's noise
   std::size_t demos = 0;       // demonstrations as targets (0: all)
   int episodes = 0;            // training starts the tracker runs from
   bool retry = false;          // the tracker tries again (from training starts)
@@ -44,11 +42,10 @@ struct DadPlan {
     char text[320];
     std::snprintf(text, sizeof text,
                   "windows=%d, iterations=%d, target=%s, corrector=%s, corrector_iterations=%d, evaluations=%d, sigma0=%g, "
-                  "population=%d, filter=%s, keep_best=%s, recover=%s, starts=%s, demos=%zu, episodes=%d, retry=%s, noisy_targets=%s",
+                  "population=%d, filter=%s, keep_best=%s, starts=%s, demos=%zu, episodes=%d, retry=%s",
                   windows, per_window, aims[static_cast<int>(aim)], corrector.c_str(), search.iterations, search.evaluations,
-                  search.sigma0, search.population, filter ? "true" : "false", keep_best ? "true" : "false", recover ? "true" : "false",
-                  from_training ? "training" : "demonstrations", demos, episodes, retry ? "true" : "false",
-                  noisy_targets ? "true" : "false");
+                  search.sigma0, search.population, filter ? "true" : "false", keep_best ? "true" : "false",
+                  from_training ? "training" : "demonstrations", demos, episodes, retry ? "true" : "false");
     return text;
   }
 };
@@ -58,13 +55,6 @@ struct Task {
   std::size_t demo = 0;
   std::size_t t = 0;
   CorrectionProblem problem;
-};
-
-// A window's correction, and whether the teacher can still finish the episode from it
-// (DadPlan::recover; true when not asked).
-struct Fix {
-  Correction correction;
-  bool finishes = true;
 };
 
 // A correction carries the rollout before its window as history (the policy's steps): those are
@@ -93,7 +83,7 @@ struct DadRun {
   std::shared_ptr<Model> model, best;
   double best_deviation = 0.0;
   int best_iteration = 0, first = 1;
-  std::size_t corrections = 0, filtered = 0, dead_ends = 0;
+  std::size_t corrections = 0, filtered = 0;
   bool from_training = false;
 
   // The iteration's policy is better: from training starts, it stacks from more of them (then
@@ -158,7 +148,7 @@ class Dad final : public Learner {
       report("rollouts", 0, 0);
       std::vector<Episode> rollouts;
       const std::vector<Task> tasks = policy_tasks(*run.model, targets, plan, window, fixed_start, envs, c.threads, rollouts);
-      const std::vector<Fix> fixes = correct_windows(c, plan, *corrector, envs, tasks, targets, k, report);
+      const std::vector<Correction> fixes = correct_windows(c, *corrector, envs, tasks, k, report);
       keep_corrections(plan, tasks, fixes, targets, rollouts, k, c.features != "state", run);
       report("fit", 0, 1);
       const std::vector<Episode> fitted = fit_data(run.data, plan, k);
@@ -181,7 +171,6 @@ class Dad final : public Learner {
     }
     chosen->record["dad_corrections_kept"] = std::to_string(run.corrections);
     chosen->record["dad_corrections_filtered"] = std::to_string(run.filtered);
-    if (plan.recover) chosen->record["dad_corrections_dead_ends"] = std::to_string(run.dead_ends);
     if (plan.code.any()) chosen->record["dad_faithful"] = params().choice("faithful");
     chosen->record["dad_settings"] = plan.summary();  // the options as this run used them
     run.result.model = chosen;
@@ -204,19 +193,12 @@ class Dad final : public Learner {
              "demonstrations to start from and correct towards, picked far apart by first state (the paper used 3); 0: all", {}},
             {"filter", ParamType::boolean, "true", 0, 1, "drop corrections that do not beat the policy's own actions", {}},
             {"keep_best", ParamType::boolean, "true", 0, 1, "return the iteration's policy that follows the held-out demonstrations best", {}},
-            {"recover", ParamType::choice, "auto", 0, 0,
-             "keep a correction only if the tracker's feedback law, taking over after its window and following the "
-             "target to its end, still stacks the dice without a wall (auto: with starts=training; faithful's label "
-             "part keeps every step)", {"auto", "true", "false"}},
             {"starts", ParamType::choice, "demos", 0, 0,
              "where rollouts start and what their corrections aim at: demos (each target demonstration's first state, "
              "its recorded states) or training (random training starts, each aiming at the recording's cup path the "
              "tracker chooses there: DaD from any start; default --features state+clock+start_state@dice+retry/position)",
              {"demos", "training"}},
             {"episodes", ParamType::integer, "300", 1, 1000000, "starts=training: how many training starts", {}},
-            {"noisy_targets", ParamType::boolean, "false", 0, 1,
-             "starts=training: the tracker plays its targets under DART's noise (0.1, 0.5, 0.2 x action.scale), the "
-             "successes kept, their clean actions the labels, as DART's demonstrations", {}},
             retry_param_spec(),
             {"faithful", ParamType::text, "false", 0, 0,
              "true: run DaD as the paper's code does; or some of its parts joined by '+': start (one fixed start), label "
@@ -249,8 +231,6 @@ class Dad final : public Learner {
       run.best = std::make_shared<Model>(load_model(c.checkpoint_dir / state->file("best_model"), *c.registry));
       run.corrections = static_cast<std::size_t>(state->integer("corrections_kept", 0, INT64_MAX));
       run.filtered = static_cast<std::size_t>(state->integer("corrections_filtered", 0, INT64_MAX));
-      // A run that keeps dead ends resumes only from a checkpoint that did too (the options compared).
-      if (plan.recover) run.dead_ends = static_cast<std::size_t>(state->integer("corrections_dead_ends", 0, INT64_MAX));
     }
     run.model = fit_model(c, fit_data(run.data, plan, run.first - 1), derive_seed(c.seed, static_cast<std::uint64_t>(run.first - 1)),
                           is_row);
@@ -262,43 +242,32 @@ class Dad final : public Learner {
     return run;
   }
 
-  // Iteration k's corrections of its windows, and with `recover` whether the teacher finishes
-  // from each one that beats the policy's own actions. Every rank cut the same windows (the
-  // rollouts are deterministic); the corrections, the heavy part, are dealt among the ranks by
-  // the steps they simulate and gathered in index order.
+  // Iteration k's corrections of its windows. Every rank cut the same windows (the rollouts are
+  // deterministic); the corrections, the heavy part, are dealt among the ranks by window length
+  // and gathered in index order.
   template <class Report>
-  static std::vector<Fix> correct_windows(const LearnContext& c, const DadPlan& plan, const Corrector& corrector, EnvPool& envs,
-                                          const std::vector<Task>& tasks, const std::vector<Episode>& targets, int k,
-                                          const Report& report) {
+  std::vector<Correction> correct_windows(const LearnContext& c, const Corrector& corrector, EnvPool& envs,
+                                          const std::vector<Task>& tasks, int k, const Report& report) const {
     std::atomic<int> finished{0};
     const int ranks = c.cluster->size();
     const std::uint64_t round_seed = derive_seed(c.seed, 1000003u + static_cast<std::uint64_t>(k));
     std::vector<double> cost(tasks.size());
-    for (std::size_t i = 0; i < tasks.size(); ++i)
-      cost[i] = static_cast<double>(plan.recover ? targets[tasks[i].demo].size() - tasks[i].t : tasks[i].problem.target.size());
-    return distributed_map<Fix>(
+    for (std::size_t i = 0; i < tasks.size(); ++i) cost[i] = static_cast<double>(tasks[i].problem.target.size());
+    return distributed_map<Correction>(
         *c.cluster, tasks.size(), c.threads,
         [&](std::size_t i, int w) {
-          const Task& task = tasks[i];
-          Fix fix{corrector.correct(envs.at(w), task.problem, derive_seed(round_seed, i))};
-          if (plan.recover && fix.correction.cost < fix.correction.warm_cost) {
-            const Episode& target = targets[task.demo];
-            const auto from = static_cast<std::ptrdiff_t>(task.t);
-            const CupPath rest{target.name, {target.states.begin() + from, target.states.end()},
-                               {target.actions.begin() + from, target.actions.end()}};
-            fix.finishes = finishes(envs.at(w), task.problem, fix.correction.actions, rest, plan.search.gain);
-          }
+          Correction fix = corrector.correct(envs.at(w), tasks[i].problem, derive_seed(round_seed, i));
           const int done = std::min(static_cast<int>(tasks.size()), ++finished * ranks);
           if (w == 0) report("corrections", done, static_cast<int>(tasks.size()));
           return fix;
         },
-        pack_fix, unpack_fix, ranks > 1 ? cost : std::vector<double>{});
+        pack_correction, unpack_correction, ranks > 1 ? cost : std::vector<double>{});
   }
 
   // Adds iteration k's corrections to the data, once each (or, as the paper's code labels,
   // every step of each window), and counts them. `with_history`: a window cut from the middle
   // of a rollout carries the rollout before it, for a map that reads more than the current state.
-  static void keep_corrections(const DadPlan& plan, const std::vector<Task>& tasks, const std::vector<Fix>& fixes,
+  static void keep_corrections(const DadPlan& plan, const std::vector<Task>& tasks, const std::vector<Correction>& fixes,
                                const std::vector<Episode>& targets, const std::vector<Episode>& rollouts, int k,
                                bool with_history, DadRun& run) {
     std::vector<Episode> made;
@@ -307,16 +276,11 @@ class Dad final : public Learner {
       run.corrections += tasks.size();
     } else {
       for (std::size_t i = 0; i < tasks.size(); ++i) {
-        const Correction& fix = fixes[i].correction;
-        if (plan.filter && !(fix.cost < fix.warm_cost)) {
+        if (plan.filter && !(fixes[i].cost < fixes[i].warm_cost)) {
           ++run.filtered;
           continue;
         }
-        if (!fixes[i].finishes) {
-          ++run.dead_ends;
-          continue;
-        }
-        made.push_back(as_episode(fix, targets[tasks[i].demo], tasks[i].t, k,
+        made.push_back(as_episode(fixes[i], targets[tasks[i].demo], tasks[i].t, k,
                                   with_history ? &rollouts[tasks[i].demo] : nullptr));
         ++run.corrections;
       }
@@ -338,7 +302,7 @@ class Dad final : public Learner {
     save_checkpoint(c.checkpoint_dir, k,
                     {{"run", run_settings(c, effective_options(*this))}, {"seed", c.seed}, {"regressor", c.regressor},
                      {"best_iteration", run.best_iteration}, {"best_model", best_file}, {"best_deviation", run.best_deviation},
-                     {"corrections_kept", run.corrections}, {"corrections_filtered", run.filtered}, {"corrections_dead_ends", run.dead_ends},
+                     {"corrections_kept", run.corrections}, {"corrections_filtered", run.filtered},
                      {"curve", curve_to_json(run.result.curve)}},
                     "dad.json", c, run.data, "DaD data after iteration " + std::to_string(k));
     remove_old_best_models(c.checkpoint_dir, best_file);
@@ -362,11 +326,6 @@ class Dad final : public Learner {
     p.filter = !p.code.search && params().boolean("filter");
     p.keep_best = !p.code.schedule && params().boolean("keep_best");
     p.from_training = params().choice("starts") == "training";
-    // The code's one-step labels keep every step of a rollout, as its episode.
-    const std::string recover = params().choice("recover");
-    p.recover = !p.code.label && (recover == "true" || (recover == "auto" && p.from_training));
-    p.noisy_targets = params().boolean("noisy_targets");
-    if (p.noisy_targets && !p.from_training) throw ConfigError("dad: noisy_targets=true needs starts=training (the tracker's episodes)");
     p.demos = static_cast<std::size_t>(params().integer("demos"));
     p.episodes = static_cast<int>(params().integer("episodes"));
     p.retry = expert_retries(params().choice("retry"), features);
@@ -389,7 +348,6 @@ class Dad final : public Learner {
     request.episodes = plan.episodes;
     request.seed = c.seed;
     request.threads = c.threads;
-    if (plan.noisy_targets) request.noise = kTrackerDartNoise;
     std::vector<Episode> targets;
     for (auto& e : record_expert("tracker", expert, c.world, request, *c.cluster))
       if (e.outcome.realistic_success()) {
@@ -490,7 +448,7 @@ class Dad final : public Learner {
   // One-step corrections of iteration k as one episode per rollout: the states the policy
   // visited from its start, each labelled with the action the corrector found there (as DAgger
   // labels a rollout), so every feature map sees them in their episode.
-  static std::vector<Episode> step_corrections(const std::vector<Task>& tasks, const std::vector<Fix>& fixes,
+  static std::vector<Episode> step_corrections(const std::vector<Task>& tasks, const std::vector<Correction>& fixes,
                                                const std::vector<Episode>& targets, int k) {
     std::vector<Episode> out;
     for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -503,31 +461,28 @@ class Dad final : public Learner {
         out.push_back(std::move(e));
       }
       Episode& e = out.back();
-      e.states.push_back(fixes[i].correction.states.front());
-      e.actions.push_back(fixes[i].correction.actions.front());
+      e.states.push_back(fixes[i].states.front());
+      e.actions.push_back(fixes[i].actions.front());
       e.sources.push_back(StepSource::correction);
       e.outcome.steps = static_cast<int>(e.states.size());
     }
     return out;
   }
 
-  static std::string pack_fix(const Fix& fix) {
-    const Correction& c = fix.correction;
+  static std::string pack_correction(const Correction& fix) {
     Packer p;
-    p.put_vector(c.states).put_vector(c.actions).put(c.cost).put(c.warm_cost).put(c.evaluations).put(static_cast<int>(fix.finishes));
+    p.put_vector(fix.states).put_vector(fix.actions).put(fix.cost).put(fix.warm_cost).put(fix.evaluations);
     return p.take();
   }
 
-  static Fix unpack_fix(std::string_view bytes) {
+  static Correction unpack_correction(std::string_view bytes) {
     Unpacker u(bytes, "correction");
-    Fix fix;
-    Correction& c = fix.correction;
-    c.states = u.get_vector<State>();
-    c.actions = u.get_vector<Action>();
-    c.cost = u.get<double>();
-    c.warm_cost = u.get<double>();
-    c.evaluations = u.get<int>();
-    fix.finishes = u.get<int>() != 0;
+    Correction fix;
+    fix.states = u.get_vector<State>();
+    fix.actions = u.get_vector<Action>();
+    fix.cost = u.get<double>();
+    fix.warm_cost = u.get<double>();
+    fix.evaluations = u.get<int>();
     return fix;
   }
 

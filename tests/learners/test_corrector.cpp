@@ -1,20 +1,16 @@
 // DaD's correctors: each one's corrections follow the demonstration better, its labels are in
-// the demonstration's units, and the paper's search from a random start keeps its own best; and
-// whether a teacher can still finish after a corrected window.
+// the demonstration's units, and the paper's search from a random start keeps its own best.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include <dicestack/core/env.hpp>
-#include <dicestack/core/error.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/datasets/episode.hpp>
 #include <dicestack/learners/corrector.hpp>
-#include <dicestack/learners/record.hpp>
 
 #include <dicestack/test/demos.hpp>
 #include <dicestack/test/helpers.hpp>
@@ -94,24 +90,6 @@ TEST(Correctors, FromARandomStartItKeepsItsBestEvenWhereThePolicysActionsScoreBe
   EXPECT_NE(fix.actions[0], demo.actions[20]);
   const Correction again = make_corrector("cmaes", o)->correct(env, p, 4);
   EXPECT_EQ(again.actions, fix.actions);  // seeded
-}
-
-TEST(Correctors, FinishesSaysWhetherTheTrackerStillStacksTheDiceAfterTheWindow) {
-  const WorldConfig world;
-  const auto recorded = record_expert("scripted", {}, world, test::record_request(4, 7, 1));
-  const auto stacked = std::find_if(recorded.begin(), recorded.end(), [](const Episode& e) { return e.outcome.realistic_success(); });
-  ASSERT_NE(stacked, recorded.end());
-  const Episode& e = *stacked;
-  DiceEnv env(world);
-  constexpr std::size_t t = 40, w = 10;
-  const CorrectionProblem p = window_of(env, e, t, w);
-  const CupPath rest{"rest", {e.states.begin() + t, e.states.end()}, {e.actions.begin() + t, e.actions.end()}};
-  EXPECT_TRUE(finishes(env, p, p.warm, rest, 10.0));  // the episode's own window: it stacked
-  // Full speed to the right for the window: the cup meets the wall, and nothing after it counts.
-  const std::vector<Action> wild(w, Action{world.action.limit[0], 0.0, 0.0});
-  EXPECT_FALSE(finishes(env, p, wild, rest, 10.0));
-  EXPECT_TRUE(env.outcome().wall_contact);
-  EXPECT_THROW(finishes(env, p, p.warm, CupPath{"nothing", {}, {}}, 10.0), InputError);
 }
 
 }  // namespace

@@ -3,10 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
-
-#include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
@@ -91,27 +88,6 @@ TEST(Dad, ResumeEqualsUninterrupted) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(Dad, ACheckpointWrittenBeforeRecoverExistedKeptEveryCorrection) {
-  const auto dir = test::scratch_path("dicestack_dad_recover");
-  std::filesystem::remove_all(dir);
-  LearnContext c = dad_context(1);
-  c.checkpoint_dir = dir;
-  LearnerRegistry::global().create("dad", kSmall)->learn(c);
-  nlohmann::json state;
-  std::ifstream(dir / "dad.json") >> state;
-  ASSERT_EQ(state["run"]["learner_options"]["recover"], "auto");
-  state["run"]["learner_options"].erase("recover");
-  std::ofstream(dir / "dad.json") << state.dump();
-  c.resume = true;
-  // From the demonstrations, auto keeps every correction, as the checkpoint's run did.
-  EXPECT_NO_THROW(LearnerRegistry::global().create("dad", kSmall)->learn(c));
-  std::vector<std::string> recovering = kSmall;
-  recovering.push_back("recover=true");
-  EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create("dad", recovering)->learn(c); }),
-              testing::HasSubstr("option recover \"(absent)\" in the checkpoint, \"true\" in this run"));
-  std::filesystem::remove_all(dir);
-}
-
 TEST(Dad, FaithfulIsTrueFalseOrPartsOfThePapersCodeAndAnythingElseIsRefusedByPart) {
   for (const char* ok : {"faithful=true", "faithful=false", "faithful=start", "faithful=label+cost+duplicates"})
     EXPECT_NO_THROW(LearnerRegistry::global().create("dad", {ok})) << ok;
@@ -151,7 +127,7 @@ TEST(Dad, TheCodesScheduleCorrectsGrowingPrefixesFiveTimesEachAndKeepsTheLastRef
   EXPECT_EQ(r.model->record.at("dad_faithful"), "schedule+label");
   // The options as the run used them: the code's schedule (10 windows of 5 refits) over the given ones.
   EXPECT_THAT(r.model->record.at("dad_settings"), testing::StartsWith("windows=10, iterations=5, target=cup, corrector=cmaes"));
-  EXPECT_THAT(r.model->record.at("dad_settings"), testing::EndsWith("starts=demonstrations, demos=2, episodes=300, retry=false, noisy_targets=false"));
+  EXPECT_THAT(r.model->record.at("dad_settings"), testing::EndsWith("starts=demonstrations, demos=2, episodes=300, retry=false"));
 }
 
 TEST(Dad, AWindowCarriesTheRolloutBeforeItAsHistoryForAMapThatReadsTheEpisode) {

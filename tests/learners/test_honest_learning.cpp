@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <map>
 #include <unistd.h>
 
 #include <dicestack/core/error.hpp>
@@ -103,29 +102,6 @@ TEST(HonestLearning, DadAndDartFromThreeRecordingsBuildNoHandMadeExpertAndNameTh
     EXPECT_TRUE(std::any_of(c.demos.begin(), c.demos.end(), [&](const Episode& e) { return followed.starts_with(e.name + " "); }))
         << followed;
   }
-}
-
-TEST(HonestLearning, DadFromTrainingStartsKeepsACorrectionOnlyWhereTheTeacherStillStacksAfterIt) {
-  LearnContext c = recordings_context();
-  c.demos.resize(3);
-  c.features = "state+clock+start_state@dice+retry/position";
-  const std::vector<std::string> options{"starts=training", "episodes=3", "windows=1", "iterations=1", "corrector=track",
-                                         "tracker_probes=1", "tracker_robust=1", "tracker_variants=false", "tracker_refine=0"};
-  auto run = [&](const std::string& recover) {
-    std::vector<std::string> o = options;
-    if (!recover.empty()) o.push_back("recover=" + recover);
-    return LearnerRegistry::global().create("dad", o)->learn(c).model->record;
-  };
-  const auto by_default = run(""), kept_all = run("false");
-  EXPECT_THAT(by_default.at("dad_settings"), HasSubstr("recover=true"));
-  EXPECT_FALSE(kept_all.contains("dad_corrections_dead_ends"));
-  // One iteration, so the same policy, windows and corrections either way: recover only sorts out
-  // the dead ends.
-  const auto count = [](const std::map<std::string, std::string>& r, const char* key) { return std::stoul(r.at(key)); };
-  EXPECT_EQ(count(by_default, "dad_corrections_kept") + count(by_default, "dad_corrections_dead_ends"),
-            count(kept_all, "dad_corrections_kept"));
-  EXPECT_EQ(count(by_default, "dad_corrections_filtered"), count(kept_all, "dad_corrections_filtered"));
-  EXPECT_GT(count(kept_all, "dad_corrections_kept"), 0u);
 }
 
 TEST(HonestLearning, TheTrackerFollowsAnotherSetsTrainingEpisodesWhenToldTo) {

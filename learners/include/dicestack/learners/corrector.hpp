@@ -13,7 +13,6 @@
 #include <vector>
 
 #include <dicestack/core/env.hpp>
-#include <dicestack/core/tracker.hpp>
 
 namespace dicestack {
 
@@ -50,13 +49,6 @@ struct Correction {
 /// with the states before each action.
 double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
                    std::vector<State>* states = nullptr);
-
-/// Whether a teacher could still finish from a corrected window: applies `actions` from
-/// problem.start, then the tracker's feedback law along `rest` (the target's states and actions
-/// from the window's first step to its end) until the episode ends, and says whether it ended in
-/// realistic success. The episode's time limit bounds it. `env` is scratch.
-bool finishes(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions, const CupPath& rest,
-              double gain);
 
 /// Searches in the optimisers' scaled action space (x = action / ActionConfig::scale), clipped
 /// to the world's limits.

@@ -34,12 +34,6 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
 /// records it as "tracker_followed": which recording a policy plays, and how robust it was.
 std::string followed_recordings(const Recordings& recordings);
 
-/// DART's noise when the tracker demonstrates, per action dimension (dvx, dvy, dw) as fractions
-/// of action.scale: following recordings, a learner errs most in dvy and dw, and the noise there
-/// is matched to that (docs/notebook/2026-11-27-learners-page-history.md, "Policies from the human
-/// recordings": 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
-inline constexpr Action kTrackerDartNoise{0.1, 0.5, 0.2};
-
 /// True when the feature map `features` answers a cup pose to servo to ("/position"): the
 /// tracker's labels are then one pose per step, and the learners follow one recording
 /// (docs/learners.md, "Position targets").
