@@ -45,12 +45,7 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   request.demos_name = dir.string();
   ProgressBar bar;
   request.progress = [&](const Progress& p) {
-    std::string text = opt.learner + " " + opt.regressor + ": iteration " + std::to_string(p.iteration) + "/" +
-                       std::to_string(p.iterations);
-    if (p.windows > 0) text += ", window " + std::to_string(p.window) + "/" + std::to_string(p.windows);
-    text += ", " + p.phase;
-    if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
-    bar.update(p.fraction, text);
+    bar.update(p.fraction, progress_text(opt.learner + " " + opt.regressor, p));
   };
   const TrainReport r = train_model(request);
   bar.finish();

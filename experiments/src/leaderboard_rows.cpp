@@ -137,8 +137,9 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   std::string last_phase;
   c.progress = [&](const Progress& p) {  // a milestone per iteration and phase
     const std::string phase = std::to_string(p.iteration) + p.phase;
-    const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), iteration " +
-                             std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " + p.phase;
+    const std::string iteration =
+        p.iterations > 0 ? "iteration " + std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", " : "";
+    const std::string text = row_text + ": training (seed " + std::to_string(seed) + "), " + iteration + p.phase;
     report_(text, at(0.5 * p.fraction), phase != last_phase);
     last_phase = phase;
   };

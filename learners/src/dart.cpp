@@ -93,6 +93,8 @@ class Dart final : public Learner {
     request.threads = c.threads;
     request.noise = d.noise;
     request.perturbation = perturbation.trained;
+    if (c.progress)
+      request.progress = [&c](int done, int total) { c.progress({"demonstrations", 1, 1, 0, 0, done, total, 0.5 * done / total}); };
     auto recorded = record_expert(d.expert, expert, c.world, request, *c.cluster);
     int successes = 0;
     for (auto& e : recorded) {

@@ -37,9 +37,9 @@ std::vector<Episode> pick_recordings(std::vector<Episode> episodes, int k, std::
 
 std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& demos, const WorldConfig& world,
                                                   const TrackerConfig& config, std::uint64_t seed, int threads,
-                                                  Cluster& cluster) {
+                                                  Cluster& cluster, const TrackerProgress& progress) {
   if (demos.empty()) throw InputError("tracker: no demonstrations to follow");
-  return std::make_shared<const Recordings>(cup_paths(demos), world, config, seed, threads, cluster);
+  return std::make_shared<const Recordings>(cup_paths(demos), world, config, seed, threads, cluster, progress);
 }
 
 namespace {
@@ -191,7 +191,11 @@ ExpertConfig learner_expert_config(const std::string& name, const Learner& learn
     if (own.empty()) throw InputError("expert tracker: no demonstrations to follow (give a set with --demos)");
     const auto followed = pick_recordings(own, static_cast<int>(params.integer("tracker_recordings")),
                                           derive_seed(c.seed, kRecordingsStream));
-    config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster);
+    // The paths' preparation can take minutes (ranking, refinements): it is shown as a phase.
+    TrackerProgress shown;
+    if (c.progress)
+      shown = [&c](const std::string& stage, int done, int total) { c.progress({"tracker: " + stage, 0, 0, 0, 0, done, total, 0.0}); };
+    config.recordings = make_recordings(followed, c.world, tracker, c.seed, c.threads, *c.cluster, shown);
   }
   return config;
 }

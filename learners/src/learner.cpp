@@ -11,6 +11,15 @@
 
 namespace dicestack {
 
+std::string progress_text(const std::string& who, const Progress& p) {
+  std::string text = who + ": ";
+  if (p.iterations > 0) text += "iteration " + std::to_string(p.iteration) + "/" + std::to_string(p.iterations) + ", ";
+  if (p.windows > 0) text += "window " + std::to_string(p.window) + "/" + std::to_string(p.windows) + ", ";
+  text += p.phase;
+  if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
+  return text;
+}
+
 void register_bc(LearnerRegistry&);
 void register_dagger(LearnerRegistry&);
 void register_dad(LearnerRegistry&);

@@ -1,5 +1,6 @@
 #include <dicestack/learners/record.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 
@@ -32,6 +33,8 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
   EnvPool envs(world, threads);
   std::vector<std::unique_ptr<Expert>> experts(workers);
+  std::atomic<int> finished{0};
+  const int ranks = cluster.size(), total = std::max(0, request.episodes);
   return distributed_map<Episode>(
       cluster, static_cast<std::size_t>(std::max(0, request.episodes)), threads,
       [&](std::size_t i, int w) {
@@ -43,6 +46,8 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
         ExpertPolicy policy(*expert, episode.env());
         Episode e = rollout(episode, policy, episode.random_start(s), s, StepSource::expert);
         e.origin = "expert " + name;
+        const int done = std::min(total, ++finished * ranks);
+        if (request.progress && w == 0) request.progress(done, total);
         return e;
       },
       [](const Episode& e) { return episode_to_bytes(e); }, [](std::string_view b) { return episode_from_bytes(b); });

@@ -160,12 +160,7 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
   request.threads = threads_from(threads);
   LongCall call(std::move(bar));
   request.progress = [&](const Progress& p) {
-    std::string text = learner + " " + regressor + ": iteration " + std::to_string(p.iteration) + "/" +
-                       std::to_string(p.iterations);
-    if (p.windows > 0) text += ", window " + std::to_string(p.window) + "/" + std::to_string(p.windows);
-    text += ", " + p.phase;
-    if (p.total > 0) text += " " + std::to_string(p.done) + "/" + std::to_string(p.total);
-    call.poll(p.fraction, text);
+    call.poll(p.fraction, progress_text(learner + " " + regressor, p));
   };
   std::optional<TrainReport> report;
   {

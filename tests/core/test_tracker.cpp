@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
@@ -364,6 +366,25 @@ TEST(TrackerRecordings, RefineRestartsRefineTheLeadingPathsInTurnUntilOneIsEnoug
   c.refine_enough = 0.8;
   c.refine_restarts = 0;
   EXPECT_NE(test::error_of([&] { Recordings(paths, w, c, 7); }).find("\"refine_restarts\""), std::string::npos);
+}
+
+TEST(TrackerRecordings, ItsPreparationReportsTheRankingAndEachRefinementsGenerations) {
+  const WorldConfig w = test::short_world(200);
+  const std::vector<CupPath> paths = three_scripted_paths(w);
+  TrackerConfig c;
+  c.probes = 4;
+  small_refinement(c);
+  c.refine_restarts = 2;  // none of them is enough to stop the restarts (the test above)
+  std::vector<std::string> seen;
+  const Recordings r(paths, w, c, 7, 1, local_cluster(), [&](const std::string& stage, int done, int total) {
+    seen.push_back(stage + " " + std::to_string(done) + "/" + std::to_string(total));
+  });
+  const std::vector<std::string> expected{"ranking the paths 0/1",    "ranking the paths 1/1",    "refining path 1 of 2 1/2",
+                                          "refining path 1 of 2 2/2", "refining path 2 of 2 1/2", "refining path 2 of 2 2/2"};
+  EXPECT_EQ(seen, expected);
+  const Recordings unwatched(paths, w, c, 7, 1);
+  EXPECT_EQ(r.order(), unwatched.order());
+  EXPECT_EQ(r.probe_successes(), unwatched.probe_successes());
 }
 
 TEST(TrackerExpert, ChoosesOnceAndFollows) {

@@ -29,6 +29,15 @@ TEST(Learners, BehaviourCloningEqualsFittingTheRegressorOnTheDemonstrations) {
   EXPECT_EQ(r.model->predict(d.x), direct.predict(d.x));
 }
 
+TEST(Learners, AProgressLineNamesTheIterationWindowPhaseAndCount) {
+  EXPECT_EQ(progress_text("dart gbt", {"demonstrations", 1, 1, 0, 0, 3, 20, 0.1}), "dart gbt: iteration 1/1, demonstrations 3/20");
+  EXPECT_EQ(progress_text("dad knn", {"corrections", 2, 6, 1, 3, 4, 9, 0.2}), "dad knn: iteration 2/6, window 1/3, corrections 4/9");
+  // Before the iterations (the tracker preparing its paths) there is no iteration to name.
+  EXPECT_EQ(progress_text("dart gbt", {"tracker: refining path 1 of 4", 0, 0, 0, 0, 5, 60, 0.0}),
+            "dart gbt: tracker: refining path 1 of 4 5/60");
+  EXPECT_EQ(progress_text("bc knn", {"fit", 1, 1, 0, 0, 0, 0, 0.5}), "bc knn: iteration 1/1, fit");
+}
+
 TEST(Learners, UnknownNamesAndEmptyDemosAreRejected) {
   EXPECT_THAT(test::error_of([] { LearnerRegistry::global().create("dagr"); }), ::testing::HasSubstr("unknown learner \"dagr\"; registered: bc"));
   LearnContext c;

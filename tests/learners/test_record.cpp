@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include <dicestack/core/error.hpp>
@@ -30,6 +31,18 @@ TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
     EXPECT_EQ(a[i].sources.front(), StepSource::expert);
   }
   EXPECT_THROW(record_expert("nobody", {}, w, test::record_request(1, 0, 1)), ConfigError);
+}
+
+TEST(Record, ReportsEachFinishedEpisodeOnOneThread) {
+  WorldConfig w;
+  w.episode.max_steps = 40;
+  RecordRequest r = test::record_request(3, 3, 1);
+  std::vector<std::pair<int, int>> seen;
+  r.progress = [&](int done, int total) { seen.emplace_back(done, total); };
+  const auto watched = record_expert("scripted", {}, w, r);
+  EXPECT_EQ(seen, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
+  const auto unwatched = record_expert("scripted", {}, w, test::record_request(3, 3, 1));
+  for (std::size_t i = 0; i < watched.size(); ++i) EXPECT_EQ(watched[i].states, unwatched[i].states);
 }
 
 TEST(RecordTracker, RecordingThroughItDoesNotDependOnThreadsAndNamesItsExpert) {

@@ -117,7 +117,7 @@ std::vector<double> start_values(const std::vector<CupPath>& paths, const WorldC
 }  // namespace
 
 CupPath refine_path(const CupPath& path, const WorldConfig& world, const TrackerConfig& c, std::uint64_t seed, int threads,
-                    Cluster& cluster) {
+                    Cluster& cluster, const std::function<void(int, int)>& generation_done) {
   const CupPath base = folded(path);
   const double dt = world.physics.control_dt;
   const auto probes = static_cast<std::size_t>(c.refine_probes);
@@ -138,6 +138,7 @@ CupPath refine_path(const CupPath& path, const WorldConfig& world, const Tracker
     for (std::size_t item = 0; item < values.size(); ++item) loss[item / probes] -= values[item];
     es.tell(loss);
     ++generation;
+    if (generation_done) generation_done(static_cast<int>(generation), c.refine);
   }
   CupPath out = offset_path(base, es.mean(), c, dt);
   out.name = path.name + " (refined)";

@@ -394,11 +394,12 @@ Action PathFollower::act(const State& s, int step) const {
 }
 
 Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, const TrackerConfig& config,
-                       std::uint64_t seed, int threads, Cluster& cluster)
+                       std::uint64_t seed, int threads, Cluster& cluster, const TrackerProgress& progress)
     : paths_(std::move(paths)), config_(config), seed_(seed) {
   validate(config_);
   if (paths_.empty()) throw InputError("tracker: no recordings to follow");
   for (const auto& p : paths_) check_path(p);
+  if (progress) progress("ranking the paths", 0, 1);
   const std::vector<CupPath> recorded = config_.variants.empty() ? std::vector<CupPath>{} : paths_;
   if (config_.smooth > 0.0)
     for (auto& p : paths_) p = smoothed(p, config_.smooth);
@@ -437,12 +438,13 @@ Recordings::Recordings(std::vector<CupPath> paths, const WorldConfig& world, con
     std::erase_if(order_, [&](std::size_t p) { return std::find(finalists.begin(), finalists.end(), p) != finalists.end(); });
     order_.insert(order_.begin(), finalists.begin(), finalists.end());
   }
-  if (config_.refine > 0) refine_leaders(world, threads, cluster);
+  if (progress) progress("ranking the paths", 1, 1);
+  if (config_.refine > 0) refine_leaders(world, threads, cluster, progress);
   if (config_.paths > 0 && static_cast<std::size_t>(config_.paths) < order_.size())
     order_.resize(static_cast<std::size_t>(config_.paths));
 }
 
-void Recordings::refine_leaders(const WorldConfig& world, int threads, Cluster& cluster) {
+void Recordings::refine_leaders(const WorldConfig& world, int threads, Cluster& cluster, const TrackerProgress& progress) {
   // Restart i refines the order's i-th path (wrapping) from a seed of its own: one refinement's
   // answer varies with its seed and its path as much as between recordings. Each is validated
   // on the same fresh starts as the leader as followed.
@@ -456,7 +458,11 @@ void Recordings::refine_leaders(const WorldConfig& world, int threads, Cluster& 
   for (int i = 0; i < config_.refine_restarts; ++i) {
     const std::size_t from = order_[static_cast<std::size_t>(i) % order_.size()];
     const std::uint64_t seed = i == 0 ? seed_ : derive_seed(seed_, static_cast<std::uint64_t>(i));
-    refined.push_back(tracker_detail::refine_path(paths_[from], world, config_, seed, threads, cluster));
+    const std::string stage = "refining path " + std::to_string(i + 1) + " of " + std::to_string(config_.refine_restarts);
+    const auto generation_done = [&](int done, int total) {
+      if (progress) progress(stage, done, total);
+    };
+    refined.push_back(tracker_detail::refine_path(paths_[from], world, config_, seed, threads, cluster, generation_done));
     if (i > 0) refined.back().name = paths_[from].name + " (refined, restart " + std::to_string(i) + ")";
     successes.push_back(validated(refined.back()));
     if (successes.back() >= config_.refine_enough * trials) break;

@@ -23,11 +23,11 @@ std::vector<CupPath> cup_paths(const std::vector<Episode>& episodes);
 std::vector<Episode> pick_recordings(std::vector<Episode> episodes, int k, std::uint64_t seed);
 
 /// The tracker's recordings from `demos` (ranked by simulation from config.probes training
-/// starts of `seed`: see Recordings). Throws InputError if `demos` is empty. Collective over
-/// `cluster`.
+/// starts of `seed`: see Recordings; `progress` as there). Throws InputError if `demos` is empty.
+/// Collective over `cluster`.
 std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& demos, const WorldConfig& world,
                                                   const TrackerConfig& config, std::uint64_t seed, int threads = 0,
-                                                  Cluster& cluster = local_cluster());
+                                                  Cluster& cluster = local_cluster(), const TrackerProgress& progress = {});
 
 /// The recordings the tracker follows, best-ranked first, each with its probe score:
 /// "episode_0039 (88 of 96 probe trials), ..." ("not ranked" with no probes). A learner's model

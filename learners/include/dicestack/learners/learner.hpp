@@ -20,7 +20,7 @@ namespace dicestack {
 /// Where a learner stands, for progress bars.
 struct Progress {
   std::string phase;    ///< e.g. "fit", "rollouts", "corrections"
-  int iteration = 0;    ///< 1-based, of `iterations`
+  int iteration = 0;    ///< 1-based, of `iterations`; both 0 for work before the iterations (the tracker's paths)
   int iterations = 0;
   int window = 0;       ///< DaD: 1-based window of `windows` (0 for other learners)
   int windows = 0;
@@ -28,6 +28,10 @@ struct Progress {
   int total = 0;
   double fraction = 0.0;  ///< of the whole run's work, in [0, 1], for an estimate of the time left
 };
+
+/// A progress line's text: "dart gbt: iteration 1/1, demonstrations 3/20", with DaD's window,
+/// and without an iteration for work before the iterations. `who` names the run ("dart gbt").
+std::string progress_text(const std::string& who, const Progress& p);
 
 /// One point of a learning curve: the policy after an iteration, rolled out from the
 /// evaluation demonstrations' first states (the held-out ones when there are any).

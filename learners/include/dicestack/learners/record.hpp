@@ -1,6 +1,7 @@
 #pragma once
 // Demonstrations from an automatic expert, and the built-in demonstration set made from them.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ struct RecordRequest {
   /// Domain randomisation: each episode runs in its own draw (draw_perturbation from its seed);
   /// nominal: today's recordings, byte for byte.
   Perturbation perturbation;
+  /// Called with (episodes finished, request.episodes) from one worker as episodes finish (may be
+  /// empty); the counts are estimates across ranks.
+  std::function<void(int, int)> progress;
 };
 
 /// Runs expert `name` from request.episodes random starts, in parallel with one world and one

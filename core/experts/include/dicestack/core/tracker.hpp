@@ -8,6 +8,7 @@
 // dice at the first contact; its cup path, tracked, scoops them again (docs/learners.md).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -173,6 +174,11 @@ class PathFollower {
   double centre_ = 0.0, shift_ = 0.0, gain_ = 10.0;
 };
 
+/// How far the preparation of Recordings has come, for a progress display: `stage` ("ranking the
+/// paths", "refining path 2 of 4") and `done` of `total` work items in it (a refinement's
+/// generations). Called on the constructing thread, between steps of the work.
+using TrackerProgress = std::function<void(const std::string& stage, int done, int total)>;
+
 /// Recordings prepared for the tracker: each path (with TrackerConfig::variants, the
 /// recordings' variants after them, named "NAME (smoothed W)"), and their order of trial. Built
 /// once (the ranking simulates every path from `config.probes` training starts) and shared,
@@ -184,7 +190,7 @@ class Recordings {
   /// different lengths or a value that is not finite (naming the path and step); ConfigError
   /// for a bad config. Collective over `cluster`: the probe simulations are dealt among its ranks.
   Recordings(std::vector<CupPath> paths, const WorldConfig& world, const TrackerConfig& config, std::uint64_t seed,
-             int threads = 0, Cluster& cluster = local_cluster());
+             int threads = 0, Cluster& cluster = local_cluster(), const TrackerProgress& progress = {});
 
   const std::vector<CupPath>& paths() const { return paths_; }
   /// Path indices in the order the tracker tries them: highest probe score first, then by index;
@@ -206,7 +212,7 @@ class Recordings {
   /// Refines the paths that lead the order (TrackerConfig::refine, refine_restarts), adds them
   /// to paths() with their validation successes as their probe scores, and puts the best first
   /// if it beats the leader there; the others go last.
-  void refine_leaders(const WorldConfig& world, int threads, Cluster& cluster);
+  void refine_leaders(const WorldConfig& world, int threads, Cluster& cluster, const TrackerProgress& progress);
   /// Probe scores of paths [from, to) from probe starts [first_probe, first_probe + probes).
   std::vector<int> probe_scores(const WorldConfig& world, int threads, Cluster& cluster, std::size_t from, std::size_t to,
                                 int first_probe, int probes, bool variants) const;
