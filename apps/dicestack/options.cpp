@@ -87,6 +87,10 @@ ProgressBar::ProgressBar(double quiet_seconds)
 void ProgressBar::update(double fraction, const std::string& text) {
   static const bool tty = isatty(fileno(stderr));
   const auto now = std::chrono::steady_clock::now();
+  if (counted_fraction_ < 0.0 && fraction > 0.0) {
+    counted_from_ = now;
+    counted_fraction_ = std::min(fraction, 1.0);
+  }
   if (!tty && printed_ && std::chrono::duration<double>(now - last_print_).count() < quiet_) return;
   fraction = std::clamp(fraction, 0.0, 1.0);
   const double elapsed = std::chrono::duration<double>(now - start_).count();
@@ -96,7 +100,9 @@ void ProgressBar::update(double fraction, const std::string& text) {
   char pct[16];
   std::snprintf(pct, sizeof pct, "%3.0f%% ", 100.0 * fraction);
   line += pct + text + "  elapsed " + clock_text(elapsed);
-  if (fraction > 0.01) line += ", left ~" + clock_text(elapsed * (1.0 - fraction) / fraction);
+  const double counted = fraction - counted_fraction_;
+  if (counted_fraction_ >= 0.0 && counted > 0.01)
+    line += ", left ~" + clock_text(std::chrono::duration<double>(now - counted_from_).count() * (1.0 - fraction) / counted);
   print_progress(line);
   last_print_ = now;
   printed_ = true;

@@ -70,14 +70,16 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
 class ProgressBar {
  public:
   explicit ProgressBar(double quiet_seconds = 10.0);
-  /// `fraction` of the whole job done, in [0, 1].
+  /// `fraction` of the whole job done, in [0, 1]. The time left is estimated from the first
+  /// update with a fraction above 0 on: work shown at 0 % before it (the tracker preparing its
+  /// paths) has no known share of the job.
   void update(double fraction, const std::string& text);
   /// Ends the bar's line on a terminal.
   void finish();
 
  private:
-  std::chrono::steady_clock::time_point start_, last_print_;
-  double quiet_;
+  std::chrono::steady_clock::time_point start_, last_print_, counted_from_;
+  double quiet_, counted_fraction_ = -1.0;  // -1: no fraction above 0 yet
   bool printed_ = false;
 };
 

@@ -348,6 +348,7 @@ class Dad final : public Learner {
     request.episodes = plan.episodes;
     request.seed = c.seed;
     request.threads = c.threads;
+    if (c.progress) request.progress = [&c](int done, int total) { c.progress({"targets", 0, 0, 0, 0, done, total, 0.0}); };
     std::vector<Episode> targets;
     for (auto& e : record_expert("tracker", expert, c.world, request, *c.cluster))
       if (e.outcome.realistic_success()) {

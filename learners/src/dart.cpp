@@ -79,9 +79,9 @@ class Dart final : public Learner {
     const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
     const DartSettings d = dart_settings(params(), c.features, !perturbation.trained.nominal());
     const int episodes = d.episodes;
-    if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
     std::vector<Episode> data = d.include_demos ? c.demos : std::vector<Episode>{};
-    ExpertConfig expert = learner_expert_config(d.expert, *this, c);
+    ExpertConfig expert = learner_expert_config(d.expert, *this, c);  // the tracker shows its preparation
+    if (c.progress) c.progress({"demonstrations", 1, 1, 0, 0, 0, episodes, 0.0});
     // mpc replans when the world leaves its prediction (here: at every noisy step), so its labels
     // depend on the noise so far; without replanning its plan is a function of the start.
     expert.replan = d.replan;

@@ -21,9 +21,14 @@ class ProgressBar:
         self._start = time.monotonic()
         self._last = None
         self._drawn = False
+        # The time left counts from the first fraction above 0: work shown at 0 % before it (the
+        # tracker preparing its paths) has no known share of the job.
+        self._counted = None  # (time, fraction)
 
     def update(self, fraction, text):
         now = time.monotonic()
+        if self._counted is None and fraction > 0.0:
+            self._counted = (now, min(float(fraction), 1.0))
         quiet = 0.1 if self._tty else 10.0
         if self._last is not None and now - self._last < quiet and fraction < 1.0:
             return
@@ -32,8 +37,9 @@ class ProgressBar:
         elapsed = now - self._start
         filled = int(fraction * 20)
         line = f"[{'#' * filled}{'-' * (20 - filled)}] {100 * fraction:3.0f}% {text}  elapsed {_clock(elapsed)}"
-        if fraction > 0.01:
-            line += f", left ~{_clock(elapsed * (1 - fraction) / fraction)}"
+        if self._counted is not None and fraction - self._counted[1] > 0.01:
+            counted = fraction - self._counted[1]
+            line += f", left ~{_clock((now - self._counted[0]) * (1 - fraction) / counted)}"
         self._stream.write(f"\r\033[K{line}" if self._tty else line + "\n")
         self._stream.flush()
         self._drawn = True

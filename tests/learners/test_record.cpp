@@ -2,7 +2,9 @@
 // naming it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -43,6 +45,22 @@ TEST(Record, ReportsEachFinishedEpisodeOnOneThread) {
   EXPECT_EQ(seen, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
   const auto unwatched = record_expert("scripted", {}, w, test::record_request(3, 3, 1));
   for (std::size_t i = 0; i < watched.size(); ++i) EXPECT_EQ(watched[i].states, unwatched[i].states);
+  // On three threads: only the calling thread reports, the counts never go back or past the total,
+  // and the episodes are the same.
+  r = test::record_request(6, 3, 3);
+  const auto caller = std::this_thread::get_id();
+  std::vector<int> counts;
+  bool elsewhere = false;
+  r.progress = [&](int done, int total) {
+    elsewhere = elsewhere || std::this_thread::get_id() != caller || total != 6;
+    counts.push_back(done);
+  };
+  const auto three = record_expert("scripted", {}, w, r), one = record_expert("scripted", {}, w, test::record_request(6, 3, 1));
+  EXPECT_FALSE(elsewhere);
+  ASSERT_FALSE(counts.empty());
+  EXPECT_TRUE(std::is_sorted(counts.begin(), counts.end()));
+  EXPECT_LE(counts.back(), 6);
+  for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(three[i].states, one[i].states);
 }
 
 TEST(RecordTracker, RecordingThroughItDoesNotDependOnThreadsAndNamesItsExpert) {
