@@ -11,6 +11,7 @@
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/experiments/train.hpp>
+#include <dicestack/learners/learner.hpp>
 
 namespace dicestack::cli {
 
@@ -100,9 +101,9 @@ void ProgressBar::update(double fraction, const std::string& text) {
   char pct[16];
   std::snprintf(pct, sizeof pct, "%3.0f%% ", 100.0 * fraction);
   line += pct + text + "  elapsed " + clock_text(elapsed);
-  const double counted = fraction - counted_fraction_;
-  if (counted_fraction_ >= 0.0 && counted > 0.01)
-    line += ", left ~" + clock_text(std::chrono::duration<double>(now - counted_from_).count() * (1.0 - fraction) / counted);
+  const double left =
+      counted_fraction_ < 0.0 ? -1.0 : time_left(std::chrono::duration<double>(now - counted_from_).count(), fraction, counted_fraction_);
+  if (left >= 0.0) line += ", left ~" + clock_text(left);
   print_progress(line);
   last_print_ = now;
   printed_ = true;

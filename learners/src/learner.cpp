@@ -20,6 +20,11 @@ std::string progress_text(const std::string& who, const Progress& p) {
   return text;
 }
 
+double time_left(double seconds, double fraction, double counted_from) {
+  const double counted = fraction - counted_from;
+  return counted > 0.01 ? seconds * (1.0 - fraction) / counted : -1.0;
+}
+
 void register_bc(LearnerRegistry&);
 void register_dagger(LearnerRegistry&);
 void register_dad(LearnerRegistry&);

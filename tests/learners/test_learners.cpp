@@ -38,6 +38,14 @@ TEST(Learners, AProgressLineNamesTheIterationWindowPhaseAndCount) {
   EXPECT_EQ(progress_text("bc knn", {"fit", 1, 1, 0, 0, 0, 0, 0.5}), "bc knn: iteration 1/1, fit");
 }
 
+TEST(Learners, TheTimeLeftCountsFromTheFirstFractionAboveZero) {
+  // 0.45 of the job in the 100 s since it stood at 0.1: 0.45 left takes 100 s more, whatever
+  // came before at 0 % (counted from the start, 300 s in, it would say 245 s).
+  EXPECT_DOUBLE_EQ(time_left(100.0, 0.55, 0.1), 100.0);
+  EXPECT_LT(time_left(100.0, 0.105, 0.1), 0.0);  // too little progress to tell
+  EXPECT_DOUBLE_EQ(time_left(50.0, 1.0, 0.2), 0.0);
+}
+
 TEST(Learners, UnknownNamesAndEmptyDemosAreRejected) {
   EXPECT_THAT(test::error_of([] { LearnerRegistry::global().create("dagr"); }), ::testing::HasSubstr("unknown learner \"dagr\"; registered: bc"));
   LearnContext c;

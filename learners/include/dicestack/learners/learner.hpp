@@ -33,6 +33,12 @@ struct Progress {
 /// and without an iteration for work before the iterations. `who` names the run ("dart gbt").
 std::string progress_text(const std::string& who, const Progress& p);
 
+/// The seconds a job has left at `fraction` done, timed from when it stood at `counted_from`
+/// (`seconds` ago): the first fraction above 0 a bar saw, since work shown at 0 % before it (the
+/// tracker preparing its paths) has no known share of the job. Negative when the fraction has not
+/// moved a hundredth since: too little to tell.
+double time_left(double seconds, double fraction, double counted_from);
+
 /// One point of a learning curve: the policy after an iteration, rolled out from the
 /// evaluation demonstrations' first states (the held-out ones when there are any).
 struct CurvePoint {
