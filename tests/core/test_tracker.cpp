@@ -1,5 +1,6 @@
 // The tracker: recorded cup paths followed by feedback on the cup, chosen by
 // simulation.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
