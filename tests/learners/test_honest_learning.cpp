@@ -9,10 +9,12 @@
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
+#include <dicestack/core/initial_state.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/policy.hpp>
 #include <dicestack/learners/record.hpp>
 
 #include <dicestack/test/demos.hpp>
@@ -102,6 +104,34 @@ TEST(HonestLearning, DadAndDartFromThreeRecordingsBuildNoHandMadeExpertAndNameTh
     EXPECT_TRUE(std::any_of(c.demos.begin(), c.demos.end(), [&](const Episode& e) { return followed.starts_with(e.name + " "); }))
         << followed;
   }
+}
+
+TEST(HonestLearning, DadFromTrainingStartsScoresEachIterationFromStartsNoTargetUsed) {
+  LearnContext c = recordings_context();
+  c.demos.resize(3);
+  c.regressor = "knn";
+  c.features = "state+clock+start_state@dice+retry/position";
+  const int episodes = 4;
+  const auto learned = LearnerRegistry::global()
+                           .create("dad", {"starts=training", "episodes=" + std::to_string(episodes), "windows=1",
+                                           "iterations=1", "keep_best=false", "corrector=track", "tracker_probes=1",
+                                           "tracker_robust=1", "tracker_variants=false", "tracker_refine=0"})
+                           ->learn(c);
+  const auto targets = static_cast<std::size_t>(std::stoul(learned.model->record.at("dad_targets")));
+  ASSERT_GT(targets, 0u);
+  // As many starts as targets, from the training stream after the targets' own.
+  std::vector<Episode> fresh(targets);
+  for (std::size_t i = 0; i < targets; ++i) {
+    fresh[i].seed = training_start_seed(c.seed, static_cast<std::uint64_t>(episodes) + i);
+    fresh[i].states = {random_start_state(c.world, fresh[i].seed)};
+  }
+  const Tracking t = track_demos([&] { return std::make_unique<ModelPolicy>(learned.model); }, fresh, c.world, 2);
+  ASSERT_EQ(learned.curve.size(), 2u);  // the first fit, then the one iteration kept (keep_best=false)
+  EXPECT_EQ(learned.curve[1].realistic_success_rate, t.stats.realistic_success.value);
+  // Scored from bare starts, not along a target: nothing to deviate from but the start itself,
+  // as the world holds it (single precision).
+  EXPECT_LT(learned.curve[1].deviation, 1e-5);
+  EXPECT_THAT(learned.model->record.at("dad_scored_on"), HasSubstr("training starts no target used"));
 }
 
 TEST(HonestLearning, TheTrackerFollowsAnotherSetsTrainingEpisodesWhenToldTo) {
