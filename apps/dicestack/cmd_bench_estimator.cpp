@@ -166,7 +166,7 @@ void add_bench_estimator_command(CLI::App& bench) {
       ->check(CLI::IsMember({"scripted", "mpc"}))
       ->capture_default_str();
   add_estimator_option(*cmd, opt->estimator)
-      ->description("The estimator measured: none (the observations) or kalman (docs/robustness.md)")
+      ->description("The estimator measured: none (the observations), kalman or particle[:N] (docs/robustness.md)")
       ->capture_default_str();
   cmd->add_option("--episodes", opt->episodes, "Episodes per row")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the first episode (then seed + 1, ...)")->check(seed_check())->capture_default_str();

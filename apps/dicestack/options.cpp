@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/parallel.hpp>
 #include <dicestack/experiments/train.hpp>
@@ -144,10 +145,20 @@ CLI::Validator threads_check() {
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {
   return cmd
       .add_option("--estimator", name,
-                  "What the policy is shown under sensing factors and delays: none (the observations) or kalman (a "
-                  "Kalman filter whose motion model is the simulator; docs/robustness.md). Default: the model's own "
-                  "(a policy trained with perturb= runs behind the estimator it names), none otherwise")
-      ->check(CLI::IsMember(estimator_names()));
+                  "What the policy is shown under sensing factors and delays: none (the observations), kalman (a "
+                  "Kalman filter whose motion model is the simulator) or particle (a particle filter of simulated "
+                  "worlds, 64; particle:N for N; docs/robustness.md). Default: the model's own (a policy trained "
+                  "with perturb= runs behind the estimator it names), none otherwise")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            try {
+              estimator_config(value);
+              return std::string();
+            } catch (const ConfigError& e) {
+              return std::string(e.what());
+            }
+          },
+          "none|kalman|particle[:N]"));
 }
 
 double median(std::vector<double> v) {

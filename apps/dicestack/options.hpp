@@ -47,7 +47,7 @@ CLI::Validator seed_check();
 /// `--threads`: a whole number in [0, kMaxThreads] (0: all cores).
 CLI::Validator threads_check();
 
-/// `--estimator NAME` (none, kalman): what a policy is shown under sensing factors and delays.
+/// `--estimator NAME` (none, kalman, particle[:N]): what a policy is shown under sensing factors and delays.
 /// Left empty when not given: each model's own (estimator_for), none for an expert.
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name);
 

@@ -99,13 +99,12 @@ struct DadRun {
   std::size_t corrections = 0, filtered = 0;
   bool from_training = false;
 
-  // The iteration's policy is better: from training starts, it stacks from more of them (then
-  // follows its targets closer); else it follows the held-out demonstrations closer.
+  // The iteration's policy is better: from training starts, it stacks from more of its scoring
+  // starts (a tie keeps the earlier, with fewer corrections); else it follows the held-out
+  // demonstrations closer.
   bool better(const CurvePoint& p) const {
     if (!from_training) return p.deviation < best_deviation;
-    const CurvePoint& b = result.curve[static_cast<std::size_t>(best_iteration)];
-    return p.realistic_success_rate > b.realistic_success_rate ||
-           (p.realistic_success_rate == b.realistic_success_rate && p.deviation < b.deviation);
+    return p.realistic_success_rate > result.curve[static_cast<std::size_t>(best_iteration)].realistic_success_rate;
   }
   // Adds iteration k's point to the curve, keeping its policy when it is the best so far.
   void add(const CurvePoint& point, int k) {
@@ -175,7 +174,9 @@ class Dad final : public Learner {
     chosen->record["learner"] = "dad";
     chosen->record["dad_iteration"] = std::to_string(plan.keep_best ? run.best_iteration : total);
     chosen->record["dad_targets"] = std::to_string(targets.size());
-    chosen->record["dad_scored_on"] = from_training ? std::to_string(targets.size()) + " training starts no target used (realistic success)"
+    chosen->record["dad_scored_on"] = from_training ? "training starts " + std::to_string(plan.episodes) + " to " +
+                                                          std::to_string(plan.episodes + static_cast<int>(targets.size()) - 1) +
+                                                          ", which no target used (realistic success)"
                                       : c.held_out.empty() ? "targets"
                                                            : std::to_string(c.held_out.size()) + " held-out demonstrations";
     if (from_training) {

@@ -143,8 +143,8 @@ std::vector<ParamSpec> perturb_param_specs() {
        "perturbation file; docs/robustness.md)",
        {}},
       {"estimator", ParamType::choice, "kalman", 0, 0,
-       "under perturb's sensing factors and delays: kalman trains without them and the policy runs behind the "
-       "estimator (the model names it); none trains through them, on what the sensors gave",
+       "under perturb's sensing factors and delays: kalman or particle trains without them and the policy runs "
+       "behind that estimator (the model names it); none trains through them, on what the sensors gave",
        estimator_names()}};
   return specs;
 }

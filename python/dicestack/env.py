@@ -81,10 +81,10 @@ class DiceStackEnv(_EnvBase):
     options={"perturb": ...} perturbs that one episode instead. info["perturbation"] (at reset)
     holds the values drawn; `state` stays the true state.
 
-    estimator: "none" (the observations as the sensors give them) or "kalman": under sensing
-    factors each observation is the estimate of a Kalman filter whose motion model is the
-    simulator, as `dicestack evaluate --estimator kalman` shows a policy (docs/robustness.md,
-    "The estimator").
+    estimator: "none" (the observations as the sensors give them), "kalman" or "particle"
+    ("particle:N" for N particles): under sensing factors each observation is the estimate of a
+    Kalman filter, or a particle filter, whose motion model is the simulator, as `dicestack
+    evaluate --estimator NAME` shows a policy (docs/robustness.md, "The estimator").
 
     embodiment: None (the world's), "cup" (the paper's floating cup) or "arm": a planar arm holds
     the cup and the same actions drive it through its joints (docs/arm.md); the observation stays
@@ -98,7 +98,7 @@ class DiceStackEnv(_EnvBase):
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
-            raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
+            raise TypeError(f"estimator must be a name (none, kalman, particle), got {type(estimator).__name__}")
         self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world), estimator)
         self.render_mode = render_mode
         self.metadata = dict(type(self).metadata, render_fps=int(round(1.0 / self._world.control_dt)))

@@ -113,7 +113,7 @@ def _estimator_name(estimator):
     if estimator is None:
         return ""  # each model's own
     if not isinstance(estimator, str):
-        raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
+        raise TypeError(f"estimator must be a name (none, kalman, particle), got {type(estimator).__name__}")
     return estimator
 
 
@@ -125,7 +125,7 @@ def evaluate(model, episodes=20, seed=0, *, world=None, start="random", demos=No
     realistic_success_rate, dice_in_cup_mean, ...; train_error and test_error when demos are
     given). The result does not depend on `threads`. perturb: as `evaluate --perturb` (a level,
     a perturbation file or a dict of its fields; docs/robustness.md); estimator: what the policy is
-    shown under sensing factors and delays, as `evaluate --estimator` ("none" or "kalman"; None: the
+    shown under sensing factors and delays, as `evaluate --estimator` ("none", "kalman" or "particle"; None: the
     model's own, the one a policy trained with perturb= names, else none). progress: a progress bar on
     stderr (None: when stderr is a terminal); Ctrl-C stops the rollouts with KeyboardInterrupt.
 
@@ -191,7 +191,8 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     "paper", where training and rollouts start (as `leaderboard --start`). perturb: roll out in
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
     nominal; docs/robustness.md); estimator: what the rolled-out policies are shown under sensing
-    factors and delays, as `leaderboard --estimator` ("none" or "kalman"; None: each model's own).
+    factors and delays, as `leaderboard --estimator` ("none", "kalman" or "particle"; None: each model's
+    own).
 
     out: also write the table there, in `format` (md, csv, latex, json or html; None: from the
     file's suffix, .md .csv .tex .json .html, else md; html is a results page with its media in

@@ -31,7 +31,7 @@ class DiceStackVectorEnv(_VectorBase):
     the first observation with reward 0 and terminated = truncated = False.
 
     perturb: as DiceStackEnv's; each environment draws its own world from its own episode seed.
-    estimator: as DiceStackEnv's ("none" or "kalman"), one per environment.
+    estimator: as DiceStackEnv's ("none", "kalman" or "particle"), one per environment.
     """
 
     metadata = {"render_modes": [], "autoreset_mode": _NEXT_STEP}
@@ -48,7 +48,7 @@ class DiceStackVectorEnv(_VectorBase):
         self.num_envs = int(num_envs)
         self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
-            raise TypeError(f"estimator must be a name (none, kalman), got {type(estimator).__name__}")
+            raise TypeError(f"estimator must be a name (none, kalman, particle), got {type(estimator).__name__}")
         self._vec = _dicestack.VectorEnv(self._world, self.num_envs, threads, resolve_perturbation(perturb, self._world),
                                          estimator)
         probe = _dicestack.Env(self._world)

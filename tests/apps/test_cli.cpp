@@ -261,6 +261,9 @@ TEST(CliInput, TheEstimatorIsCheckedFirstAndNoneChangesNothing) {
   const Process bad = run_within(5, "robustness --expert scripted --estimator particles --episodes 1");
   EXPECT_NE(bad.status, 0);
   EXPECT_THAT(bad.output, HasSubstr("--estimator"));
+  const Process none_left = run_within(5, "robustness --expert scripted --estimator particle:0 --episodes 1");
+  EXPECT_NE(none_left.status, 0);
+  EXPECT_THAT(none_left.output, HasSubstr("a count of particles from 1 to 4096"));
   const Process world = run_within(5, "robustness --expert scripted --estimator kalman --episodes 1");
   EXPECT_EQ(world.status, 1);
   EXPECT_THAT(world.output, HasSubstr("--expert-feedback observations"));

@@ -54,7 +54,14 @@ double shown_error(const Perturbation& p, const EstimatorConfig& estimator, std:
 TEST(Estimator, NamesAreParsedAtTheEdgeAndABadOneIsRefusedNamingTheChoices) {
   EXPECT_EQ(estimator_config("none").kind, EstimatorKind::none);
   EXPECT_EQ(estimator_config("kalman").kind, EstimatorKind::kalman);
-  EXPECT_THAT(test::error_of([] { estimator_config("particles"); }), HasSubstr("not one of none, kalman"));
+  EXPECT_THAT(test::error_of([] { estimator_config("particles"); }), HasSubstr("not one of none, kalman, particle"));
+  EXPECT_EQ(estimator_config("particle").kind, EstimatorKind::particle);
+  EXPECT_EQ(estimator_config("particle").particles, 64);
+  EXPECT_EQ(estimator_config("particle:8").particles, 8);
+  EXPECT_EQ(estimator_config("particle:4096").particles, kMaxParticles);
+  for (const char* bad : {"particle:0", "particle:4097", "particle:-1", "particle:+8", "particle: 8", "particle:8x", "particle:",
+                          "particle:x", "particle:1e3", "particle:0000000008"})
+    EXPECT_THAT(test::error_of([&] { estimator_config(bad); }), HasSubstr("a count of particles from 1 to 4096")) << bad;
 }
 
 TEST(Estimator, WithoutSensingFactorsThePolicySeesTheStateAsBefore) {
@@ -117,13 +124,48 @@ TEST(Estimator, FiltersSensorNoiseOnThePoses) {
 TEST(Estimator, TheSameEpisodeGivesTheSameEstimatesBitForBit) {
   const Perturbation both = perturbation_level("medium");
   const WorldConfig w;
-  DiceEnv a(w), b(w);
-  PerturbedEnv x(a, both, 7), y(b, both, 7);
-  x.use_estimator(estimator_config("kalman"));
-  y.use_estimator(estimator_config("kalman"));
-  EXPECT_TRUE(test::bit_equal(x.reset(7), y.reset(7)));
-  for (int t = 0; t < 60; ++t) EXPECT_TRUE(test::bit_equal(x.step(swing(t)).shown, y.step(swing(t)).shown)) << t;
-  EXPECT_TRUE(x.unseen().empty());  // the estimate is of the current state
+  for (const char* name : {"kalman", "particle:8"}) {
+    DiceEnv a(w), b(w);
+    PerturbedEnv x(a, both, 7), y(b, both, 7);
+    x.use_estimator(estimator_config(name));
+    y.use_estimator(estimator_config(name));
+    EXPECT_TRUE(test::bit_equal(x.reset(7), y.reset(7))) << name;
+    for (int t = 0; t < 60; ++t) EXPECT_TRUE(test::bit_equal(x.step(swing(t)).shown, y.step(swing(t)).shown)) << name << " " << t;
+    EXPECT_TRUE(x.unseen().empty());  // the estimate is of the current state
+  }
+}
+
+TEST(ParticleEstimator, FiltersSensorNoiseThroughTheContacts) {
+  const Perturbation noisy = perturbation_factor("observation_noise", "medium");
+  for (std::uint64_t seed : {1u, 2u}) {
+    const double raw = shown_error(noisy, estimator_config("none"), seed);
+    const double estimated = shown_error(noisy, estimator_config("particle:16"), seed);
+    EXPECT_LT(estimated, 0.9 * raw) << "seed " << seed << ": raw " << raw << ", estimated " << estimated;
+    EXPECT_LT(shown_error(noisy, estimator_config("particle:16"), seed, true), shown_error(noisy, estimator_config("none"), seed, true))
+        << "seed " << seed << ": the poses";
+  }
+}
+
+TEST(ParticleEstimator, IsTheFilterUnderSensorNoiseAndTheKalmanFilterMakesUpADelayWithoutIt) {
+  const WorldConfig w;
+  const auto noisy = make_estimator(estimator_config("particle:4"), w,
+                                    draw_perturbation(perturbation_factor("observation_noise", "easy"), w, 1));
+  EXPECT_NE(dynamic_cast<ParticleEstimator*>(noisy.get()), nullptr);
+  const auto late = make_estimator(estimator_config("particle:4"), w,
+                                   draw_perturbation(perturbation_factor("observation_delay", "medium"), w, 1));
+  EXPECT_NE(dynamic_cast<KalmanEstimator*>(late.get()), nullptr);
+  EXPECT_EQ(shown_error(perturbation_factor("observation_delay", "medium"), estimator_config("particle:4"), 1), 0.0);
+  // Its estimates are its own, not the Kalman filter's.
+  const Perturbation medium = perturbation_factor("observation_noise", "medium");
+  EXPECT_NE(shown_error(medium, estimator_config("particle:8"), 1), shown_error(medium, estimator_config("kalman"), 1));
+}
+
+TEST(ParticleEstimator, ACountOutsideItsRangeIsRefusedWhereverTheConfigComesFrom) {
+  const WorldConfig w;
+  EstimatorConfig c = estimator_config("particle");
+  c.particles = 0;
+  const PerturbationDraw draw = draw_perturbation(perturbation_factor("observation_noise", "easy"), w, 1);
+  EXPECT_THAT(test::error_of([&] { make_estimator(c, w, draw); }), HasSubstr("takes 1 to 4096 particles, got 0"));
 }
 
 }  // namespace

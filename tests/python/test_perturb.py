@@ -218,3 +218,16 @@ def test_a_bad_estimator_is_refused(estimator, error):
     with pytest.raises(error) as caught:
         dicestack.DiceStackEnv(estimator=estimator)
     assert len(str(caught.value)) < 300
+
+
+def test_the_particle_filter_runs_behind_the_env_the_same_way_each_time(rng):
+    actions = random_actions(rng, 30)
+    noisy = {"observation_noise": 0.05}
+    raw = episode(dicestack.DiceStackEnv(perturb=noisy), 5, actions)
+    first = episode(dicestack.DiceStackEnv(perturb=noisy, estimator="particle:8"), 5, actions)
+    again = episode(dicestack.DiceStackEnv(perturb=noisy, estimator="particle:8"), 5, actions)
+    assert np.array_equal(raw[1], first[1])  # the same episode runs
+    assert np.array_equal(first[0], again[0])  # and the same estimates are shown
+    assert not np.array_equal(first[0], raw[0])
+    with pytest.raises(ValueError, match="from 1 to 4096"):
+        dicestack.DiceStackEnv(perturb=noisy, estimator="particle:0")

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <string>
 
 #include <dicestack/core/error.hpp>
 
@@ -37,8 +38,10 @@ constexpr double kModelErrorFloor = 1e-4;
 
 }  // namespace
 
+double model_error_of(std::size_t k) { return std::max(kModelError[k], kModelErrorFloor) * observation_spread()[k]; }
+
 const std::vector<std::string>& estimator_names() {
-  static const std::vector<std::string> names{"none", "kalman"};
+  static const std::vector<std::string> names{"none", "kalman", "particle"};
   return names;
 }
 
@@ -53,15 +56,56 @@ EstimatorConfig estimator_config(std::string_view name) {
     c.kind = EstimatorKind::kalman;
     return c;
   }
-  throw ConfigError("estimator \"" + std::string(name.substr(0, 60)) + "\" is not one of none, kalman");
+  constexpr std::string_view particle = "particle";
+  if (name.substr(0, particle.size()) == particle && (name.size() == particle.size() || name[particle.size()] == ':')) {
+    c.kind = EstimatorKind::particle;
+    if (name.size() == particle.size()) return c;
+    const std::string_view count = name.substr(particle.size() + 1);
+    long long n = 0;
+    const bool digits = !count.empty() && count.size() <= 6 &&
+                        std::all_of(count.begin(), count.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+    if (digits) n = std::stoll(std::string(count));
+    if (!digits || n < 1 || n > kMaxParticles)
+      throw ConfigError("estimator \"" + std::string(name.substr(0, 60)) + "\": particle:N takes a count of particles from 1 to " +
+                        std::to_string(kMaxParticles));
+    c.particles = static_cast<int>(n);
+    return c;
+  }
+  throw ConfigError("estimator \"" + std::string(name.substr(0, 60)) + "\" is not one of none, kalman, particle (particle:N)");
+}
+
+void CommandTimeline::start() {
+  steps_ = lagged_step_ = 0;
+  queue_.assign(static_cast<std::size_t>(action_delay_), Action{0.0, 0.0, 0.0});
+  since_.clear();
+}
+
+bool CommandTimeline::choose(const Action& chosen) {
+  queue_.push_back(chosen);
+  since_.push_back(queue_.front());
+  queue_.pop_front();
+  ++steps_;
+  // The observation shows the state of observation_delay steps ago (the start before then).
+  return steps_ - observation_delay_ > lagged_step_;
+}
+
+Action CommandTimeline::take_ran() {
+  const Action ran = since_.front();
+  since_.pop_front();
+  ++lagged_step_;
+  return ran;
+}
+
+void CommandTimeline::run_on(World& world) const {
+  for (const Action& a : since_) world.step(a);
+  for (const Action& a : queue_) world.step(a);
 }
 
 KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config)
-    : model_(model), dt_(model.physics.control_dt), observation_delay_(draw.observation_delay),
-      action_delay_(draw.action_delay) {
+    : model_(model), dt_(model.physics.control_dt), timeline_(draw.action_delay, draw.observation_delay) {
   for (std::size_t k = 0; k < kStateDim; ++k) {
     sensor_variance_[k] = draw.observation_noise[k] * draw.observation_noise[k];
-    const double q = config.model_error * std::max(kModelError[k], kModelErrorFloor) * observation_spread()[k];
+    const double q = config.model_error * model_error_of(k);
     process_variance_[k] = q * q;
   }
 }
@@ -72,15 +116,12 @@ State KalmanEstimator::start(const State& observed) {
   const auto& all = kPairs;
   for (std::size_t i = 0; i < all.size(); ++i)
     covariance_[i] = {sensor_variance_[all[i].pose], 0.0, sensor_variance_[all[i].velocity]};
-  steps_ = lagged_step_ = 0;
-  queue_.assign(static_cast<std::size_t>(action_delay_), Action{0.0, 0.0, 0.0});
-  since_.clear();
+  timeline_.start();
   return ahead();
 }
 
 void KalmanEstimator::predict() {
-  model_.step(since_.front());  // the model stands at lagged_, its contacts warm where it was not corrected
-  since_.pop_front();
+  model_.step(timeline_.take_ran());  // the model stands at lagged_, its contacts warm where it was not corrected
   lagged_ = model_.state();
   // The covariance moves as a pose and its velocity do over one step (the pose gains dt times
   // the velocity), plus the model's error.
@@ -91,7 +132,6 @@ void KalmanEstimator::predict() {
     c.pv += dt_ * c.vv;
     c.vv += process_variance_[all[i].velocity];
   }
-  ++lagged_step_;
 }
 
 void KalmanEstimator::correct(const State& observed) {
@@ -125,23 +165,16 @@ void KalmanEstimator::correct(const State& observed) {
 }
 
 State KalmanEstimator::update(const Action& chosen, const State& observed) {
-  // What ran this step, as the robot's own command queue knows it.
-  queue_.push_back(chosen);
-  since_.push_back(queue_.front());
-  queue_.pop_front();
-  ++steps_;
-  // The observation shows the state of observation_delay steps ago (the start before then):
-  // when that moved on by a step, the lagged estimate is predicted through it first.
-  if (steps_ - observation_delay_ > lagged_step_) predict();
+  // When the observation moved on by a step, the lagged estimate is predicted through it first.
+  if (timeline_.choose(chosen)) predict();
   correct(observed);
   return ahead();
 }
 
 State KalmanEstimator::ahead() {
-  if (since_.empty() && queue_.empty()) return lagged_;
+  if (timeline_.empty()) return lagged_;
   const WorldSnapshot at_lagged = model_.snapshot();
-  for (const Action& a : since_) model_.step(a);
-  for (const Action& a : queue_) model_.step(a);
+  timeline_.run_on(model_);
   const State landing = model_.state();
   model_.restore(at_lagged);
   return landing;
@@ -149,9 +182,13 @@ State KalmanEstimator::ahead() {
 
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
                                           const PerturbationDraw& draw) {
-  bool sensed = draw.observation_delay > 0 || draw.action_delay > 0;
-  for (double sigma : draw.observation_noise) sensed = sensed || sigma > 0.0;
+  bool noisy = false;
+  for (double sigma : draw.observation_noise) noisy = noisy || sigma > 0.0;
+  const bool sensed = noisy || draw.observation_delay > 0 || draw.action_delay > 0;
   if (config.kind == EstimatorKind::none || !sensed) return nullptr;
+  // Without sensor noise there is nothing to weigh particles by: the delays alone are made up
+  // exactly by the Kalman filter's forward simulation, which a particle filter would repeat.
+  if (config.kind == EstimatorKind::particle && noisy) return std::make_unique<ParticleEstimator>(model, draw, config);
   return std::make_unique<KalmanEstimator>(model, draw, config);
 }
 

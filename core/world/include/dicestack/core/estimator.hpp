@@ -13,14 +13,16 @@
 #include <vector>
 
 #include <dicestack/core/perturbation.hpp>
+#include <dicestack/core/rng.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/world.hpp>
 #include <dicestack/core/world_config.hpp>
 
 namespace dicestack {
 
-/// none: the policy sees the observations; kalman: KalmanEstimator's estimate.
-enum class EstimatorKind { none, kalman };
+/// none: the policy sees the observations; kalman: KalmanEstimator's estimate; particle:
+/// ParticleEstimator's.
+enum class EstimatorKind { none, kalman, particle };
 
 /// Which estimator, and its settings: parsed once, at the edge, from `--estimator NAME`.
 struct EstimatorConfig {
@@ -29,12 +31,27 @@ struct EstimatorConfig {
   /// from true states (estimator.cpp; `dicestack bench estimator` prints it), > 0: larger trusts
   /// the sensor more, smaller the simulator. 3 did best of 1, 3, 10 and 30 on tuning seeds.
   double model_error = 3.0;
+  /// particle: how many simulated worlds the filter keeps (`particle:N`), 1 to kMaxParticles.
+  int particles = 64;
+  /// particle: the model's error, in the same units. The particles must spread as far as a
+  /// contact-rich swing carries runs of the simulator from one another, far beyond its one-step
+  /// error from true states: 30 did best of 3, 10, 30, 100 and 300 (docs/notebook/2026-11-28-estimator.md).
+  double particle_model_error = 30.0;
 };
 
-/// The estimators by name: none, kalman.
+/// The most particles `particle:N` takes: each is a world of its own (tens of kilobytes) stepped
+/// at every control step, so more would cost minutes per episode before memory.
+inline constexpr int kMaxParticles = 4096;
+
+/// The estimators by name: none, kalman, particle.
 const std::vector<std::string>& estimator_names();
-/// The estimator of `name` with its default settings; throws ConfigError naming the choices.
+/// The estimator of `name` with its default settings (`particle:N`: N particles); throws
+/// ConfigError naming the choices, or the count's range.
 EstimatorConfig estimator_config(std::string_view name);
+
+/// The simulator's error over one control step in state number k, in its own units (RMS from
+/// true states; the filters' process noise is a multiple of it).
+double model_error_of(std::size_t k);
 
 /// True when `p` perturbs what a policy senses (observation noise or delay) or when its commands
 /// run (action delay): only then does an estimator run.
@@ -52,6 +69,32 @@ class Estimator {
   /// trained without the delay acts on the state its action meets. A policy's clock stays the
   /// count of its own choices: the choice lands after as many of them as it would without.
   virtual State update(const Action& chosen, const State& observed) = 0;
+};
+
+/// What a robot's own command queue knows under delays, for an estimator: the commands chosen
+/// but not run yet (a command delay), and those that ran since the step the newest observation
+/// shows (an observation delay), which the estimate of that step must be moved through.
+class CommandTimeline {
+ public:
+  CommandTimeline(int action_delay, int observation_delay)
+      : action_delay_(action_delay), observation_delay_(observation_delay) {}
+  /// A new episode: action_delay zero commands queued, nothing run.
+  void start();
+  /// Records the choice of the step just taken; true when the newest observation now shows a
+  /// step later than the estimate stands at (move it through take_ran() first).
+  bool choose(const Action& chosen);
+  /// The command that ran at the estimate's step; the estimate's step moves on by one.
+  Action take_ran();
+  /// Steps `world` on through what ran since the estimate's step, then what is queued.
+  void run_on(World& world) const;
+  bool empty() const { return since_.empty() && queue_.empty(); }
+
+ private:
+  int action_delay_, observation_delay_;
+  int steps_ = 0;         // control steps taken
+  int lagged_step_ = 0;   // the step the estimate stands at
+  std::deque<Action> queue_;  // chosen, not run yet
+  std::deque<Action> since_;  // what ran from lagged_step_ to now, in order
 };
 
 /// A Kalman filter whose prediction is the simulator. It keeps an estimate of the state the
@@ -82,20 +125,52 @@ class KalmanEstimator final : public Estimator {
 
   World model_;
   double dt_;
-  int observation_delay_;
-  int action_delay_;
+  CommandTimeline timeline_;
   State sensor_variance_{};
   State process_variance_{};
   State lagged_{};  // the estimate of the state the newest observation shows
   std::array<Covariance, 12> covariance_{};  // per pose number and its velocity
-  int steps_ = 0;   // control steps taken
-  int lagged_step_ = 0;
-  std::deque<Action> queue_;  // chosen, not run yet (the command delay)
-  std::deque<Action> since_;  // what ran from lagged_step_ to now, in order
+};
+
+/// A particle filter whose motion model is the simulator, for the contact phases a filter per
+/// number cannot follow: each particle is a world of its own, stepped with the action that ran
+/// (its contacts the simulator's, a die riding in the cup rides in every particle), then drawn
+/// towards the observation as the optimal proposal for Gaussian noise does (the model's error
+/// against the sensor's, number by number) and weighted by how likely the observation was from
+/// it; resampled (systematically) when the weights' effective count falls below half. The
+/// estimate is the weighted mean. docs/robustness.md, "The particle filter". Delays are made
+/// up as the Kalman filter makes them up: the cloud stands at the newest observation's step,
+/// and the mean is simulated forward through what ran since and what is queued. Seeded by the
+/// episode's noise stream, so the same on any number of threads or ranks.
+class ParticleEstimator final : public Estimator {
+ public:
+  ParticleEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config);
+  State start(const State& observed) override;
+  State update(const Action& chosen, const State& observed) override;
+
+ private:
+  void predict();
+  void weigh(const State& observed);
+  void resample_if_starved();
+  State mean() const;
+  State ahead();
+
+  CommandTimeline timeline_;
+  State sensor_sigma_{};
+  State process_sigma_{};
+  std::uint64_t seed_;
+  Rng rng_{0};
+  std::vector<World> worlds_;    // one per particle
+  std::vector<State> states_;    // their states
+  std::vector<double> weights_;  // their weights, summing to 1
+  World scratch_;                // where the mean is run on through the delays
+  bool predicted_ = false;       // the particles were stepped since the last observation
 };
 
 /// The estimator of `config` for one episode (nullptr for none, and when the draw's sensing and
-/// command timing are nominal: the policy then sees the state itself). Each episode needs its own: start() first.
+/// command timing are nominal: the policy then sees the state itself; particle without sensor
+/// noise is the Kalman filter, which makes up the delays exactly). Each episode needs its own:
+/// start() first.
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
                                           const PerturbationDraw& draw);
 
