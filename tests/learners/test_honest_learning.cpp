@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
@@ -134,6 +137,29 @@ TEST(HonestLearning, DadFromTrainingStartsScoresEachIterationFromStartsNoTargetU
   // The starts named are those after the targets' own (training starts 0 to episodes - 1).
   EXPECT_EQ(learned.model->record.at("dad_scored_on"), "training starts 4 to " + std::to_string(3 + targets) +
                                                            ", which no target used (realistic success)");
+}
+
+TEST(HonestLearning, ADadCheckpointThatScoredOnItsTargetsStartsIsNotResumed) {
+  LearnContext c = recordings_context();
+  c.demos.resize(3);
+  c.regressor = "knn";
+  c.features = "state+clock+start_state@dice+retry/position";
+  c.checkpoint_dir = test::scratch_path("dicestack_dad_scored_on");
+  fs::remove_all(c.checkpoint_dir);
+  const std::vector<std::string> options{"starts=training", "episodes=2", "windows=1", "iterations=1", "corrector=track",
+                                         "tracker_probes=1", "tracker_robust=1", "tracker_variants=false", "tracker_refine=0"};
+  LearnerRegistry::global().create("dad", options)->learn(c);
+  const auto path = c.checkpoint_dir / "dad.json";
+  nlohmann::json state;
+  std::ifstream(path) >> state;
+  ASSERT_EQ(state["run"]["scored_on"], "training starts no target used");
+  state["run"].erase("scored_on");  // as written before DaD scored on fresh starts
+  { std::ofstream(path) << state.dump(); }
+  c.resume = true;
+  const std::string refused = test::error_of([&] { LearnerRegistry::global().create("dad", options)->learn(c); });
+  EXPECT_THAT(refused, HasSubstr("dad.json: cannot resume a run made with other settings"));
+  EXPECT_THAT(refused, HasSubstr("scored_on"));
+  fs::remove_all(c.checkpoint_dir);
 }
 
 TEST(HonestLearning, TheTrackerFollowsAnotherSetsTrainingEpisodesWhenToldTo) {
