@@ -231,3 +231,15 @@ def test_the_particle_filter_runs_behind_the_env_the_same_way_each_time(rng):
     assert not np.array_equal(first[0], raw[0])
     with pytest.raises(ValueError, match="from 1 to 4096"):
         dicestack.DiceStackEnv(perturb=noisy, estimator="particle:0")
+    # Each environment's estimates are its own episode's, whatever the thread count.
+    shown = []
+    for threads in (1, 2):
+        vec = dicestack.DiceStackVectorEnv(2, perturb=noisy, estimator="particle:8", threads=threads)
+        obs, _ = vec.reset(seed=[5, 6])
+        steps = [obs]
+        for a in actions[:10]:
+            obs, *_ = vec.step(np.array([a, a]))
+            steps.append(obs)
+        shown.append(np.array(steps))
+    assert np.array_equal(shown[0], shown[1])
+    assert np.array_equal(shown[0][:, 0], first[0][:11])  # as the single environment shows it
