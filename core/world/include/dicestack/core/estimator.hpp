@@ -39,8 +39,8 @@ struct EstimatorConfig {
   double particle_model_error = 30.0;
 };
 
-/// The most particles `particle:N` takes: each is a world of its own (tens of kilobytes) stepped
-/// at every control step, so more would cost minutes per episode before memory.
+/// The most particles `particle:N` takes: each is a world of its own (about 155 KB) stepped at
+/// every control step (about 30 us), so 4096 hold about 630 MB and take about 40 s per episode.
 inline constexpr int kMaxParticles = 4096;
 
 /// The estimators by name: none, kalman, particle.
