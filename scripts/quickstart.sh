@@ -26,6 +26,11 @@ case "$mode" in
   run)
     mkdir -p out
     ./build/apps/dicestack leaderboard --out out/leaderboard.md
+    # The paper's setting: three recordings made in this world from the paper's start, then knn
+    # under BC and under DaD from training starts on them, rolled out from paper starts.
+    ./build/apps/dicestack record --expert tracker --demos human --start paper --episodes 3 --seed 0 --out out/paper3
+    ./build/apps/dicestack leaderboard --start paper --demos out/paper3 --regressors knn \
+      --learners bc,dad:starts=training:corrector=track:episodes=100:tracker_refine=0 --out out/paper-setting.md
     ;;
   test)
     if [ "${DICESTACK_SANITIZE:-0}" = 1 ]; then bash scripts/sanitize.sh --jobs 2; fi
