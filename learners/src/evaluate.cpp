@@ -181,6 +181,9 @@ void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "rollouts");
   check_threads(request.threads, "evaluate: threads");
+  require_memory("evaluate: the estimators of the episodes running at once",
+                 static_cast<std::uint64_t>(resolve_threads(request.threads)), estimator_bytes(request.estimator),
+                 "episodes");
 }
 
 EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, const EvalRequest& request,

@@ -188,7 +188,7 @@ class VectorEnv {
 
   VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation,
             const EstimatorConfig& estimator)
-      : pool_(pool_size(num_envs, threads)) {
+      : pool_(pool_size(num_envs, threads, estimator)) {
     envs_.reserve(static_cast<std::size_t>(num_envs));
     validate(perturbation, world);
     for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation, estimator);
@@ -204,10 +204,12 @@ class VectorEnv {
     return out;
   }
 
-  // The count checked before the pool's threads start: at least 1, and within memory.
-  static int pool_size(long long num_envs, int threads) {
+  // The count checked before the pool's threads start: at least 1, and within memory with each
+  // environment's estimator.
+  static int pool_size(long long num_envs, int threads, const EstimatorConfig& estimator) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1, got " + std::to_string(num_envs));
-    require_memory("DiceStackVectorEnv", static_cast<std::uint64_t>(num_envs), kEnvironmentBytes, "environments");
+    require_memory("DiceStackVectorEnv", static_cast<std::uint64_t>(num_envs), kEnvironmentBytes + estimator_bytes(estimator),
+                   "environments");
     return static_cast<int>(std::min<long long>(num_envs, resolve_threads(threads)));
   }
 

@@ -160,6 +160,12 @@ TEST(ParticleEstimator, IsTheFilterUnderSensorNoiseAndTheKalmanFilterMakesUpADel
   EXPECT_NE(shown_error(medium, estimator_config("particle:8"), 1), shown_error(medium, estimator_config("kalman"), 1));
 }
 
+TEST(ParticleEstimator, ItsMemoryIsAWorldPerParticleAndOneToRunTheMeanOn) {
+  EXPECT_EQ(estimator_bytes(estimator_config("none")), 0.0);
+  EXPECT_EQ(estimator_bytes(estimator_config("kalman")), kEstimatorWorldBytes);
+  EXPECT_EQ(estimator_bytes(estimator_config("particle:8")), 9 * kEstimatorWorldBytes);
+}
+
 TEST(ParticleEstimator, ACountOutsideItsRangeIsRefusedWhereverTheConfigComesFrom) {
   const WorldConfig w;
   EstimatorConfig c = estimator_config("particle");

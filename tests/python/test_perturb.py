@@ -231,6 +231,9 @@ def test_the_particle_filter_runs_behind_the_env_the_same_way_each_time(rng):
     assert not np.array_equal(first[0], raw[0])
     with pytest.raises(ValueError, match="from 1 to 4096"):
         dicestack.DiceStackEnv(perturb=noisy, estimator="particle:0")
+    # Counts that fit one by one but not a thousand environments at once: refused before any is made.
+    with pytest.raises(ValueError, match="DiceStackVectorEnv: 1000 environments would need"):
+        dicestack.DiceStackVectorEnv(1000, perturb=noisy, estimator="particle:4096")
     # Each environment's estimates are its own episode's, whatever the thread count.
     shown = []
     for threads in (1, 2):

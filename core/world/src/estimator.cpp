@@ -40,6 +40,15 @@ constexpr double kModelErrorFloor = 1e-4;
 
 double model_error_of(std::size_t k) { return std::max(kModelError[k], kModelErrorFloor) * observation_spread()[k]; }
 
+double estimator_bytes(const EstimatorConfig& config) {
+  switch (config.kind) {
+    case EstimatorKind::none: return 0.0;
+    case EstimatorKind::kalman: return kEstimatorWorldBytes;
+    case EstimatorKind::particle: break;
+  }
+  return (config.particles + 1.0) * kEstimatorWorldBytes;  // the particles and the world the mean runs on in
+}
+
 const std::vector<std::string>& estimator_names() {
   static const std::vector<std::string> names{"none", "kalman", "particle"};
   return names;

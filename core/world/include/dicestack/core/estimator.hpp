@@ -39,8 +39,9 @@ struct EstimatorConfig {
   double particle_model_error = 30.0;
 };
 
-/// The most particles `particle:N` takes: each is a world of its own (about 155 KB) stepped at
-/// every control step (about 30 us), so 4096 hold about 630 MB and take about 40 s per episode.
+/// The most particles `particle:N` takes: each is a world of its own (kEstimatorWorldBytes)
+/// stepped at every control step (about 30 us), so 4096 hold about 650 MB and take about 40 s
+/// per episode.
 inline constexpr int kMaxParticles = 4096;
 
 /// The estimators by name: none, kalman, particle.
@@ -48,6 +49,14 @@ const std::vector<std::string>& estimator_names();
 /// The estimator of `name` with its default settings (`particle:N`: N particles); throws
 /// ConfigError naming the choices, or the count's range.
 EstimatorConfig estimator_config(std::string_view name);
+
+/// Bytes one world of an estimator holds, measured: 1024 particles peak 158 MB above one
+/// (docs/robustness.md, "The particle filter").
+inline constexpr double kEstimatorWorldBytes = 160e3;
+
+/// The most memory one episode's estimator of `config` holds, in bytes (0 for none): what a
+/// caller running many episodes at once checks (require_memory) before any work.
+double estimator_bytes(const EstimatorConfig& config);
 
 /// The simulator's error over one control step in state number k, in its own units (RMS from
 /// true states; the filters' process noise is a multiple of it).
