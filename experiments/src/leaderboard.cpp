@@ -253,6 +253,14 @@ void check_request(RunPlan& plan) {
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
 }
 
+// A row whose learner trains under perturb= labels it on its map, or is refused before any work.
+void check_labellable(const RunPlan& plan, const std::string& learner, const std::string& features) {
+  const auto& schema = LearnerRegistry::global().info(plan.base(learner)).params;
+  if (std::none_of(schema.begin(), schema.end(), [](const ParamSpec& p) { return p.name == "perturb"; })) return;
+  const Params params(schema, plan.options_for(learner), learner);
+  require_labellable(learner_perturbation(params, plan.request.world, learner), feature_map(features), learner);
+}
+
 // The (learner, feature map) rows: each learner with every map of --features it can read, or
 // with its own default map.
 std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan, const Say& say) {
@@ -275,6 +283,7 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
       if (opt.split == "rows" && f != "state" && opt.features.empty()) continue;  // a default map that needs episodes
       if (opt.split == "rows" && f != "state")
         throw ConfigError("features \"" + f + "\" read an episode's history; --split rows shuffles the rows: use --split episodes");
+      check_labellable(plan, l, f);
       combos.emplace_back(l, f);
     }
   }

@@ -12,13 +12,14 @@ namespace dicestack {
 
 std::string check_train_settings(const TrainRequest& request) {
   const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
-  for (const auto& [key, value] : learner->params().as_text())
-    if (key == "perturb") learner_perturbation(learner->params(), request.world, request.learner);
   // An unknown regressor or a bad --set value would otherwise surface only at the first fit,
   // after DART had recorded its episodes.
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
   const FeatureMap& features = feature_map(
       request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
+  for (const auto& [key, value] : learner->params().as_text())
+    if (key == "perturb")
+      require_labellable(learner_perturbation(learner->params(), request.world, request.learner), features, request.learner);
   check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");

@@ -77,6 +77,7 @@ class Dart final : public Learner {
 
   LearnResult learn(const LearnContext& c) const override {
     const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
+    require_labellable(perturbation, feature_map(c.features), "dart");
     const DartSettings d = dart_settings(params(), c.features, !perturbation.trained.nominal());
     const int episodes = d.episodes;
     std::vector<Episode> data = d.include_demos ? c.demos : std::vector<Episode>{};

@@ -144,7 +144,8 @@ std::vector<ParamSpec> perturb_param_specs() {
        {}},
       {"estimator", ParamType::choice, "kalman", 0, 0,
        "under perturb's sensing factors and delays: kalman or particle trains without them and the policy runs "
-       "behind that estimator (the model names it); none trains through them, on what the sensors gave",
+       "behind that estimator (the model names it); none trains through them, refusing a factor the expert cannot "
+       "label on the map (observation noise; a delay off an /ahead or /landing map)",
        estimator_names()}};
   return specs;
 }
@@ -164,6 +165,22 @@ TrainingPerturbation learner_perturbation(const Params& params, const WorldConfi
   t.trained.action_delay = 0;
   t.trained.delays_drawn = false;
   return t;
+}
+
+void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner) {
+  const Perturbation& t = p.trained;
+  const std::string where = learner + ": option perturb (" + p.name + ") with estimator none: ";
+  if (t.observation_noise > 0.0)
+    throw ConfigError(where + "observation_noise cannot be labelled: the expert answers the true state and the policy "
+                              "would be shown a noisy one; train behind an estimator (estimator=kalman, the default)");
+  const char* delayed = t.action_delay > 0 ? "action_delay" : t.observation_delay > 0 ? "observation_delay" : nullptr;
+  if (delayed && !features.ahead())
+    throw ConfigError(where + delayed + " cannot be labelled on the map " + features.name() +
+                      ": the expert answers the state its action lands in, which the row does not show; use an "
+                      "\"/ahead\" or \"/landing\" map, or an estimator (estimator=kalman, the default)");
+  if (t.observation_delay > 0 && t.delays_drawn)
+    throw ConfigError(where + "a drawn observation_delay cannot be labelled: the row does not say how old its state is; "
+                              "fix the delay (delays_drawn false) or train behind an estimator");
 }
 
 void record_perturbation(const TrainingPerturbation& p, Model& model) {

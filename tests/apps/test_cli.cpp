@@ -321,6 +321,7 @@ TEST(CliInput, ABadNameOrOptionIsRefusedBeforeTheDemonstrationsAreRead) {
   const std::string base = "train --demos /nonexistent/set --out " + test::scratch_path("dicestack_cli_edge.dsm").string();
   const std::vector<std::pair<std::string, std::string>> cases{
       {" --regressor knn --learner dart --option perturb=nosuch", "option perturb: nosuch: not a perturbation level"},
+      {" --regressor knn --learner dart --option perturb=medium --option estimator=none", "observation_noise cannot be labelled"},
       {" --regressor knn --learner dart --features state+x", "unknown part \"x\""},
       {" --regressor knn --learner dart --option tracker_preset=x", "\"tracker_preset\" must be one of plain, distill"},
       {" --regressor knn --set k=-1", "\"k\" must be in [1, 64]"},
@@ -507,6 +508,10 @@ TEST(CliLearning, BadArgumentsGiveAClearMessage) {
   p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc,dart --option perturb=stormy");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("stormy"));
+  EXPECT_THAT(p.output, Not(HasSubstr("training")));
+  p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc,dart --option perturb=hard --option estimator=none");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("observation_noise cannot be labelled"));
   EXPECT_THAT(p.output, Not(HasSubstr("training")));
   p = run("leaderboard --demos " + kTinyDemos + " --regressors knn --learners bc --option iterations=3");
   EXPECT_EQ(p.status, 1);

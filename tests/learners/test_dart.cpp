@@ -82,6 +82,39 @@ TEST(Dart, TrainsUnderRandomisedWorldsOnAnyThreadCount) {
                 HasSubstr(std::string(learner_name) + ": option perturb: "));
 }
 
+// Behind no estimator the expert's labels answer the world's state: a factor that keeps them from
+// being a function of what the policy is shown is refused by name, before any episode.
+TEST(Dart, AFactorTheExpertCannotLabelIsRefusedByName) {
+  const auto through = [](Perturbation p) {
+    TrainingPerturbation t;
+    t.name = "a file";
+    t.trained = p;
+    return t;
+  };
+  Perturbation noise, acting, seeing;
+  noise.observation_noise = 0.01;
+  acting.action_delay = 2;
+  seeing.observation_delay = 2;
+  const FeatureMap& now = feature_map("state+clock"), &ahead = feature_map("state+clock/ahead");
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(noise), ahead, "dart"); }),
+              HasSubstr("dart: option perturb (a file) with estimator none: observation_noise cannot be labelled"));
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(acting), now, "dart"); }),
+              HasSubstr("action_delay cannot be labelled on the map state+clock"));
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(seeing), now, "dagger"); }),
+              HasSubstr("dagger: option perturb (a file) with estimator none: observation_delay cannot be labelled"));
+  // The row of an "/ahead" map carries what is pending and unseen: a fixed delay is labellable.
+  EXPECT_NO_THROW(require_labellable(through(acting), ahead, "dart"));
+  EXPECT_NO_THROW(require_labellable(through(seeing), ahead, "dart"));
+  seeing.delays_drawn = true;
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(seeing), ahead, "dart"); }),
+              HasSubstr("a drawn observation_delay cannot be labelled"));
+  // A level through the learner: refused before its first episode.
+  LearnContext c = knn_context();
+  for (const char* learner : {"dart", "dagger"})
+    EXPECT_THAT(test::error_of([&] { LearnerRegistry::global().create(learner, {"perturb=medium", "estimator=none"})->learn(c); }),
+                HasSubstr(std::string(learner) + ": option perturb (medium) with estimator none: observation_noise"));
+}
+
 // Behind the estimator (the default), a level's sensing factors and delays are the estimator's
 // to make up: training randomises the rest, and the model names the estimator it runs behind.
 TEST(Dart, ALevelWithSensingTrainsWithoutItAndTheModelNamesTheEstimator) {
