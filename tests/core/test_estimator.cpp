@@ -98,6 +98,26 @@ TEST(Estimator, MakesUpAnObservationDelayFromTheActionsThatRan) {
   EXPECT_LT(estimated, 0.2 * raw) << "raw " << raw << ", estimated " << estimated;
 }
 
+// Under a delay in a world whose friction is not the nominal one, the forecast runs in the
+// friction the observations show, closer to the truth than the nominal model's; under sensor
+// noise no bank is kept, and the estimate is the nominal model's.
+TEST(Estimator, UnderADelayItForecastsInTheFrictionTheObservationsShow) {
+  Perturbation slippery = perturbation_factor("friction", "medium");
+  slippery.action_delay = 3;
+  slippery.observation_delay = 3;
+  EstimatorConfig nominal = estimator_config("kalman");
+  nominal.identify_friction = false;
+  double identified = 0.0, assumed = 0.0;
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    identified += shown_error(slippery, estimator_config("kalman"), seed);
+    assumed += shown_error(slippery, nominal, seed);
+  }
+  EXPECT_LT(identified, 0.8 * assumed) << "identified " << identified << ", nominal friction " << assumed;
+  Perturbation noisy = slippery;
+  noisy.observation_noise = 0.01;
+  EXPECT_EQ(shown_error(noisy, estimator_config("kalman"), 1), shown_error(noisy, nominal, 1));
+}
+
 // The poses are what the simulator predicts best; the dice's velocities, made by contacts, it
 // predicts least well, and there the estimate stays near the sensor's.
 // A command delay alone: a policy trained without it is shown the state its action will meet,
@@ -162,7 +182,7 @@ TEST(ParticleEstimator, IsTheFilterUnderSensorNoiseAndTheKalmanFilterMakesUpADel
 
 TEST(ParticleEstimator, ItsMemoryIsAWorldPerParticleAndOneToRunTheMeanOn) {
   EXPECT_EQ(estimator_bytes(estimator_config("none")), 0.0);
-  EXPECT_EQ(estimator_bytes(estimator_config("kalman")), kEstimatorWorldBytes);
+  EXPECT_EQ(estimator_bytes(estimator_config("kalman")), 27 * kEstimatorWorldBytes);  // its friction bank
   EXPECT_EQ(estimator_bytes(estimator_config("particle:8")), 9 * kEstimatorWorldBytes);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 
 #include <dicestack/core/error.hpp>
@@ -36,6 +37,29 @@ constexpr State kModelError{0.0000, 0.0011, 0.0001,                          // 
                             0.0010, 0.0101, 0.0015};                         // cup vx, vy, w
 constexpr double kModelErrorFloor = 1e-4;
 
+// How much older observations count in a model's misfit (each step's is multiplied by this),
+// and how much better (in nats) another model must fit before the forecast moves to it: a
+// model chosen on one lucky step would flicker.
+constexpr double kMisfitMemory = 0.9;
+constexpr double kSwitchMargin = 5.0;
+
+// The nominal world with its dice', cup's and walls' friction scaled by every combination of
+// kFrictionScales but the nominal one.
+std::vector<World> friction_bank(const WorldConfig& model) {
+  std::vector<World> bank;
+  for (const double dice : kFrictionScales)
+    for (const double cup : kFrictionScales)
+      for (const double walls : kFrictionScales) {
+        if (dice == 1.0 && cup == 1.0 && walls == 1.0) continue;
+        WorldConfig w = model;
+        w.dice.friction *= dice;
+        w.cup.friction *= cup;
+        w.walls.friction *= walls;
+        bank.emplace_back(w);
+      }
+  return bank;
+}
+
 }  // namespace
 
 double model_error_of(std::size_t k) { return std::max(kModelError[k], kModelErrorFloor) * observation_spread()[k]; }
@@ -43,7 +67,8 @@ double model_error_of(std::size_t k) { return std::max(kModelError[k], kModelErr
 double estimator_bytes(const EstimatorConfig& config) {
   switch (config.kind) {
     case EstimatorKind::none: return 0.0;
-    case EstimatorKind::kalman: return kEstimatorWorldBytes;
+    case EstimatorKind::kalman:  // the model and, under a delay with exact observations, its friction bank
+      return (config.identify_friction ? std::pow(kFrictionScales.size(), 3) : 1.0) * kEstimatorWorldBytes;
     case EstimatorKind::particle: break;
   }
   return (config.particles + 1.0) * kEstimatorWorldBytes;  // the particles and the world the mean runs on in
@@ -117,10 +142,16 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
     const double q = config.model_error * model_error_of(k);
     process_variance_[k] = q * q;
   }
+  const bool exact = std::all_of(sensor_variance_.begin(), sensor_variance_.end(), [](double v) { return v == 0.0; });
+  if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0)) bank_ = friction_bank(model);
 }
 
 State KalmanEstimator::start(const State& observed) {
   model_.set_state(observed);
+  for (World& w : bank_) w.set_state(observed);
+  predicted_.assign(bank_.size() + 1, observed);
+  misfit_.assign(bank_.size() + 1, 0.0);
+  chosen_ = 0;
   lagged_ = observed;
   const auto& all = kPairs;
   for (std::size_t i = 0; i < all.size(); ++i)
@@ -130,8 +161,15 @@ State KalmanEstimator::start(const State& observed) {
 }
 
 void KalmanEstimator::predict() {
-  model_.step(timeline_.take_ran());  // the model stands at lagged_, its contacts warm where it was not corrected
-  lagged_ = model_.state();
+  // Every model stands at lagged_, its contacts warm where it was not corrected.
+  const Action ran = timeline_.take_ran();
+  model_.step(ran);
+  predicted_[0] = model_.state();
+  for (std::size_t m = 0; m < bank_.size(); ++m) {
+    bank_[m].step(ran);
+    predicted_[m + 1] = bank_[m].state();
+  }
+  lagged_ = predicted_[chosen_];
   // The covariance moves as a pose and its velocity do over one step (the pose gains dt times
   // the velocity), plus the model's error.
   const auto& all = kPairs;
@@ -143,8 +181,22 @@ void KalmanEstimator::predict() {
   }
 }
 
+void KalmanEstimator::choose_model(const State& observed) {
+  for (std::size_t m = 0; m < predicted_.size(); ++m) {
+    double misfit = 0.0;
+    for (std::size_t k = 0; k < kStateDim; ++k) {
+      const double d = observed[k] - predicted_[m][k];
+      misfit += 0.5 * d * d / (sensor_variance_[k] + process_variance_[k]);
+    }
+    misfit_[m] = kMisfitMemory * misfit_[m] + misfit;
+  }
+  const auto best = static_cast<std::size_t>(std::min_element(misfit_.begin(), misfit_.end()) - misfit_.begin());
+  if (misfit_[best] < misfit_[chosen_] - kSwitchMargin) chosen_ = best;
+  lagged_ = predicted_[chosen_];
+}
+
 void KalmanEstimator::correct(const State& observed) {
-  const State prior = lagged_;
+  if (!bank_.empty()) choose_model(observed);
   const auto& all = kPairs;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Pair& p = all[i];
@@ -170,7 +222,12 @@ void KalmanEstimator::correct(const State& observed) {
   // Rebuilt only where corrected: a model the sensor agrees with keeps its contacts'
   // warm-starting, which a rebuild loses (the cup's velocity follows the dice it carries).
   // Moving the bodies of a running model instead, contacts kept, measured no better under noise.
-  if (lagged_ != prior) model_.set_state(lagged_);
+  // Each model's prediction stays the state it stands at until the next step.
+  for (std::size_t m = 0; m < predicted_.size(); ++m)
+    if (predicted_[m] != lagged_) {
+      (m == 0 ? model_ : bank_[m - 1]).set_state(lagged_);
+      predicted_[m] = lagged_;
+    }
 }
 
 State KalmanEstimator::update(const Action& chosen, const State& observed) {
@@ -182,10 +239,11 @@ State KalmanEstimator::update(const Action& chosen, const State& observed) {
 
 State KalmanEstimator::ahead() {
   if (timeline_.empty()) return lagged_;
-  const WorldSnapshot at_lagged = model_.snapshot();
-  timeline_.run_on(model_);
-  const State landing = model_.state();
-  model_.restore(at_lagged);
+  World& forecast = forecaster();
+  const WorldSnapshot at_lagged = forecast.snapshot();
+  timeline_.run_on(forecast);
+  const State landing = forecast.state();
+  forecast.restore(at_lagged);
   return landing;
 }
 

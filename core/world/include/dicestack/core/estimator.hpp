@@ -37,6 +37,9 @@ struct EstimatorConfig {
   /// contact-rich swing carries runs of the simulator from one another, far beyond its one-step
   /// error from true states: 30 did best of 3, 10, 30, 100 and 300 (docs/notebook/2026-11-28-estimator.md).
   double particle_model_error = 30.0;
+  /// kalman: under a delay with exact observations, predict in the friction the observations
+  /// show (FrictionBank) rather than the nominal one.
+  bool identify_friction = true;
 };
 
 /// The most particles `particle:N` takes: each is a world of its own (kEstimatorWorldBytes)
@@ -53,6 +56,9 @@ EstimatorConfig estimator_config(std::string_view name);
 /// Bytes one world of an estimator holds, measured: 1024 particles peak 158 MB above one
 /// (docs/robustness.md, "The particle filter").
 inline constexpr double kEstimatorWorldBytes = 160e3;
+
+/// The friction scales the Kalman filter's bank tries for each material (KalmanEstimator).
+inline constexpr std::array<double, 3> kFrictionScales{0.8, 1.0, 1.2};
 
 /// The most memory one episode's estimator of `config` holds, in bytes (0 for none): what a
 /// caller running many episodes at once checks (require_memory) before any work.
@@ -116,6 +122,14 @@ class CommandTimeline {
 /// action lands in). Contacts are the simulator's: a die riding in the cup is predicted as such. The model
 /// is rebuilt only where corrected, so without sensor noise, in the nominal world, it runs as
 /// the world does and makes up a delay exactly.
+///
+/// Under a delay its forecast runs several steps in a physics it does not know, and the friction
+/// moves it most (a die sliding in the cup or on the table). With exact observations and a delay
+/// it keeps the world at kFrictionScales of the nominal friction for the dice, the cup and the
+/// walls apart (27 worlds), each stepped as the model is, and forecasts with the one whose
+/// one-step predictions have matched the observations best. Under sensor noise the bank is not
+/// kept: the noise outweighs what tells the frictions apart, and choosing among them measured
+/// worse (docs/robustness.md, "The estimator").
 class KalmanEstimator final : public Estimator {
  public:
   /// `model`: the nominal world; `draw`: the episode's sensing and command delays and its
@@ -130,9 +144,15 @@ class KalmanEstimator final : public Estimator {
   };
   void predict();
   void correct(const State& observed);
+  void choose_model(const State& observed);
+  World& forecaster() { return chosen_ == 0 ? model_ : bank_[chosen_ - 1]; }
   State ahead();
 
   World model_;
+  std::vector<World> bank_;       // the other frictions; empty: the nominal model alone
+  std::vector<State> predicted_;  // each model's prediction of the newest observation, model_'s first
+  std::vector<double> misfit_;    // each model's discounted negative log-likelihood of the observations
+  std::size_t chosen_ = 0;        // the model that predicts: 0 model_, else bank_[chosen_ - 1]
   double dt_;
   CommandTimeline timeline_;
   State sensor_variance_{};
