@@ -253,14 +253,6 @@ void check_request(RunPlan& plan) {
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
 }
 
-// A row whose learner trains under perturb= labels it on its map, or is refused before any work.
-void check_labellable(const RunPlan& plan, const std::string& learner, const std::string& features) {
-  const auto& schema = LearnerRegistry::global().info(plan.base(learner)).params;
-  if (std::none_of(schema.begin(), schema.end(), [](const ParamSpec& p) { return p.name == "perturb"; })) return;
-  const Params params(schema, plan.options_for(learner), learner);
-  require_labellable(learner_perturbation(params, plan.request.world, learner), feature_map(features), learner);
-}
-
 // The (learner, feature map) rows: each learner with every map of --features it can read, or
 // with its own default map.
 std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan, const Say& say) {
@@ -272,8 +264,7 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
     const std::string own = default_features(plan.base(l), plan.options_for(l));
     std::vector<std::string> maps{own};
     if (plan.profile->every_feature_map && own != "state") maps.insert(maps.begin(), "state");
-    if (plan.profile->every_feature_map && own == "state")
-      maps.push_back(LearnerRegistry::global().info("dart").default_features);
+    if (plan.profile->every_feature_map && own == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
       feature_map(f);  // unknown names fail before any work
       if (info.own_features_only && f != own) {
@@ -283,7 +274,7 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
       if (opt.split == "rows" && f != "state" && opt.features.empty()) continue;  // a default map that needs episodes
       if (opt.split == "rows" && f != "state")
         throw ConfigError("features \"" + f + "\" read an episode's history; --split rows shuffles the rows: use --split episodes");
-      check_labellable(plan, l, f);
+      require_labellable(info.params, Params(info.params, plan.options_for(l), l), opt.world, feature_map(f), plan.base(l));
       combos.emplace_back(l, f);
     }
   }
@@ -537,8 +528,8 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     rollouts.perturbation = plan.perturbation;
     check_evaluation(opt.world, rollouts);
   }
+  plan.combos = row_combos(plan, say);  // a row that cannot train is refused before the demonstrations are read
   plan.set = read_demo_set(opt.demos);
-  plan.combos = row_combos(plan, say);
   for (const auto& [learner, features] : plan.combos) check_ahead_world(feature_map(features), opt.world);
   // The table keeps every row's rollouts of every seed (the pages' per-episode results).
   const double rollouts = static_cast<double>(plan.combos.size()) * opt.seeds * plan.episodes;

@@ -19,7 +19,8 @@ std::string check_train_settings(const TrainRequest& request) {
       request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
   for (const auto& [key, value] : learner->params().as_text())
     if (key == "perturb")
-      require_labellable(learner_perturbation(learner->params(), request.world, request.learner), features, request.learner);
+      require_labellable(learner_perturbation(learner->params(), request.world, request.learner), features, request.learner,
+                         request.learner == "dagger");
   check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");

@@ -145,7 +145,8 @@ std::vector<ParamSpec> perturb_param_specs() {
       {"estimator", ParamType::choice, "kalman", 0, 0,
        "under perturb's sensing factors and delays: kalman or particle trains without them and the policy runs "
        "behind that estimator (the model names it); none trains through them, refusing a factor the expert cannot "
-       "label on the map (observation noise; a delay off an /ahead or /landing map)",
+       "label on the map (observation noise; a delay off an /ahead or /landing map, or drawn per episode for the "
+       "observations, or under dagger)",
        estimator_names()}};
   return specs;
 }
@@ -167,13 +168,18 @@ TrainingPerturbation learner_perturbation(const Params& params, const WorldConfi
   return t;
 }
 
-void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner) {
+void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner,
+                        bool own_choices) {
   const Perturbation& t = p.trained;
   const std::string where = learner + ": option perturb (" + p.name + ") with estimator none: ";
   if (t.observation_noise > 0.0)
     throw ConfigError(where + "observation_noise cannot be labelled: the expert answers the true state and the policy "
                               "would be shown a noisy one; train behind an estimator (estimator=kalman, the default)");
   const char* delayed = t.action_delay > 0 ? "action_delay" : t.observation_delay > 0 ? "observation_delay" : nullptr;
+  if (delayed && own_choices)
+    throw ConfigError(where + delayed + " cannot be labelled: the rollouts record the expert's labels, not what the "
+                              "learner chose, so no row shows what was pending; train behind an estimator "
+                              "(estimator=kalman, the default)");
   if (delayed && !features.ahead())
     throw ConfigError(where + delayed + " cannot be labelled on the map " + features.name() +
                       ": the expert answers the state its action lands in, which the row does not show; use an "
@@ -181,6 +187,12 @@ void require_labellable(const TrainingPerturbation& p, const FeatureMap& feature
   if (t.observation_delay > 0 && t.delays_drawn)
     throw ConfigError(where + "a drawn observation_delay cannot be labelled: the row does not say how old its state is; "
                               "fix the delay (delays_drawn false) or train behind an estimator");
+}
+
+void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
+                        const FeatureMap& features, const std::string& learner) {
+  if (std::none_of(schema.begin(), schema.end(), [](const ParamSpec& s) { return s.name == "perturb"; })) return;
+  require_labellable(learner_perturbation(params, world, learner), features, learner, learner == "dagger");
 }
 
 void record_perturbation(const TrainingPerturbation& p, Model& model) {

@@ -183,7 +183,9 @@ TEST(ParticleEstimator, IsTheFilterUnderSensorNoiseAndTheKalmanFilterMakesUpADel
 TEST(ParticleEstimator, ItsMemoryIsAWorldPerParticleAndOneToRunTheMeanOn) {
   EXPECT_EQ(estimator_bytes(estimator_config("none")), 0.0);
   EXPECT_EQ(estimator_bytes(estimator_config("kalman")), 27 * kEstimatorWorldBytes);  // its friction bank
-  EXPECT_EQ(estimator_bytes(estimator_config("particle:8")), 9 * kEstimatorWorldBytes);
+  // Without sensor noise a particle filter is the Kalman filter, bank and all.
+  EXPECT_EQ(estimator_bytes(estimator_config("particle:8")), 27 * kEstimatorWorldBytes);
+  EXPECT_EQ(estimator_bytes(estimator_config("particle:64")), 65 * kEstimatorWorldBytes);
 }
 
 TEST(ParticleEstimator, ACountOutsideItsRangeIsRefusedWhereverTheConfigComesFrom) {

@@ -105,6 +105,12 @@ TEST(Dart, AFactorTheExpertCannotLabelIsRefusedByName) {
   // The row of an "/ahead" map carries what is pending and unseen: a fixed delay is labellable.
   EXPECT_NO_THROW(require_labellable(through(acting), ahead, "dart"));
   EXPECT_NO_THROW(require_labellable(through(seeing), ahead, "dart"));
+  // DAgger's rows record the expert's labels of the learner's steps, not what it chose.
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(acting), ahead, "dagger", true); }),
+              HasSubstr("dagger: option perturb (a file) with estimator none: action_delay cannot be labelled: the rollouts"));
+  // The documented recipe: an action delay drawn per episode on a "/landing" map.
+  acting.delays_drawn = true;
+  EXPECT_NO_THROW(require_labellable(through(acting), feature_map("state+clock+start_state@dice/position/landing"), "dart"));
   seeing.delays_drawn = true;
   EXPECT_THAT(test::error_of([&] { require_labellable(through(seeing), ahead, "dart"); }),
               HasSubstr("a drawn observation_delay cannot be labelled"));

@@ -47,6 +47,7 @@ constexpr double kSwitchMargin = 5.0;
 // kFrictionScales but the nominal one.
 std::vector<World> friction_bank(const WorldConfig& model) {
   std::vector<World> bank;
+  bank.reserve(kFrictionScales.size() * kFrictionScales.size() * kFrictionScales.size() - 1);
   for (const double dice : kFrictionScales)
     for (const double cup : kFrictionScales)
       for (const double walls : kFrictionScales) {
@@ -65,13 +66,15 @@ std::vector<World> friction_bank(const WorldConfig& model) {
 double model_error_of(std::size_t k) { return std::max(kModelError[k], kModelErrorFloor) * observation_spread()[k]; }
 
 double estimator_bytes(const EstimatorConfig& config) {
+  // The Kalman filter's model and, under a delay with exact observations, its friction bank.
+  const double kalman = config.identify_friction ? std::pow(static_cast<double>(kFrictionScales.size()), 3) : 1.0;
   switch (config.kind) {
     case EstimatorKind::none: return 0.0;
-    case EstimatorKind::kalman:  // the model and, under a delay with exact observations, its friction bank
-      return (config.identify_friction ? std::pow(kFrictionScales.size(), 3) : 1.0) * kEstimatorWorldBytes;
-    case EstimatorKind::particle: break;
+    case EstimatorKind::kalman: break;
+    case EstimatorKind::particle:  // the particles and the world the mean runs on in, or without noise the Kalman filter
+      return std::max(config.particles + 1.0, kalman) * kEstimatorWorldBytes;
   }
-  return (config.particles + 1.0) * kEstimatorWorldBytes;  // the particles and the world the mean runs on in
+  return kalman * kEstimatorWorldBytes;
 }
 
 const std::vector<std::string>& estimator_names() {
@@ -144,6 +147,8 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
   }
   const bool exact = std::all_of(sensor_variance_.begin(), sensor_variance_.end(), [](double v) { return v == 0.0; });
   if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0)) bank_ = friction_bank(model);
+  predicted_.assign(bank_.size() + 1, State{});
+  misfit_.assign(bank_.size() + 1, 0.0);
 }
 
 State KalmanEstimator::start(const State& observed) {

@@ -173,13 +173,19 @@ struct TrainingPerturbation {
 };
 /// Those options, checked against `world`; throws ConfigError naming the option.
 TrainingPerturbation learner_perturbation(const Params& params, const WorldConfig& world, const std::string& learner);
-/// Throws ConfigError naming each factor of `p.trained` the expert cannot label for a policy on
-/// `features`: its labels answer the world's own state, so they must be a function of what the
-/// policy is shown. Observation noise never is (behind no estimator the policy sees noise the
-/// label ignores); a delay is only on an "/ahead" or "/landing" map, whose row carries what is
-/// pending and unseen, and an observation delay drawn per episode not even there (the row does
-/// not say how old its state is).
-void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner);
+/// Throws ConfigError naming the first factor of `p.trained` the expert cannot label for a
+/// policy on `features`: its labels answer the world's own state, so they must be a function of
+/// what the policy is shown. Observation noise never is (behind no estimator the policy sees
+/// noise the label ignores); a delay is only on an "/ahead" or "/landing" map, whose row carries
+/// what is pending and unseen, and an observation delay drawn per episode not even there (the
+/// row does not say how old its state is). A learner whose rollouts run its own choices
+/// (`own_choices`: DAgger) records only the expert's labels of them, so no row can rebuild what
+/// was pending under a delay: every delay is refused.
+void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner,
+                        bool own_choices = false);
+/// The same for a learner's options: nothing when `schema` has no "perturb" (a leaderboard's row).
+void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
+                        const FeatureMap& features, const std::string& learner);
 /// Names `p` in the model's record: "perturb", and "estimator" when the policy runs behind one.
 void record_perturbation(const TrainingPerturbation& p, Model& model);
 

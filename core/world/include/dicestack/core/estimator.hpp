@@ -37,8 +37,8 @@ struct EstimatorConfig {
   /// contact-rich swing carries runs of the simulator from one another, far beyond its one-step
   /// error from true states: 30 did best of 3, 10, 30, 100 and 300 (docs/notebook/2026-11-28-estimator.md).
   double particle_model_error = 30.0;
-  /// kalman: under a delay with exact observations, predict in the friction the observations
-  /// show (FrictionBank) rather than the nominal one.
+  /// kalman: under a delay with exact observations, forecast in the friction the observations
+  /// show rather than the nominal one (KalmanEstimator's bank of 27 worlds).
   bool identify_friction = true;
 };
 
