@@ -45,20 +45,18 @@ constexpr double kSwitchMargin = 5.0;
 
 // The nominal world with its dice', cup's and walls' friction scaled by every combination of
 // kFrictionScales but the nominal one.
-std::vector<World> friction_bank(const WorldConfig& model) {
-  std::vector<World> bank;
-  bank.reserve(kFrictionScales.size() * kFrictionScales.size() * kFrictionScales.size() - 1);
+std::vector<WorldConfig> other_frictions(const WorldConfig& model) {
+  std::vector<WorldConfig> out;
   for (const double dice : kFrictionScales)
     for (const double cup : kFrictionScales)
       for (const double walls : kFrictionScales) {
         if (dice == 1.0 && cup == 1.0 && walls == 1.0) continue;
-        WorldConfig w = model;
+        WorldConfig& w = out.emplace_back(model);
         w.dice.friction *= dice;
         w.cup.friction *= cup;
         w.walls.friction *= walls;
-        bank.emplace_back(w);
       }
-  return bank;
+  return out;
 }
 
 }  // namespace
@@ -139,23 +137,26 @@ void CommandTimeline::run_on(World& world) const {
 }
 
 KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config)
-    : model_(model), dt_(model.physics.control_dt), timeline_(draw.action_delay, draw.observation_delay) {
+    : dt_(model.physics.control_dt), timeline_(draw.action_delay, draw.observation_delay) {
   for (std::size_t k = 0; k < kStateDim; ++k) {
     sensor_variance_[k] = draw.observation_noise[k] * draw.observation_noise[k];
     const double q = config.model_error * model_error_of(k);
     process_variance_[k] = q * q;
   }
   const bool exact = std::all_of(sensor_variance_.begin(), sensor_variance_.end(), [](double v) { return v == 0.0; });
-  if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0)) bank_ = friction_bank(model);
-  predicted_.assign(bank_.size() + 1, State{});
-  misfit_.assign(bank_.size() + 1, 0.0);
+  std::vector<WorldConfig> worlds{model};
+  if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0))
+    for (const WorldConfig& w : other_frictions(model)) worlds.push_back(w);
+  models_.reserve(worlds.size());
+  for (const WorldConfig& w : worlds) models_.emplace_back(w);
+  predicted_.assign(models_.size(), State{});
+  misfit_.assign(models_.size(), 0.0);
 }
 
 State KalmanEstimator::start(const State& observed) {
-  model_.set_state(observed);
-  for (World& w : bank_) w.set_state(observed);
-  predicted_.assign(bank_.size() + 1, observed);
-  misfit_.assign(bank_.size() + 1, 0.0);
+  for (World& w : models_) w.set_state(observed);
+  predicted_.assign(models_.size(), observed);
+  misfit_.assign(models_.size(), 0.0);
   chosen_ = 0;
   lagged_ = observed;
   const auto& all = kPairs;
@@ -168,11 +169,9 @@ State KalmanEstimator::start(const State& observed) {
 void KalmanEstimator::predict() {
   // Every model stands at lagged_, its contacts warm where it was not corrected.
   const Action ran = timeline_.take_ran();
-  model_.step(ran);
-  predicted_[0] = model_.state();
-  for (std::size_t m = 0; m < bank_.size(); ++m) {
-    bank_[m].step(ran);
-    predicted_[m + 1] = bank_[m].state();
+  for (std::size_t m = 0; m < models_.size(); ++m) {
+    models_[m].step(ran);
+    predicted_[m] = models_[m].state();
   }
   lagged_ = predicted_[chosen_];
   // The covariance moves as a pose and its velocity do over one step (the pose gains dt times
@@ -201,7 +200,7 @@ void KalmanEstimator::choose_model(const State& observed) {
 }
 
 void KalmanEstimator::correct(const State& observed) {
-  if (!bank_.empty()) choose_model(observed);
+  if (models_.size() > 1) choose_model(observed);
   const auto& all = kPairs;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Pair& p = all[i];
@@ -230,7 +229,7 @@ void KalmanEstimator::correct(const State& observed) {
   // Each model's prediction stays the state it stands at until the next step.
   for (std::size_t m = 0; m < predicted_.size(); ++m)
     if (predicted_[m] != lagged_) {
-      (m == 0 ? model_ : bank_[m - 1]).set_state(lagged_);
+      models_[m].set_state(lagged_);
       predicted_[m] = lagged_;
     }
 }
@@ -244,7 +243,7 @@ State KalmanEstimator::update(const Action& chosen, const State& observed) {
 
 State KalmanEstimator::ahead() {
   if (timeline_.empty()) return lagged_;
-  World& forecast = forecaster();
+  World& forecast = models_[chosen_];
   const WorldSnapshot at_lagged = forecast.snapshot();
   timeline_.run_on(forecast);
   const State landing = forecast.state();

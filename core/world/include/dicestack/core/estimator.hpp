@@ -145,14 +145,12 @@ class KalmanEstimator final : public Estimator {
   void predict();
   void correct(const State& observed);
   void choose_model(const State& observed);
-  World& forecaster() { return chosen_ == 0 ? model_ : bank_[chosen_ - 1]; }
   State ahead();
 
-  World model_;
-  std::vector<World> bank_;       // the other frictions; empty: the nominal model alone
-  std::vector<State> predicted_;  // each model's prediction of the newest observation, model_'s first
+  std::vector<World> models_;     // the nominal world first, then the bank's other frictions (if kept)
+  std::vector<State> predicted_;  // each model's prediction of the newest observation (the state it stands at)
   std::vector<double> misfit_;    // each model's discounted negative log-likelihood of the observations
-  std::size_t chosen_ = 0;        // the model that predicts: 0 model_, else bank_[chosen_ - 1]
+  std::size_t chosen_ = 0;        // the model that forecasts
   double dt_;
   CommandTimeline timeline_;
   State sensor_variance_{};
