@@ -52,7 +52,7 @@ class Handover final : public Policy {
   ExpertPolicy expert_;
   const Model& model_;
   int k_;
-  Action scale_;
+  std::array<double, kActionDim> scale_;
 };
 
 }  // namespace

@@ -32,7 +32,7 @@ struct RolloutOptions {
 // Uniform random actions in the optimisers' range (action.scale), from their own stream, or none.
 class BuiltinController final : public Policy {
  public:
-  BuiltinController(bool random, const Action& scale, std::uint64_t seed) : random_(random), scale_(scale), rng_(seed) {}
+  BuiltinController(bool random, const std::array<double, kActionDim>& scale, std::uint64_t seed) : random_(random), scale_(scale), rng_(seed) {}
   Action act(const History&) override {
     Action a{0.0, 0.0, 0.0};
     if (random_)
@@ -43,7 +43,7 @@ class BuiltinController final : public Policy {
 
  private:
   bool random_;
-  Action scale_;
+  std::array<double, kActionDim> scale_;
   Rng rng_;
 };
 

@@ -61,4 +61,25 @@ py::array_t<double> to_array(const Matrix& m) {
   return out;
 }
 
+py::array_t<double> actions_to_array(const std::vector<Action>& actions, ActionKind kind) {
+  const std::size_t width = action_dim(kind);
+  py::array_t<double> out({static_cast<py::ssize_t>(actions.size()), static_cast<py::ssize_t>(width)});
+  double* p = out.mutable_data();
+  for (const Action& a : actions) {
+    if (a.kind() != kind)
+      throw py::value_error(std::string("an action for the ") + std::string(action_kind_name(a.kind())) +
+                            " controller among actions for the " + std::string(action_kind_name(kind)) + " controller");
+    p = std::copy(a.begin(), a.end(), p);
+  }
+  return out;
+}
+
+std::vector<Action> actions_from(const py::handle& obj, std::string_view what, ActionKind kind) {
+  const Matrix m = matrix_from(obj, action_dim(kind), what);
+  std::vector<Action> out(static_cast<std::size_t>(m.rows()), Action::zeros(kind));
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index k = 0; k < m.cols(); ++k) out[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)] = m(i, k);
+  return out;
+}
+
 }  // namespace dicestack::python

@@ -43,6 +43,10 @@ py::array_t<double> rows_to_array(const std::vector<std::array<double, N>>& rows
   for (const auto& r : rows) p = std::copy(r.begin(), r.end(), p);
   return out;
 }
+/// Actions of one kind as an (N, action_dim(kind)) array.
+py::array_t<double> actions_to_array(const std::vector<Action>& actions, ActionKind kind = ActionKind::cup);
+/// An (N, action_dim(kind)) array as actions of `kind` (N may be 0); ValueError for another shape.
+std::vector<Action> actions_from(const py::handle& obj, std::string_view what, ActionKind kind = ActionKind::cup);
 /// An (N, width) array as rows (N may be 0); ValueError for another shape.
 template <std::size_t N>
 std::vector<std::array<double, N>> rows_from(const py::handle& obj, std::string_view what) {

@@ -22,7 +22,7 @@ py::dict episode_dict(const Episode& e) {
   d["name"] = e.name;
   d["seed"] = e.seed;
   d["states"] = rows_to_array(e.states);
-  d["actions"] = rows_to_array(e.actions);
+  d["actions"] = actions_to_array(e.actions);
   d["sources"] = sources;
   d["origin"] = e.origin;
   d["steps"] = e.outcome.steps;
@@ -44,7 +44,7 @@ Episode episode_from(const py::handle& obj) {
   e.name = d["name"].cast<std::string>();
   e.seed = seed_from(d["seed"], "episode seed").value_or(0);
   e.states = rows_from<kStateDim>(d["states"], "episode states");
-  e.actions = rows_from<kActionDim>(d["actions"], "episode actions");
+  e.actions = actions_from(d["actions"], "episode actions");
   for (const auto& s : d["sources"]) e.sources.push_back(step_source_from(s.cast<std::string>()));
   e.origin = d["origin"].cast<std::string>();
   e.outcome.steps = d["steps"].cast<int>();

@@ -200,7 +200,7 @@ class VectorEnv {
   /// Each environment's pending (or unseen) actions under its delays, as (d, 3) arrays.
   py::list queues(bool pending) const {
     py::list out;
-    for (const EnvCore& e : envs_) out.append(rows_to_array(pending ? e.pending() : e.unseen()));
+    for (const EnvCore& e : envs_) out.append(actions_to_array(pending ? e.pending() : e.unseen()));
     return out;
   }
 
@@ -228,7 +228,7 @@ class VectorEnv {
   }
 
   py::tuple step(const py::handle& action_rows) {
-    const auto actions = rows_from<kActionDim>(action_rows, "actions");
+    const auto actions = actions_from(action_rows, "actions");
     if (actions.size() != envs_.size())
       throw py::value_error("actions must have shape (" + std::to_string(envs_.size()) + ", 3), got " +
                             std::to_string(actions.size()) + " rows");
@@ -380,8 +380,8 @@ void bind_env(py::module_& m) {
       .def("action_bounds", [](const EnvCore& c) { return bounds(c.env().action_space()); })
       .def_property_readonly("state", [](const EnvCore& c) { return to_array(c.env().get_state()); })
       .def_property_readonly("t", [](const EnvCore& c) { return c.env().t(); })
-      .def_property_readonly("pending", [](const EnvCore& c) { return rows_to_array(c.pending()); })
-      .def_property_readonly("unseen", [](const EnvCore& c) { return rows_to_array(c.unseen()); })
+      .def_property_readonly("pending", [](const EnvCore& c) { return actions_to_array(c.pending()); })
+      .def_property_readonly("unseen", [](const EnvCore& c) { return actions_to_array(c.unseen()); })
       .def_property_readonly("info", [](const EnvCore& c) { return info_dict(c.info()); })
       .def_property_readonly("world", [](const EnvCore& c) { return c.env().config(); })
       .def_property_readonly("world_hash", &EnvCore::world_hash)

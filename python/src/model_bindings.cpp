@@ -55,7 +55,7 @@ class PyPolicy {
   // None, or (N, 3) finite actions.
   static std::vector<Action> actions_from(const py::handle& rows, const char* what) {
     if (rows.is_none()) return {};
-    auto actions = rows_from<kActionDim>(rows, what);
+    auto actions = dicestack::python::actions_from(rows, what);
     for (std::size_t i = 0; i < actions.size(); ++i)
       for (std::size_t k = 0; k < kActionDim; ++k)
         if (!std::isfinite(actions[i][k]))

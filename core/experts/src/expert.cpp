@@ -162,7 +162,7 @@ class MpcExpert final : public Expert {
     StepResult r;
     r.observation = sim_->get_state();
     Rng rng(noise_seed);
-    const Action& scale = sim_->config().action.scale;
+    const auto& scale = sim_->config().action.scale;
     while (sim_->t() < sim_->config().episode.max_steps) {
       Action a = plan.act(r.observation, sim_->t());
       if (noise > 0.0)

@@ -27,7 +27,7 @@ Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& st
                std::uint64_t noise_seed) {
   sim.restore(start);
   Rng rng(noise_seed);
-  const Action& scale = sim.config().action.scale;
+  const auto& scale = sim.config().action.scale;
   const bool noisy = noise[0] > 0.0 || noise[1] > 0.0 || noise[2] > 0.0;
   const bool clean = !sim.outcome().wall_contact;
   const int end = sim.t() + follower.length() + hold_steps;

@@ -27,6 +27,18 @@ const std::array<std::string_view, kActionDim>& action_names() {
   return names;
 }
 
+const std::array<std::string_view, kJointCount>& torque_names() {
+  static constexpr std::array<std::string_view, kJointCount> names{"tau0", "tau1", "tau2", "tau3"};
+  return names;
+}
+
+std::span<const std::string_view> action_names(ActionKind kind) {
+  if (kind == ActionKind::cup) return action_names();
+  return torque_names();
+}
+
+std::string_view action_kind_name(ActionKind kind) { return kind == ActionKind::cup ? "cup" : "joint_torque"; }
+
 namespace {
 
 template <std::size_t N>
@@ -46,8 +58,10 @@ State to_state(std::span<const double> values, std::string_view what) {
   return to_array<kStateDim>(values, what, "a state");
 }
 
-Action to_action(std::span<const double> values, std::string_view what) {
-  return to_array<kActionDim>(values, what, "an action");
+Action to_action(std::span<const double> values, std::string_view what, ActionKind kind) {
+  if (kind == ActionKind::joint_torque) return Action::torques(to_array<kJointCount>(values, what, "a joint-torque action"));
+  const auto a = to_array<kActionDim>(values, what, "an action");
+  return Action{a[0], a[1], a[2]};
 }
 
 void require_finite(std::span<const double> values, std::string_view what) {

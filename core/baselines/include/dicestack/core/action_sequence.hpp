@@ -45,7 +45,7 @@ class ActionSequenceProblem {
   double cost(DiceEnv& env, const double* x) const { return cost_(env, actions(x)); }
 
  private:
-  Action scale_, half_width_;
+  std::array<double, kActionDim> scale_, half_width_;
   int steps_;
   Cost cost_;
 };
