@@ -89,17 +89,26 @@ class DiceStackEnv(_EnvBase):
     embodiment: None (the world's), "cup" (the paper's floating cup) or "arm": a planar arm holds
     the cup and the same actions drive it through its joints (docs/arm.md); the observation stays
     the 24 numbers. `dicestack/DiceStackArm-v0` is this environment with embodiment="arm".
+
+    controller: "cup" (the action is the cup's velocity change, on either embodiment) or
+    "joint_torque" (the arm only: the action is the four joint torques in N m, shoulder first,
+    held through the step and clipped to the arm's limits, which `action_space` gives). On the
+    arm, info also holds link_angles and link_rates (each link's absolute direction and rate)
+    and joint_torques (what the joints gave in the last substep).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
-    def __init__(self, world=None, render_mode=None, perturb=None, start="random", estimator="none", embodiment=None):
+    def __init__(self, world=None, render_mode=None, perturb=None, start="random", estimator="none", embodiment=None,
+                 controller="cup"):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
             raise TypeError(f"estimator must be a name (none, kalman, particle), got {type(estimator).__name__}")
-        self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world), estimator)
+        if not isinstance(controller, str):
+            raise TypeError(f"controller must be a name (cup, joint_torque), got {type(controller).__name__}")
+        self._env = _dicestack.Env(self._world, resolve_perturbation(perturb, self._world), estimator, controller)
         self.render_mode = render_mode
         self.metadata = dict(type(self).metadata, render_fps=int(round(1.0 / self._world.control_dt)))
         self.observation_space = box(*self._env.observation_bounds())

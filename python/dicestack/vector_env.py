@@ -32,6 +32,7 @@ class DiceStackVectorEnv(_VectorBase):
 
     perturb: as DiceStackEnv's; each environment draws its own world from its own episode seed.
     estimator: as DiceStackEnv's ("none", "kalman" or "particle"), one per environment.
+    embodiment, controller: as DiceStackEnv's.
     """
 
     metadata = {"render_modes": [], "autoreset_mode": _NEXT_STEP}
@@ -40,7 +41,7 @@ class DiceStackVectorEnv(_VectorBase):
     closed = False
 
     def __init__(self, num_envs, world=None, threads=None, perturb=None, start="random", estimator="none",
-                 embodiment=None):
+                 embodiment=None, controller="cup"):
         if isinstance(num_envs, bool) or not isinstance(num_envs, numbers.Integral) or num_envs < 1:
             raise ValueError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
         if num_envs >= 2**63:
@@ -49,9 +50,11 @@ class DiceStackVectorEnv(_VectorBase):
         self._world = resolve_world(world, start, embodiment)
         if not isinstance(estimator, str):
             raise TypeError(f"estimator must be a name (none, kalman, particle), got {type(estimator).__name__}")
+        if not isinstance(controller, str):
+            raise TypeError(f"controller must be a name (cup, joint_torque), got {type(controller).__name__}")
         self._vec = _dicestack.VectorEnv(self._world, self.num_envs, threads, resolve_perturbation(perturb, self._world),
-                                         estimator)
-        probe = _dicestack.Env(self._world)
+                                         estimator, controller)
+        probe = _dicestack.Env(self._world, controller=controller)
         obs_low, obs_high = probe.observation_bounds()
         act_low, act_high = probe.action_bounds()
         self.single_observation_space = box(obs_low, obs_high)

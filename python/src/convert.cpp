@@ -35,8 +35,8 @@ std::vector<double> vector_from(const py::handle& obj, std::size_t size, std::st
 
 State state_from(const py::handle& obj, std::string_view what) { return to_state(vector_from(obj, kStateDim, what), what); }
 
-Action action_from(const py::handle& obj, std::string_view what) {
-  return to_action(vector_from(obj, kActionDim, what), what);
+Action action_from(const py::handle& obj, std::string_view what, ActionKind kind) {
+  return to_action(vector_from(obj, action_dim(kind), what), what, kind);
 }
 
 Matrix matrix_from(const py::handle& obj, std::size_t cols, std::string_view what) {

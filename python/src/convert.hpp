@@ -28,7 +28,7 @@ std::string shape_text(const py::array& array);
 /// Exactly `size` finite numbers in an array of shape (size,); ValueError otherwise.
 std::vector<double> vector_from(const py::handle& obj, std::size_t size, std::string_view what);
 State state_from(const py::handle& obj, std::string_view what);
-Action action_from(const py::handle& obj, std::string_view what = "action");
+Action action_from(const py::handle& obj, std::string_view what = "action", ActionKind kind = ActionKind::cup);
 
 /// A 2-D array of shape (N, cols) (cols = 0: any); ValueError otherwise.
 Matrix matrix_from(const py::handle& obj, std::size_t cols, std::string_view what);

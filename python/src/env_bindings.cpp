@@ -66,13 +66,30 @@ Snapshot snapshot_from_state(const py::tuple& t) {
   return s;
 }
 
-py::tuple step_tuple(const StepResult& r) {
-  return py::make_tuple(to_array(r.observation), r.reward, r.terminated, r.truncated, info_dict(r.info));
-}
-
 template <std::size_t N>
 py::tuple bounds(const Box<N>& box) {
   return py::make_tuple(to_array(box.low), to_array(box.high));
+}
+
+// "cup" or "joint_torque"; ValueError otherwise.
+ActionKind controller_from(const std::string& name) {
+  for (ActionKind kind : {ActionKind::cup, ActionKind::joint_torque})
+    if (name == action_kind_name(kind)) return kind;
+  throw py::value_error("controller must be \"cup\" or \"joint_torque\", got \"" + name.substr(0, 40) + "\"");
+}
+
+py::tuple action_bounds(const EnvCore& core) {
+  return core.controller() == ActionKind::cup ? bounds(core.env().action_space()) : bounds(core.env().torque_space());
+}
+
+// An arm's links and joints beside the 24 observed numbers, which a joint-torque policy needs.
+py::dict with_arm(py::dict info, const EnvCore& core) {
+  const World& w = core.env().world();
+  if (w.config().embodiment != Embodiment::arm) return info;
+  info["link_angles"] = to_array(w.arm_link_angles());
+  info["link_rates"] = to_array(w.arm_link_rates());
+  info["joint_torques"] = to_array(w.arm_joint_torques());
+  return info;
 }
 
 py::array_t<std::uint8_t> render_rgb(const EnvCore& core, double pixels_per_metre, bool hud) {
@@ -187,11 +204,11 @@ class VectorEnv {
   static constexpr double kEnvironmentBytes = 120e3;
 
   VectorEnv(const WorldConfig& world, long long num_envs, int threads, const Perturbation& perturbation,
-            const EstimatorConfig& estimator)
-      : pool_(pool_size(num_envs, threads, estimator)) {
+            const EstimatorConfig& estimator, ActionKind controller)
+      : controller_(controller), pool_(pool_size(num_envs, threads, estimator)) {
     envs_.reserve(static_cast<std::size_t>(num_envs));
     validate(perturbation, world);
-    for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation, estimator);
+    for (long long i = 0; i < num_envs; ++i) envs_.emplace_back(world, perturbation, estimator, controller);
     done_.assign(envs_.size(), 0);
     slots_.resize(envs_.size());
   }
@@ -228,10 +245,10 @@ class VectorEnv {
   }
 
   py::tuple step(const py::handle& action_rows) {
-    const auto actions = actions_from(action_rows, "actions");
+    const auto actions = actions_from(action_rows, "actions", controller_);
     if (actions.size() != envs_.size())
-      throw py::value_error("actions must have shape (" + std::to_string(envs_.size()) + ", 3), got " +
-                            std::to_string(actions.size()) + " rows");
+      throw py::value_error("actions must have shape (" + std::to_string(envs_.size()) + ", " +
+                            std::to_string(action_dim(controller_)) + "), got " + std::to_string(actions.size()) + " rows");
     for (std::size_t i = 0; i < actions.size(); ++i) require_finite(actions[i], "action of environment " + std::to_string(i));
     const BatchArrays out = run([&](std::size_t i) {
       SlotResult& r = slots_[i];
@@ -271,6 +288,7 @@ class VectorEnv {
     return std::move(*out);
   }
 
+  ActionKind controller_;
   std::vector<EnvCore> envs_;
   std::vector<char> done_;
   std::vector<SlotResult> slots_;
@@ -355,10 +373,12 @@ void bind_env(py::module_& m) {
       .def_property_readonly("nominal", &Perturbation::nominal);
 
   py::class_<EnvCore>(m, "Env", "One dice-stacking environment (the core of dicestack.DiceStackEnv)")
-      .def(py::init([](const WorldConfig& world, const Perturbation& perturbation, const std::string& estimator) {
-             return std::make_unique<EnvCore>(world, perturbation, estimator_config(estimator));
+      .def(py::init([](const WorldConfig& world, const Perturbation& perturbation, const std::string& estimator,
+                       const std::string& controller) {
+             return std::make_unique<EnvCore>(world, perturbation, estimator_config(estimator), controller_from(controller));
            }),
-           py::arg("world"), py::arg("perturbation") = Perturbation{}, py::arg("estimator") = "none")
+           py::arg("world"), py::arg("perturbation") = Perturbation{}, py::arg("estimator") = "none",
+           py::arg("controller") = "cup")
       .def(
           "reset",
           [](EnvCore& core, const py::object& seed, const py::object& state, const std::optional<Perturbation>& p) {
@@ -366,18 +386,24 @@ void bind_env(py::module_& m) {
             const Perturbation* override = p ? &*p : nullptr;
             const State obs = state.is_none() ? core.reset(s, override)
                                               : core.reset_to(state_from(state, "options[\"state\"]"), s, override);
-            return py::make_tuple(to_array(obs), info_dict(core.info()));
+            return py::make_tuple(to_array(obs), with_arm(info_dict(core.info()), core));
           },
           py::arg("seed") = py::none(), py::arg("state") = py::none(), py::arg("perturbation") = py::none())
       .def_property_readonly("draw", [](const EnvCore& c) { return draw_to_json(c.draw()); })
       .def_property_readonly("perturbed", [](const EnvCore& c) { return c.draw().physics || c.draw().acts; })
-      .def("step", [](EnvCore& core, const py::handle& action) { return step_tuple(core.step(action_from(action))); },
-           py::arg("action"))
+      .def(
+          "step",
+          [](EnvCore& core, const py::handle& action) {
+            const StepResult r = core.step(action_from(action, "action", core.controller()));
+            return py::make_tuple(to_array(r.observation), r.reward, r.terminated, r.truncated, with_arm(info_dict(r.info), core));
+          },
+          py::arg("action"))
       .def("snapshot", &take_snapshot)
       .def("restore", &restore_snapshot, py::arg("snapshot"))
       .def("render", &render_rgb, py::arg("pixels_per_metre") = 100.0, py::arg("hud") = true)
       .def("observation_bounds", [](const EnvCore& c) { return bounds(c.env().observation_space()); })
-      .def("action_bounds", [](const EnvCore& c) { return bounds(c.env().action_space()); })
+      .def("action_bounds", &action_bounds)
+      .def_property_readonly("controller", [](const EnvCore& c) { return std::string(action_kind_name(c.controller())); })
       .def_property_readonly("state", [](const EnvCore& c) { return to_array(c.env().get_state()); })
       .def_property_readonly("t", [](const EnvCore& c) { return c.env().t(); })
       .def_property_readonly("pending", [](const EnvCore& c) { return actions_to_array(c.pending()); })
@@ -389,12 +415,13 @@ void bind_env(py::module_& m) {
 
   py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
       .def(py::init([](const WorldConfig& world, long long num_envs, const py::object& threads, const Perturbation& perturbation,
-                       const std::string& estimator) {
+                       const std::string& estimator, const std::string& controller) {
              const EstimatorConfig shown = estimator_config(estimator);  // before any environment is made
-             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation, shown);
+             return std::make_unique<VectorEnv>(world, num_envs, threads_from(threads), perturbation, shown,
+                                                controller_from(controller));
            }),
            py::arg("world"), py::arg("num_envs"), py::arg("threads") = py::none(), py::arg("perturbation") = Perturbation{},
-           py::arg("estimator") = "none")
+           py::arg("estimator") = "none", py::arg("controller") = "cup")
       .def("__len__", &VectorEnv::size)
       .def(
           "reset",

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include <dicestack/core/cost.hpp>
+#include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/rng.hpp>
 
@@ -23,16 +24,22 @@ std::uint64_t EpisodeSeeds::next(std::optional<std::uint64_t> seed) {
   return derive_seed(*base_, ++count_);
 }
 
-EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation, const EstimatorConfig& estimator)
+EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation, const EstimatorConfig& estimator,
+                 ActionKind controller)
     : world_(world),
       perturbation_(perturbation),
       estimator_(estimator),
+      controller_(controller),
       nominal_(std::make_unique<DiceEnv>(world)),
       goal_(goal_state(world)),
       nominal_hash_(dicestack::world_hash(world)),
       world_hash_(nominal_hash_),
       nominal_draw_(draw_perturbation(Perturbation{}, world, 0)) {
   validate(perturbation, world);
+  if (controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
+    throw ConfigError("controller \"joint_torque\" drives an arm's joints: it needs embodiment \"arm\"");
+  if (controller == ActionKind::joint_torque && (perturbation.action_noise > 0.0 || perturbation.action_bias > 0.0))
+    throw ConfigError("action noise and bias are drawn for the cup's actions; the joint_torque controller cannot take them");
 }
 
 void EnvCore::begin(const Perturbation* perturbation) {

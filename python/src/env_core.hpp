@@ -38,8 +38,13 @@ class EpisodeSeeds {
 /// same episodes as C++.
 class EnvCore {
  public:
-  /// `estimator`: what the policy is shown under sensing factors (estimator.hpp).
-  explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {}, const EstimatorConfig& estimator = {});
+  /// `estimator`: what the policy is shown under sensing factors (estimator.hpp); `controller`:
+  /// what an action is (the cup's velocity change, or an arm's joint torques). Throws
+  /// ConfigError for joint torques without the arm, or under action noise or bias (drawn for
+  /// the cup's actions).
+  explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {}, const EstimatorConfig& estimator = {},
+                   ActionKind controller = ActionKind::cup);
+  ActionKind controller() const { return controller_; }
 
   /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds, under
   /// `perturbation` if given (this episode only), else the environment's own.
@@ -86,6 +91,7 @@ class EnvCore {
   WorldConfig world_;  // the nominal world
   Perturbation perturbation_;
   EstimatorConfig estimator_;
+  ActionKind controller_;
   std::unique_ptr<DiceEnv> nominal_;  // the world of every episode whose physics is nominal
   std::unique_ptr<PerturbedEnv> episode_;  // the current episode (null before the first reset)
   State goal_;

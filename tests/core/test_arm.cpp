@@ -9,6 +9,7 @@
 #include <string>
 
 #include <dicestack/core/arm.hpp>
+#include <dicestack/core/env.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/hash.hpp>
 #include <dicestack/core/initial_state.hpp>
@@ -130,6 +131,36 @@ TEST(Arm, AVersionOneSnapshotRecordOfTheFloatingCupIsRead) {
   run.step({0.1, 0.0, 0.1});
   restored.step({0.1, 0.0, 0.1});
   EXPECT_TRUE(test::bit_equal(restored.state(), run.state()));
+}
+
+// The joint_torque controller: the torques hold through the step, each within its limit; the
+// floating cup refuses them; the environment clips them to the arm's limits.
+TEST(Arm, JointTorquesAreHeldThroughTheStepWithinTheirLimits) {
+  const WorldConfig c = arm_world();
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;  // clear of the dice
+  World limp(c, lifted), turned(c, lifted);
+  for (int t = 0; t < 3; ++t) {
+    limp.step(Action::torques({}));
+    turned.step(Action::torques({0.0, 0.0, 0.0, 1e6}));
+    EXPECT_EQ(turned.arm_joint_torques(), (std::array<double, 4>{0.0, 0.0, 0.0, c.arm.torque_limit[3]})) << "step " << t;
+  }
+  EXPECT_LT(limp.state()[si::kCupY], lifted[si::kCupY] - 0.01) << "without torques the arm falls";
+  EXPECT_GT(turned.state()[si::kCupAngle], limp.state()[si::kCupAngle] + 0.05) << "the wrist's torque turns the cup";
+
+  World floating(WorldConfig{}, lifted);
+  try {
+    floating.step(Action::torques({1.0, 0.0, 0.0, 0.0}));
+    ADD_FAILURE() << "a floating cup took joint torques";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("embodiment"));
+  }
+
+  DiceEnv env(c);
+  env.reset_to(lifted);
+  const StepResult r = env.step(Action::torques({-1e9, 1e9, 0.5, 0.0}));
+  EXPECT_EQ(r.applied, Action::torques({-c.arm.torque_limit[0], c.arm.torque_limit[1], 0.5, 0.0}));
+  EXPECT_EQ(env.torque_space().high, c.arm.torque_limit);
 }
 
 TEST(Arm, ALinkOnAWallIsWallContact) {

@@ -204,9 +204,33 @@ def test_the_arm_environment_runs_the_same_task_with_the_same_spaces():
         dicestack.DiceStackEnv(embodiment="robot")
 
 
+def test_the_joint_torque_controller_takes_the_arms_four_torques():
+    env = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque")
+    assert env.action_space.shape == (4,) and np.all(env.action_space.high > 100.0)
+    _, info = env.reset(seed=3)
+    assert info["link_angles"].shape == (3,) and info["link_rates"].shape == (3,)
+    held = env.action_space.high * np.array([0.0, 0.0, 0.0, 2.0])  # past the wrist's limit: clipped to it
+    for _ in range(3):
+        obs, _, _, _, info = env.step(held)
+    assert info["joint_torques"][3] == env.action_space.high[3] and not np.any(info["joint_torques"][:3])
+    with pytest.raises(ValueError, match=r"action must have shape \(4,\)"):
+        env.step(np.zeros(3))
+    with pytest.raises(ValueError, match='needs embodiment "arm"'):
+        dicestack.DiceStackEnv(controller="joint_torque")
+    with pytest.raises(ValueError, match="controller must be"):
+        dicestack.DiceStackEnv(embodiment="arm", controller="torque")
+    # The vector env steps the same episodes.
+    vec = dicestack.DiceStackVectorEnv(2, embodiment="arm", controller="joint_torque")
+    vec.reset(seed=3)
+    assert vec.single_action_space.shape == (4,)
+    env.reset(seed=3)
+    assert np.array_equal(vec.step(np.tile(held, (2, 1)))[0][0], env.step(held)[0])
+
+
 def test_the_arm_environment_is_registered_and_passes_the_checker():
     gymnasium = pytest.importorskip("gymnasium")
     from gymnasium.utils.env_checker import check_env
 
     env = gymnasium.make(dicestack.ARM_ENV_ID)
     check_env(env.unwrapped)
+    check_env(gymnasium.make(dicestack.ARM_ENV_ID, controller="joint_torque").unwrapped)

@@ -29,9 +29,10 @@ StepResult DiceEnv::step(const Action& action) {
   require_finite(action, "action");
   const auto& c = config();
   Action a = action;
-  for (std::size_t k = 0; k < kActionDim; ++k) {
-    if (c.physics.action_noise > 0.0) a[k] += c.physics.action_noise * c.action.scale[k] * noise_.normal();
-    a[k] = std::clamp(a[k], -c.action.limit[k], c.action.limit[k]);
+  const auto scale = action_scale(c, a.kind()), limit = action_limit(c, a.kind());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (c.physics.action_noise > 0.0) a[k] += c.physics.action_noise * scale[k] * noise_.normal();
+    a[k] = std::clamp(a[k], -limit[k], limit[k]);
   }
   StepResult r = finish_step(world_.step(a));
   r.applied = a;
@@ -136,6 +137,15 @@ Box<kActionDim> DiceEnv::action_space() const {
   Box<kActionDim> box;
   for (std::size_t k = 0; k < kActionDim; ++k) {
     box.high[k] = config().action.limit[k];
+    box.low[k] = -box.high[k];
+  }
+  return box;
+}
+
+Box<kJointCount> DiceEnv::torque_space() const {
+  Box<kJointCount> box;
+  for (std::size_t k = 0; k < kJointCount; ++k) {
+    box.high[k] = config().arm.torque_limit[k];
     box.low[k] = -box.high[k];
   }
   return box;

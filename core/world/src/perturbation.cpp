@@ -391,8 +391,16 @@ Action PerturbedChannel::execute(const Action& chosen) {
   chosen_.push_back(chosen);  // holds action_delay zeros from the start: nothing runs before then
   Action a = chosen_.front();
   chosen_.pop_front();
+  // The zeros the delay starts with are the cup's; for joint torques they are zero torques.
+  if (a.kind() != chosen.kind() && a == Action{}) a = Action::zeros(chosen.kind());
   ran_.push_back(a);
   if (ran_.size() > static_cast<std::size_t>(draw_.observation_delay)) ran_.pop_front();
+  if (a.kind() != ActionKind::cup) {
+    for (std::size_t k = 0; k < kActionDim; ++k)
+      if (draw_.action_bias[k] != 0.0 || draw_.action_noise[k] > 0.0)
+        throw InputError("action noise and bias are drawn for cup actions; joint torques cannot take them");
+    return a;
+  }
   for (std::size_t k = 0; k < kActionDim; ++k) {
     a[k] += draw_.action_bias[k];
     if (draw_.action_noise[k] > 0.0) a[k] += draw_.action_noise[k] * noise_.normal();

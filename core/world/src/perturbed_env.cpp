@@ -1,7 +1,9 @@
 #include <dicestack/core/perturbed_env.hpp>
 
 #include <algorithm>
+#include <string>
 
+#include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 
 namespace dicestack {
@@ -27,7 +29,7 @@ State PerturbedEnv::first_shown(const State& start) {
 
 void PerturbedEnv::add_executed_noise(const Action& sigma, std::uint64_t seed) {
   executed_noise_ = sigma;
-  noisy_ = sigma[0] > 0.0 || sigma[1] > 0.0 || sigma[2] > 0.0;
+  noisy_ = std::any_of(sigma.begin(), sigma.end(), [](double x) { return x > 0.0; });
   noise_ = Rng(seed);
 }
 
@@ -40,17 +42,21 @@ State PerturbedEnv::reset_to(const State& start, std::uint64_t seed) { return fi
 State PerturbedEnv::reset(std::uint64_t seed) { return first_shown(env_->reset(seed)); }
 
 Action PerturbedEnv::clip(const Action& a) const {
-  const auto& limit = env_->config().action.limit;
+  const auto limit = action_limit(env_->config(), a.kind());
   Action c = a;
-  for (std::size_t k = 0; k < kActionDim; ++k) c[k] = std::clamp(c[k], -limit[k], limit[k]);
+  for (std::size_t k = 0; k < c.size(); ++k) c[k] = std::clamp(c[k], -limit[k], limit[k]);
   return c;
 }
 
 PerturbedStep PerturbedEnv::step(const Action& chosen) {
   const Action clipped = clip(chosen);
   Action executed = channel_ ? channel_->execute(clipped) : clipped;
-  if (noisy_)
-    for (std::size_t k = 0; k < kActionDim; ++k) executed[k] += executed_noise_[k] * noise_.normal();
+  if (noisy_) {
+    if (executed.kind() != executed_noise_.kind())
+      throw InputError("the executed noise is for " + std::string(action_kind_name(executed_noise_.kind())) +
+                       " actions, the action is for the " + std::string(action_kind_name(executed.kind())) + " controller");
+    for (std::size_t k = 0; k < executed.size(); ++k) executed[k] += executed_noise_[k] * noise_.normal();
+  }
   PerturbedStep s{env_->step(executed), {}};
   s.shown = channel_ ? channel_->observe(s.result.observation) : s.result.observation;
   if (estimator_) s.shown = estimator_->update(clipped, s.shown);

@@ -1,5 +1,6 @@
 #include "scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <new>
@@ -232,6 +233,12 @@ std::array<double, 3> Scene::link_angles() const {
   return a;
 }
 
+std::array<double, 3> Scene::link_rates() const {
+  std::array<double, 3> r{};
+  for (std::size_t i = 0; i < links.size(); ++i) r[i] = links[i]->GetAngularVelocity();
+  return r;
+}
+
 void Scene::drive_arm(const ArmConfig& arm, const Action& target, double dt, Vec2 gravity) {
   ArmMotion now;
   const std::array<b2Body*, 4> chain{links[0], links[1], links[2], bodies[0]};
@@ -243,8 +250,23 @@ void Scene::drive_arm(const ArmConfig& arm, const Action& target, double dt, Vec
   now.cup_mass = bodies[0]->GetMass();
   now.cup_inertia = bodies[0]->GetInertia() / (u * u);
   torques = arm_torques(arm, now, {target[0], target[1]}, target[2], dt, gravity);
+  apply_joint_torques();
+}
+
+void Scene::hold_joint_torques(const ArmConfig& arm, const std::array<double, 4>& wanted) {
+  const std::array<const b2Body*, 4> chain{links[0], links[1], links[2], bodies[0]};
+  for (std::size_t j = 0; j < 4; ++j) {
+    const double rate = chain[j]->GetAngularVelocity() - (j > 0 ? chain[j - 1]->GetAngularVelocity() : 0.0);
+    const double tau = std::clamp(wanted[j], -arm.torque_limit[j], arm.torque_limit[j]);
+    torques[j] = std::abs(rate) >= arm.speed_limit[j] && tau * rate > 0.0 ? 0.0 : tau;
+  }
+  apply_joint_torques();
+}
+
+void Scene::apply_joint_torques() {
   // Joint j turns body j by its torque and the body before it back (the ground takes the
   // shoulder's reaction).
+  const std::array<b2Body*, 4> chain{links[0], links[1], links[2], bodies[0]};
   for (std::size_t i = 0; i < 4; ++i)
     chain[i]->ApplyTorque(static_cast<float>((torques[i] - (i + 1 < 4 ? torques[i + 1] : 0.0)) * u * u), true);
 }

@@ -72,10 +72,19 @@ struct Scene {
   }
   /// The links' absolute directions (rad), from their bodies.
   std::array<double, 3> link_angles() const;
+  /// The links' absolute rates (rad/s).
+  std::array<double, 3> link_rates() const;
   /// Applies, for the next substep of `dt`, the joint torques that bring the cup's velocity to
   /// `target` (m/s, m/s, rad/s; arm_torques); they are kept in `torques`.
   void drive_arm(const ArmConfig& arm, const Action& target, double dt, Vec2 gravity);
+  /// Applies, for the next substep, the joint torques `wanted` (N m, shoulder first) as the
+  /// arm's drives give them: each clipped to its limit, and none while its joint already turns
+  /// at its speed limit in the torque's direction. They are kept in `torques`.
+  void hold_joint_torques(const ArmConfig& arm, const std::array<double, 4>& wanted);
   std::array<double, 4> torques{};  // the arm's joint torques in the last substep, N m
+
+ private:
+  void apply_joint_torques();  // `torques`, each on its body and back on the body before it
 };
 
 }  // namespace dicestack::detail

@@ -44,6 +44,17 @@ bool World::step(const Action& dv) {
   b2Body* cup = sc.bodies[0];
   const int vel_it = c.physics.velocity_iterations, pos_it = c.physics.position_iterations;
   bool wall = false;
+  if (dv.kind() == ActionKind::joint_torque) {
+    if (c.embodiment != Embodiment::arm)
+      throw InputError("action: joint torques need a world whose embodiment is \"arm\"; in this one the cup floats");
+    const std::array<double, 4> wanted{dv[0], dv[1], dv[2], dv[3]};
+    for (int k = 0; k < c.physics.substeps; ++k) {
+      sc.hold_joint_torques(c.arm, wanted);  // Box2D clears applied torques after each step
+      sc.world->Step(impl_->sub_dt, vel_it, pos_it);
+      wall = wall || impl_->touches_wall();
+    }
+    return wall;
+  }
   if (c.embodiment == Embodiment::arm) {
     // The velocity a floating cup would have after each substep: its own plus dv, then
     // gravity's pull; the arm's torques drive it there (the dice push it less than they push a
@@ -72,6 +83,8 @@ bool World::step(const Action& dv) {
 }
 
 std::array<double, 3> World::arm_link_angles() const { return impl_->scene->link_angles(); }
+
+std::array<double, 3> World::arm_link_rates() const { return impl_->scene->link_rates(); }
 
 std::array<double, 4> World::arm_joint_torques() const { return impl_->scene->torques; }
 

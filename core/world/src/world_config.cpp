@@ -492,6 +492,16 @@ CostConfig WorldConfig::default_cost() {
   return cost;
 }
 
+std::span<const double> action_limit(const WorldConfig& config, ActionKind kind) {
+  if (kind == ActionKind::joint_torque) return config.arm.torque_limit;
+  return config.action.limit;
+}
+
+std::span<const double> action_scale(const WorldConfig& config, ActionKind kind) {
+  if (kind == ActionKind::joint_torque) return config.arm.torque_limit;
+  return config.action.scale;
+}
+
 void validate(const WorldConfig& config) {
   visit_fields(config, RangeChecker{"<value>"});
   validate_relations(config, "<value>");

@@ -70,8 +70,9 @@ class DiceEnv {
   /// Starts an episode from a bare state (e.g. a recorded one); `seed` seeds the noise.
   State reset_to(const State& state, std::uint64_t seed = 0);
 
-  /// Applies `action` (clipped to config.action.limit, plus noise if configured) and advances
-  /// one control step. Throws InputError if the action is not finite.
+  /// Applies `action` (plus noise if configured, then clipped to action_limit: a cup action
+  /// to config.action.limit, joint torques to the arm's limits) and advances one control step.
+  /// Throws InputError if the action is not finite, or holds joint torques for a floating cup.
   StepResult step(const Action& action);
 
   State get_state() const { return world_.state(); }
@@ -87,8 +88,10 @@ class DiceEnv {
   /// Observation bounds: positions inside the walls, velocities below Box2D's speed cap,
   /// angles unbounded.
   Box<kStateDim> observation_space() const;
-  /// Action bounds: +-config.action.limit.
+  /// Cup action bounds: +-config.action.limit.
   Box<kActionDim> action_space() const;
+  /// Joint-torque action bounds (an arm's): +-config.arm.torque_limit.
+  Box<kJointCount> torque_space() const;
 
  private:
   StepResult finish_step(bool wall);

@@ -89,11 +89,14 @@ class World {
   /// Throws InputError if the snapshot is empty.
   void restore(const WorldSnapshot& snapshot);
 
-  /// One control step: adds `dv` (m/s, m/s, rad/s) to the cup's velocity, then runs the
-  /// configured substeps. With the arm, the joints' motors drive the cup at the velocity a
-  /// floating cup would have (its velocity plus dv, then gravity's pull over the step), within
-  /// their torque limits. Returns true if the cup, a die or a link touched a side wall or the
-  /// ceiling during the step. Throws InputError if `dv` is not finite. Does not clip.
+  /// One control step. A cup action adds `dv` (m/s, m/s, rad/s) to the cup's velocity, then
+  /// runs the configured substeps; with the arm, the cup controller's torques drive the cup at
+  /// the velocity a floating cup would have (its velocity plus dv, then gravity's pull over the
+  /// step), within the torque limits. A joint-torque action (the arm only) holds its four torques
+  /// through every substep, each clipped to its limit and withheld while its joint turns at its
+  /// speed limit in the torque's direction. Returns true if the cup, a die or a link touched a
+  /// side wall or the ceiling during the step. Throws InputError if `dv` is not finite, or
+  /// holds joint torques for a floating cup. Does not clip a cup action.
   bool step(const Action& dv);
 
   /// Every shape, in world coordinates, for drawing.
@@ -109,6 +112,8 @@ class World {
 
   /// The arm's link directions now (absolute, rad); zeros for the floating cup.
   std::array<double, 3> arm_link_angles() const;
+  /// The arm's link rates now (absolute, rad/s); zeros for the floating cup.
+  std::array<double, 3> arm_link_rates() const;
   /// The torque each joint's motor gave in the last substep, N m; zeros for the floating cup.
   std::array<double, 4> arm_joint_torques() const;
 

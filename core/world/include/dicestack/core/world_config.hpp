@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <numbers>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -155,6 +156,13 @@ struct WorldConfig {
   static CostConfig default_cost();
   bool operator==(const WorldConfig&) const = default;
 };
+
+/// The largest |value| an environment passes on, per component of an action of `kind`:
+/// action.limit for the cup, arm.torque_limit for joint torques. Refers into `config`.
+std::span<const double> action_limit(const WorldConfig& config, ActionKind kind);
+/// One unit of a component of an action of `kind`, what action noise is a fraction of:
+/// action.scale for the cup, arm.torque_limit for joint torques. Refers into `config`.
+std::span<const double> action_scale(const WorldConfig& config, ActionKind kind);
 
 /// Throws ConfigError naming the first field that is out of range, e.g.
 /// `world config: field "physics.substeps" must be >= 1, got 0`, or whose start does not fit:
