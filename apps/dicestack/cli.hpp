@@ -42,6 +42,7 @@ void add_interop_commands(CLI::App& import, CLI::App& dataset);  // import robom
 void add_bench_optimise_command(CLI::App& bench);    // under `bench`
 void add_bench_estimator_command(CLI::App& bench);   // under `bench`
 void add_bench_arm_command(CLI::App& bench);         // under `bench`
+void add_bench_arm_open_loop_command(CLI::App& bench);  // under `bench`
 void add_optimise_command(CLI::App& app, Cluster& cluster);
 void add_reinforce_command(CLI::App& app, Cluster& cluster);
 void add_rrt_command(CLI::App& app, Cluster& cluster);

@@ -244,6 +244,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_optimise_command(*bench);
   add_bench_estimator_command(*bench);
   add_bench_arm_command(*bench);
+  add_bench_arm_open_loop_command(*bench);
 }
 
 }  // namespace dicestack::cli

@@ -1,6 +1,7 @@
 // `dicestack robustness`: a model's or an expert's realistic success in perturbed worlds, factor
 // by factor and level by level (docs/robustness.md). The work is the library's
 // (learners/robustness.hpp): this parses, calls it and prints.
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -22,7 +23,7 @@ namespace {
 struct RobustnessOptions {
   WorldOption world;
   std::filesystem::path model, demos, out;
-  std::string expert, format = "md", expert_feedback = "world";
+  std::string expert, format = "md", expert_feedback = "world", controller = "cup";
   std::string estimator;  // empty: the model's own, none for an expert
   int episodes = 100;
   std::uint64_t seed = 0;
@@ -38,6 +39,13 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
   if (opt.tracker.given() && opt.expert != "tracker")
     throw ConfigError("robustness: --tracker-preset and --tracker set --expert tracker");
+  if (opt.controller != "cup" && opt.expert.empty())
+    throw ConfigError("robustness: --controller is for --expert NAME (a model answers in its own actions)");
+  if (opt.controller != "cup" && world.embodiment != Embodiment::arm)
+    throw ConfigError("robustness: --controller " + opt.controller + " drives an arm's joints: give --embodiment arm");
+  if (opt.controller != "cup" && (opt.factors.empty() || std::find(opt.factors.begin(), opt.factors.end(), "action_noise") != opt.factors.end()))
+    throw ConfigError("robustness: --controller " + opt.controller + ": action noise and bias are drawn in the cup's units; "
+                      "name the factors without action_noise (--factors none, friction, ...)");
   const bool sensed = opt.expert_feedback == "observations";
   if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
@@ -71,6 +79,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     run.record = model->record;
   } else {
     ExpertConfig config;
+    if (opt.controller == "joint_torque") config.controller = ActionKind::joint_torque;
     if (opt.expert == "tracker") {
       if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
       config.recordings =
@@ -81,7 +90,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     const ExpertFeedback feedback = sensed ? ExpertFeedback::observations : ExpertFeedback::world;
     factory = [name = opt.expert, config, feedback] { return std::make_unique<OwnedExpertPolicy>(make_expert(name, config), feedback); };
     run.policy = "expert " + opt.expert + (opt.demos.empty() ? "" : " (recordings " + opt.demos.string() + ")") +
-                 opt.tracker.as_arguments() +
+                 opt.tracker.as_arguments() + (opt.controller == "cup" ? "" : ", in joint torques") +
                  (sensed ? ", feedback on the observations" : "");
     request.reads_world = !sensed;
   }
@@ -122,6 +131,11 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
   opt->tracker.add_to(*cmd);
+  cmd->add_option("--controller", opt->controller,
+                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions told "
+                  "in the joint torques the cup controller held)")
+      ->check(CLI::IsMember({"cup", "joint_torque"}))
+      ->capture_default_str();
   cmd->add_option("--expert-feedback", opt->expert_feedback,
                   "What the expert's feedback acts on: world (its own privilege; the sensing factors are left out) or "
                   "observations (what a policy is shown; its choices still read the world)")

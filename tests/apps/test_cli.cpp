@@ -1169,6 +1169,16 @@ TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable)
   p = run(cmd + "--expert-feedback observations");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("--expert-feedback is for --expert"));
+  // An expert in joint torques: the arm's, and without the action noise drawn in the cup's units.
+  p = run(expert + "--factors none --controller joint_torque");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("give --embodiment arm"));
+  p = run(expert + "--embodiment arm --factors action_noise --controller joint_torque");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("without action_noise"));
+  p = run(expert + "--embodiment arm --factors none --controller joint_torque", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("\nnone,none,"));
   std::filesystem::remove(out);
   std::filesystem::remove(world);
   std::filesystem::remove(model);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include <dicestack/core/error.hpp>
@@ -204,6 +205,50 @@ TEST(ExpertRegistry, AReplacedFactoryIsUsedAndCanBePutBack) {
   EXPECT_EQ(test::error_of([] { make_expert("scripted"); }), "no scripted here");
   ExpertRegistry::global().replace("scripted", std::move(old));
   EXPECT_EQ(make_expert("scripted")->name(), "scripted");
+}
+
+}  // namespace
+}  // namespace dicestack
+
+namespace dicestack {
+namespace {
+
+// Cup actions fixed in advance, one per step.
+class FixedCupActions final : public Expert {
+ public:
+  std::string name() const override { return "fixed"; }
+  Action action(int t) const { return {0.4 * std::sin(0.3 * t), 0.2 * std::cos(0.2 * t), 0.3 * std::sin(0.1 * t)}; }
+
+ private:
+  void do_reset(std::uint64_t) override {}
+  Action do_act(const DiceEnv& env, const State&) override { return action(env.t()); }
+};
+
+// Told in joint torques, a cup expert moves the held cup (in free space) as its cup actions do.
+TEST(Expert, ACupExpertToldInJointTorquesMovesTheHeldCupAsItsCupActionsDo) {
+  WorldConfig arm;
+  arm.embodiment = Embodiment::arm;
+  State lifted = paper_start_state(arm);
+  lifted[state_index::kCupY] += 1.5;  // clear of the dice
+  const FixedCupActions cup;
+  auto torques = in_joint_torques(std::make_unique<FixedCupActions>());
+  EXPECT_EQ(torques->name(), "fixed");
+  EXPECT_EQ(torques->controller(), ActionKind::joint_torque);
+  DiceEnv held(arm), reference(arm);
+  held.reset_to(lifted);
+  for (int t = 0; t < 15; ++t) {
+    reference.restore(held.snapshot());
+    const Action a = torques->act(held);
+    ASSERT_EQ(a.kind(), ActionKind::joint_torque);
+    const State want = reference.step(cup.action(t)).observation, got = held.step(a).observation;
+    for (std::size_t k : {state_index::kCupVx, state_index::kCupVy, state_index::kCupW})
+      EXPECT_NEAR(got[k], want[k], 0.05) << "step " << t << ", number " << k;
+  }
+  DiceEnv floating{WorldConfig{}};
+  EXPECT_THROW(torques->act(floating), InputError);
+  ExpertConfig config;
+  config.controller = ActionKind::joint_torque;
+  EXPECT_EQ(make_expert("scripted", config)->controller(), ActionKind::joint_torque);
 }
 
 }  // namespace

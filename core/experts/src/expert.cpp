@@ -334,8 +334,8 @@ Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const St
     DiceEnv& ahead = planning_sim(ahead_, env);
     ahead.restore(env.snapshot());
     for (const Action& p : pending)
-      if (ahead.t() >= ahead.config().episode.max_steps || ahead.step(p).terminated) return Action{0.0, 0.0, 0.0};
-    if (ahead.t() >= ahead.config().episode.max_steps) return Action{0.0, 0.0, 0.0};
+      if (ahead.t() >= ahead.config().episode.max_steps || ahead.step(p).terminated) return Action::zeros(controller());
+    if (ahead.t() >= ahead.config().episode.max_steps) return Action::zeros(controller());
     at = &ahead;
   }
   State feedback = at == &env ? now : at->get_state();
@@ -343,8 +343,8 @@ Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const St
     for (std::size_t k = 0; k < kStateDim; ++k) feedback[k] = (*sensed)[k] + feedback[k] - now[k];
   Action a = do_act(*at, feedback);
   require_finite(a, name() + " expert: action");
-  const auto& limit = env.config().action.limit;
-  for (std::size_t k = 0; k < kActionDim; ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
+  const auto limit = action_limit(env.config(), a.kind());
+  for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
   return a;
 }
 
@@ -398,7 +398,8 @@ std::vector<ExpertInfo> ExpertRegistry::list() const {
 std::vector<ExpertInfo> expert_list() { return ExpertRegistry::global().list(); }
 
 std::unique_ptr<Expert> make_expert(std::string_view name, const ExpertConfig& config) {
-  return ExpertRegistry::global().create(name, config);
+  auto expert = ExpertRegistry::global().create(name, config);
+  return config.controller == ActionKind::joint_torque ? in_joint_torques(std::move(expert)) : std::move(expert);
 }
 
 ExpertEpisode run_expert_episode(Expert& expert, DiceEnv& env, bool keep_trajectory) {

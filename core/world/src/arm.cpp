@@ -95,9 +95,18 @@ std::array<double, 3> arm_link_rates(const ArmConfig& arm, const std::array<doub
   return rates;
 }
 
-std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
-                                  double dt, Vec2 gravity) {
-  using Vec4 = Eigen::Vector4d;
+namespace {
+
+using Vec4 = Eigen::Vector4d;
+
+// The chain's mass matrix on the absolute angles, and what its centripetal terms and gravity ask
+// of the angles' forces.
+struct ChainDynamics {
+  Eigen::Matrix4d m;
+  Vec4 bias;
+};
+
+ChainDynamics chain_dynamics(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
   const auto& a = now.angles;
   const auto& w = now.rates;
   // Each body's centre and its derivative by each angle: a link's centre lies half its length
@@ -113,7 +122,7 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   // -sum_j reach_ij * (cos a_j, sin a_j) * w_j^2.
   const auto reach = [&](std::size_t i, std::size_t j) { return j < i ? arm.link_lengths[j] : j == i ? along[i] : 0.0; };
   Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-  Vec4 bias = Vec4::Zero();  // what the centripetal terms and gravity ask of the angles' forces
+  Vec4 bias = Vec4::Zero();
   for (std::size_t i = 0; i < 4; ++i) {
     Eigen::Matrix<double, 2, 4> jv = Eigen::Matrix<double, 2, 4>::Zero();
     Eigen::Vector2d centripetal = Eigen::Vector2d::Zero();
@@ -127,6 +136,54 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
     m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) += inertia[i];
     bias += mass[i] * jv.transpose() * (centripetal - Eigen::Vector2d(gravity.x, gravity.y));
   }
+  return {m, bias};
+}
+
+// Generalised forces on the absolute angles as joint torques, each clipped to its limit: the
+// force on body j is its joint's torque less the next joint's (which acts back on it).
+std::array<double, 4> joint_torques_of(const ArmConfig& arm, const Vec4& force) {
+  std::array<double, 4> torque{};
+  double after = 0.0;
+  for (int j = 3; j >= 0; --j) {
+    after += force(j);
+    torque[static_cast<std::size_t>(j)] = after;
+  }
+  for (std::size_t j = 0; j < 4; ++j) torque[j] = std::clamp(torque[j], -arm.torque_limit[j], arm.torque_limit[j]);
+  return torque;
+}
+
+}  // namespace
+
+std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
+                                              Vec2 gravity) {
+  const ChainDynamics d = chain_dynamics(arm, now, gravity);
+  return joint_torques_of(arm, d.m * Vec4(accel[0], accel[1], accel[2], accel[3]) + d.bias);
+}
+
+std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity_change, double turn_change,
+                                        double dt) {
+  const ChainDynamics d = chain_dynamics(arm, now, {0.0, 0.0});
+  // Joint torques to the forces on the absolute angles (each joint turns its body and the one
+  // before it back), then to the cup's velocity and turn through the task's Jacobian.
+  Eigen::Matrix4d forces = Eigen::Matrix4d::Identity();
+  for (Eigen::Index j = 1; j < 4; ++j) forces(j - 1, j) = -1.0;
+  Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
+  for (std::size_t j = 0; j < 3; ++j) {
+    task(0, static_cast<Eigen::Index>(j)) = -arm.link_lengths[j] * std::sin(now.angles[j]);
+    task(1, static_cast<Eigen::Index>(j)) = arm.link_lengths[j] * std::cos(now.angles[j]);
+  }
+  task(2, 3) = 1.0;
+  const Eigen::Matrix<double, 3, 4> a = dt * task * d.m.inverse() * forces;
+  const Eigen::Matrix3d aat = a * a.transpose() + 1e-12 * Eigen::Matrix3d::Identity();
+  const Vec4 change = a.transpose() * aat.ldlt().solve(Eigen::Vector3d(velocity_change.x, velocity_change.y, turn_change));
+  return {change(0), change(1), change(2), change(3)};
+}
+
+std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
+                                  double dt, Vec2 gravity) {
+  const auto& a = now.angles;
+  const auto& w = now.rates;
+  const ChainDynamics d = chain_dynamics(arm, now, gravity);
   // The task: the cup's centre (the wrist) and its angle.
   Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
   Eigen::Vector3d drift = Eigen::Vector3d::Zero();  // the task's acceleration at zero angular acceleration
@@ -160,17 +217,7 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
     absolute += relative[i];
     accel(static_cast<Eigen::Index>(i)) = (absolute - w[i]) / dt;
   }
-  // Generalised forces on the absolute angles, then the joint torques: the force on body j is
-  // its joint's torque less the next joint's (which acts back on it).
-  const Vec4 force = m * accel + bias;
-  std::array<double, 4> torque{};
-  double after = 0.0;
-  for (int j = 3; j >= 0; --j) {
-    after += force(j);
-    torque[static_cast<std::size_t>(j)] = after;
-  }
-  for (std::size_t j = 0; j < 4; ++j) torque[j] = std::clamp(torque[j], -arm.torque_limit[j], arm.torque_limit[j]);
-  return torque;
+  return joint_torques_of(arm, d.m * accel + d.bias);
 }
 
 }  // namespace dicestack

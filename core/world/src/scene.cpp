@@ -267,6 +267,7 @@ void Scene::apply_joint_torques() {
   // Joint j turns body j by its torque and the body before it back (the ground takes the
   // shoulder's reaction).
   const std::array<b2Body*, 4> chain{links[0], links[1], links[2], bodies[0]};
+  for (std::size_t i = 0; i < 4; ++i) torque_sum[i] += torques[i];
   for (std::size_t i = 0; i < 4; ++i)
     chain[i]->ApplyTorque(static_cast<float>((torques[i] - (i + 1 < 4 ? torques[i + 1] : 0.0)) * u * u), true);
 }

@@ -82,6 +82,7 @@ struct Scene {
   /// at its speed limit in the torque's direction. They are kept in `torques`.
   void hold_joint_torques(const ArmConfig& arm, const std::array<double, 4>& wanted);
   std::array<double, 4> torques{};  // the arm's joint torques in the last substep, N m
+  std::array<double, 4> torque_sum{};  // summed over the substeps of the step under way, N m
 
  private:
   void apply_joint_torques();  // `torques`, each on its body and back on the body before it

@@ -44,6 +44,7 @@ bool World::step(const Action& dv) {
   b2Body* cup = sc.bodies[0];
   const int vel_it = c.physics.velocity_iterations, pos_it = c.physics.position_iterations;
   bool wall = false;
+  sc.torque_sum = {};
   if (dv.kind() == ActionKind::joint_torque) {
     if (c.embodiment != Embodiment::arm)
       throw InputError("action: joint torques need a world whose embodiment is \"arm\"; in this one the cup floats");
@@ -87,6 +88,26 @@ std::array<double, 3> World::arm_link_angles() const { return impl_->scene->link
 std::array<double, 3> World::arm_link_rates() const { return impl_->scene->link_rates(); }
 
 std::array<double, 4> World::arm_joint_torques() const { return impl_->scene->torques; }
+
+ArmMotion World::arm_motion() const {
+  const auto links = arm_link_angles();
+  const auto rates = arm_link_rates();
+  const State s = state();
+  const CupGeometry cup = cup_geometry(impl_->config.cup);
+  ArmMotion m;
+  m.angles = {links[0], links[1], links[2], s[state_index::kCupAngle]};
+  m.rates = {rates[0], rates[1], rates[2], s[state_index::kCupW]};
+  m.cup_velocity = {s[state_index::kCupVx], s[state_index::kCupVy]};
+  m.cup_mass = cup.mass;
+  m.cup_inertia = cup.inertia;
+  return m;
+}
+
+std::array<double, 4> World::arm_step_torques() const {
+  std::array<double, 4> mean = impl_->scene->torque_sum;
+  for (double& t : mean) t /= impl_->config.physics.substeps;
+  return mean;
+}
 
 std::vector<ShapeOutline> World::outlines() const {
   const Scene& sc = *impl_->scene;

@@ -73,6 +73,9 @@ struct ExpertConfig {
   /// "tracker": the recordings it follows (required; built once and shared by every copy). Its
   /// TrackerConfig is the one the Recordings were built with.
   std::shared_ptr<const Recordings> recordings;
+  /// What the expert answers: the cup's velocity change, or (on the arm) joint torques, its cup
+  /// actions told in torques by in_joint_torques.
+  ActionKind controller = ActionKind::cup;
 };
 
 /// A policy that may use the simulator. act() works from any state of an episode, not only
@@ -95,6 +98,8 @@ class Expert {
 
   /// The name make_expert() knows it by.
   virtual std::string name() const = 0;
+  /// What its actions are: the cup's velocity change unless it answers joint torques.
+  virtual ActionKind controller() const { return ActionKind::cup; }
 
  private:
   virtual void do_reset(std::uint64_t seed) = 0;
@@ -103,6 +108,13 @@ class Expert {
 
   std::optional<DiceEnv> ahead_;  // where `pending` leads (act with a delay)
 };
+
+/// `cup_expert` answering in joint torques, for an arm world's joint_torque controller: each cup
+/// action it chooses runs through the cup controller from the environment's snapshot; the
+/// torques that step held on average (World::arm_step_torques), corrected once by the chain's
+/// dynamics towards the cup velocity that step ended at (arm_torque_change), are its answer.
+/// Its name and every choice are the cup expert's. In a floating cup's world it throws InputError.
+std::unique_ptr<Expert> in_joint_torques(std::unique_ptr<Expert> cup_expert);
 
 /// Names make_expert() accepts, with a one-line description each.
 struct ExpertInfo {

@@ -52,4 +52,16 @@ struct ArmMotion {
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
                                   double dt, Vec2 gravity);
 
+/// Joint-space control: the four joint torques that give the chain's absolute angles (the three
+/// links, then the cup) the accelerations `accel` (rad/s^2), from the chain's own dynamics as
+/// arm_torques uses them; each torque clipped to its limit.
+std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
+                                              Vec2 gravity);
+
+/// The least change of four joint torques held through a step of `dt` that changes the cup's
+/// velocity at its end by `velocity_change` and its turn by `turn_change`, from the chain's
+/// dynamics at `now` (linearised: what the contacts do is not in it; no limits applied).
+std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity_change, double turn_change,
+                                        double dt);
+
 }  // namespace dicestack

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/types.hpp>
 #include <dicestack/core/vec2.hpp>
 #include <dicestack/core/world_config.hpp>
@@ -114,8 +115,15 @@ class World {
   std::array<double, 3> arm_link_angles() const;
   /// The arm's link rates now (absolute, rad/s); zeros for the floating cup.
   std::array<double, 3> arm_link_rates() const;
+  /// The arm and the cup as one chain now (arm.hpp's ArmMotion: the links' and the cup's angles
+  /// and rates, the cup's velocity, mass and inertia), for joint-space control.
+  ArmMotion arm_motion() const;
   /// The torque each joint's motor gave in the last substep, N m; zeros for the floating cup.
   std::array<double, 4> arm_joint_torques() const;
+  /// The joint torques averaged over the last step's substeps, N m: held through a step, they
+  /// give the joints the angular impulse the step gave them (how a cup action is told in
+  /// joint torques). Zeros for the floating cup.
+  std::array<double, 4> arm_step_torques() const;
 
   /// True if the cup or a die is within judge.wall_contact_distance of a side wall or the
   /// ceiling now. Like has_overlaps, for probe worlds (e.g. judging recorded states).
