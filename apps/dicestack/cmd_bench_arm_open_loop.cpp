@@ -52,6 +52,7 @@ Judged judge_pattern(const WorldConfig& world, const JointOscillation& pattern, 
 }
 
 int run_arm_open_loop(const ArmOpenLoopOptions& opt) {
+  if (opt.world.embodiment == "cup") throw ConfigError("bench arm-open-loop: the patterns move the arm's joints; drop --embodiment cup");
   WorldConfig base = opt.world.load();
   base.embodiment = Embodiment::arm;
   nlohmann::json rows = nlohmann::json::array();

@@ -32,20 +32,29 @@ struct RobustnessOptions {
   TrackerOption tracker;
 };
 
-void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
-  const WorldConfig world = opt.world.load();
+// An expert in joint torques: on the arm, without the factors drawn in the cup's units or an
+// estimator (its worlds hold no arm links).
+void check_controller(const RobustnessOptions& opt, const WorldConfig& world) {
+  if (opt.controller == "cup") return;
+  const std::string what = "robustness: --controller " + opt.controller;
+  if (opt.expert.empty()) throw ConfigError(what + " is for --expert NAME (a model answers in its own actions)");
+  if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
+  const auto names = [&](const char* factor) { return std::find(opt.factors.begin(), opt.factors.end(), factor) != opt.factors.end(); };
+  if (opt.factors.empty() || names("all") || names("action_noise") || names("action_delay"))
+    throw ConfigError(what + ": an action delay, action noise and bias are drawn for the cup's actions; name the factors "
+                           "without action_delay, action_noise and all (--factors none, friction, ...)");
+  if (!opt.estimator.empty() && opt.estimator != "none")
+    throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; leave --estimator out");
+}
+
+// Every option that does not need a file read, checked before any work.
+void check_options(const RobustnessOptions& opt, const WorldConfig& world) {
   if (opt.model.empty() == opt.expert.empty()) throw ConfigError("robustness: give one of --model M or --expert NAME");
   if (!opt.demos.empty() && opt.expert != "tracker")
     throw ConfigError("robustness: --demos gives the recordings of --expert tracker");
   if (opt.tracker.given() && opt.expert != "tracker")
     throw ConfigError("robustness: --tracker-preset and --tracker set --expert tracker");
-  if (opt.controller != "cup" && opt.expert.empty())
-    throw ConfigError("robustness: --controller is for --expert NAME (a model answers in its own actions)");
-  if (opt.controller != "cup" && world.embodiment != Embodiment::arm)
-    throw ConfigError("robustness: --controller " + opt.controller + " drives an arm's joints: give --embodiment arm");
-  if (opt.controller != "cup" && (opt.factors.empty() || std::find(opt.factors.begin(), opt.factors.end(), "action_noise") != opt.factors.end()))
-    throw ConfigError("robustness: --controller " + opt.controller + ": action noise and bias are drawn in the cup's units; "
-                      "name the factors without action_noise (--factors none, friction, ...)");
+  check_controller(opt, world);
   const bool sensed = opt.expert_feedback == "observations";
   if (sensed && opt.expert.empty()) throw ConfigError("robustness: --expert-feedback is for --expert NAME (a model acts on the observations)");
   check_robustness_factors(opt.factors);
@@ -58,6 +67,12 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     rows.threads = opt.threads;
     check_evaluation(world, rows);
   }
+}
+
+void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
+  const WorldConfig world = opt.world.load();
+  check_options(opt, world);
+  const bool sensed = opt.expert_feedback == "observations";
   if (!opt.out.empty() && cluster.is_root()) check_robustness_out(opt.out, opt.format);  // before any work
   PolicyFactory factory;
   RobustnessRun run;

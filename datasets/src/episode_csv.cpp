@@ -134,6 +134,10 @@ std::string number_text(double v) {
 }
 
 void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftovers) {
+  for (const Action& a : e.actions)  // before the file is made: nothing half-written
+    if (a.kind() != ActionKind::cup)
+      throw InputError(path.string() + ": an episode's file holds the cup's actions (dvx, dvy, dw); joint torques cannot be "
+                                       "written to it");
   AtomicFile file(path, ownership(), leftovers);
   auto& out = file.stream();
   const auto columns = episode_csv_columns();

@@ -18,6 +18,8 @@ namespace dicestack {
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
+  if (config.controller != ActionKind::cup)
+    throw ConfigError("record: demonstration sets hold the cup's actions; an expert answering joint torques cannot be recorded");
   validate(request.perturbation, world);
   require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "episodes");

@@ -170,7 +170,7 @@ class DiceStackEnv(_EnvBase):
     @property
     def unseen(self):
         """Under an observation delay, the actions that ran (as chosen) since the state the last
-        observation shows, in order; (0, 3) without a delay."""
+        observation shows, in order; (0, 3) without a delay. Four columns under joint_torque."""
         return self._env.unseen
 
     @property

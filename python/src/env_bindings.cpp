@@ -214,10 +214,11 @@ class VectorEnv {
   }
 
   std::size_t size() const { return envs_.size(); }
-  /// Each environment's pending (or unseen) actions under its delays, as (d, 3) arrays.
+  /// Each environment's pending (or unseen) actions under its delays, as (d, 3) arrays ((d, 4)
+  /// under joint_torque).
   py::list queues(bool pending) const {
     py::list out;
-    for (const EnvCore& e : envs_) out.append(actions_to_array(pending ? e.pending() : e.unseen()));
+    for (const EnvCore& e : envs_) out.append(actions_to_array(pending ? e.pending() : e.unseen(), controller_));
     return out;
   }
 
@@ -351,27 +352,10 @@ EnvCore& env_core(const py::handle& env) {
   throw py::type_error("expected a dicestack.DiceStackEnv, got " + std::string(py::repr(env)));
 }
 
-void bind_env(py::module_& m) {
-  py::class_<Snapshot>(m, "Snapshot", "An exact copy of an environment; picklable, restores only into the same world")
-      .def_property_readonly("state", [](const Snapshot& s) { return to_array(s.env.world.state()); })
-      .def_property_readonly("t", [](const Snapshot& s) { return s.env.outcome.steps; })
-      .def_property_readonly("world_hash", [](const Snapshot& s) { return s.world_hash; })
-      .def(py::pickle(&snapshot_state, &snapshot_from_state));
+namespace {
 
-  py::class_<Perturbation>(m, "Perturbation", "How far each factor of a perturbed world may go (docs/robustness.md)")
-      .def(py::init<>())
-      .def_static(
-          "load", [](const std::string& level_or_file, const WorldConfig& world) { return load_perturbation(level_or_file, world); },
-          py::arg("level_or_file"), py::arg("world"))
-      .def_static(
-          "from_json",
-          [](const std::string& text, const std::string& source, const WorldConfig& world) {
-            return perturbation_from_json(text, source, world);
-          },
-          py::arg("text"), py::arg("source"), py::arg("world"))
-      .def("to_json", [](const Perturbation& p) { return perturbation_to_json(p); })
-      .def_property_readonly("nominal", &Perturbation::nominal);
-
+// The Env class: one environment.
+void bind_env_core(py::module_& m) {
   py::class_<EnvCore>(m, "Env", "One dice-stacking environment (the core of dicestack.DiceStackEnv)")
       .def(py::init([](const WorldConfig& world, const Perturbation& perturbation, const std::string& estimator,
                        const std::string& controller) {
@@ -406,13 +390,16 @@ void bind_env(py::module_& m) {
       .def_property_readonly("controller", [](const EnvCore& c) { return std::string(action_kind_name(c.controller())); })
       .def_property_readonly("state", [](const EnvCore& c) { return to_array(c.env().get_state()); })
       .def_property_readonly("t", [](const EnvCore& c) { return c.env().t(); })
-      .def_property_readonly("pending", [](const EnvCore& c) { return actions_to_array(c.pending()); })
-      .def_property_readonly("unseen", [](const EnvCore& c) { return actions_to_array(c.unseen()); })
+      .def_property_readonly("pending", [](const EnvCore& c) { return actions_to_array(c.pending(), c.controller()); })
+      .def_property_readonly("unseen", [](const EnvCore& c) { return actions_to_array(c.unseen(), c.controller()); })
       .def_property_readonly("info", [](const EnvCore& c) { return info_dict(c.info()); })
       .def_property_readonly("world", [](const EnvCore& c) { return c.env().config(); })
       .def_property_readonly("world_hash", &EnvCore::world_hash)
       .def_property_readonly("episode_seed", &EnvCore::episode_seed);
+}
 
+// The VectorEnv class: N environments stepped together.
+void bind_vector_env(py::module_& m) {
   py::class_<VectorEnv>(m, "VectorEnv", "N environments stepped in C++ (the core of dicestack.DiceStackVectorEnv)")
       .def(py::init([](const WorldConfig& world, long long num_envs, const py::object& threads, const Perturbation& perturbation,
                        const std::string& estimator, const std::string& controller) {
@@ -434,6 +421,33 @@ void bind_env(py::module_& m) {
       .def("step", &VectorEnv::step, py::arg("actions"))
       .def_property_readonly("pending", [](const VectorEnv& v) { return v.queues(true); })
       .def_property_readonly("unseen", [](const VectorEnv& v) { return v.queues(false); });
+}
+
+}  // namespace
+
+void bind_env(py::module_& m) {
+  py::class_<Snapshot>(m, "Snapshot", "An exact copy of an environment; picklable, restores only into the same world")
+      .def_property_readonly("state", [](const Snapshot& s) { return to_array(s.env.world.state()); })
+      .def_property_readonly("t", [](const Snapshot& s) { return s.env.outcome.steps; })
+      .def_property_readonly("world_hash", [](const Snapshot& s) { return s.world_hash; })
+      .def(py::pickle(&snapshot_state, &snapshot_from_state));
+
+  py::class_<Perturbation>(m, "Perturbation", "How far each factor of a perturbed world may go (docs/robustness.md)")
+      .def(py::init<>())
+      .def_static(
+          "load", [](const std::string& level_or_file, const WorldConfig& world) { return load_perturbation(level_or_file, world); },
+          py::arg("level_or_file"), py::arg("world"))
+      .def_static(
+          "from_json",
+          [](const std::string& text, const std::string& source, const WorldConfig& world) {
+            return perturbation_from_json(text, source, world);
+          },
+          py::arg("text"), py::arg("source"), py::arg("world"))
+      .def("to_json", [](const Perturbation& p) { return perturbation_to_json(p); })
+      .def_property_readonly("nominal", &Perturbation::nominal);
+
+  bind_env_core(m);
+  bind_vector_env(m);
 }
 
 }  // namespace dicestack::python

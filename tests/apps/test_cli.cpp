@@ -1175,7 +1175,10 @@ TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable)
   EXPECT_THAT(p.output, HasSubstr("give --embodiment arm"));
   p = run(expert + "--embodiment arm --factors action_noise --controller joint_torque");
   EXPECT_EQ(p.status, 1);
-  EXPECT_THAT(p.output, HasSubstr("without action_noise"));
+  EXPECT_THAT(p.output, HasSubstr("without action_delay, action_noise and all"));
+  p = run(expert + "--embodiment arm --factors none,all --controller joint_torque");
+  EXPECT_EQ(p.status, 1);
+  EXPECT_THAT(p.output, HasSubstr("without action_delay, action_noise and all"));
   p = run(expert + "--embodiment arm --factors none --controller joint_torque", false);
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(p.output, HasSubstr("\nnone,none,"));

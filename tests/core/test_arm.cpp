@@ -163,6 +163,38 @@ TEST(Arm, JointTorquesAreHeldThroughTheStepWithinTheirLimits) {
   EXPECT_EQ(env.torque_space().high, c.arm.torque_limit);
 }
 
+// A joint at its speed limit gets no torque that would turn it faster.
+TEST(Arm, AJointAtItsSpeedLimitIsNotDrivenFaster) {
+  WorldConfig c = arm_world();
+  c.arm.speed_limit[3] = 2.0;  // rad/s: the wrist reaches it within a step at its torque limit
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;
+  World w(c, lifted);
+  bool withheld = false;
+  for (int t = 0; t < 10; ++t) {
+    w.step(Action::torques({0.0, 0.0, 0.0, 1e6}));
+    const double wrist_rate = w.state()[si::kCupW] - w.arm_link_rates()[2];
+    EXPECT_LT(wrist_rate, 2.0 + 1.0) << "step " << t;  // at most one substep of the limit's torque beyond it
+    withheld = withheld || w.arm_joint_torques()[3] == 0.0;
+  }
+  EXPECT_TRUE(withheld);
+}
+
+// The torque change asked for a velocity change gives it, in free space.
+TEST(Arm, ATorqueChangeChangesTheCupsVelocityByWhatWasAsked) {
+  const WorldConfig c = arm_world();
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;
+  World base(c, lifted), changed(c, lifted);
+  const std::array<double, 4> hold{0.0, 0.0, 0.0, 0.0};
+  const auto delta = arm_torque_change(c.arm, base.arm_motion(), {0.3, -0.2}, 0.5, c.physics.control_dt);
+  base.step(Action::torques(hold));
+  changed.step(Action::torques({delta[0], delta[1], delta[2], delta[3]}));
+  EXPECT_NEAR(changed.state()[si::kCupVx] - base.state()[si::kCupVx], 0.3, 0.03);
+  EXPECT_NEAR(changed.state()[si::kCupVy] - base.state()[si::kCupVy], -0.2, 0.03);
+  EXPECT_NEAR(changed.state()[si::kCupW] - base.state()[si::kCupW], 0.5, 0.05);
+}
+
 TEST(Arm, ALinkOnAWallIsWallContact) {
   WorldConfig c = arm_world();
   State s = paper_start_state(c);

@@ -11,7 +11,7 @@
 namespace dicestack {
 namespace {
 
-WorldConfig arm_world() {
+WorldConfig oscillating_arm_world() {
   WorldConfig c;
   c.embodiment = Embodiment::arm;
   return c;
@@ -20,7 +20,7 @@ WorldConfig arm_world() {
 // In free space a still pattern holds the arm where it started, and a swinging elbow follows
 // its sine.
 TEST(ArmOscillation, TheServoHoldsEachJointOnItsPattern) {
-  const WorldConfig c = arm_world();
+  const WorldConfig c = oscillating_arm_world();
   DiceEnv env(c);
   State start = paper_start_state(c);
   start[state_index::kCupY] += 1.5;  // clear of the dice: nothing but the servo moves the arm
@@ -50,7 +50,7 @@ TEST(ArmOscillation, TheSearchIsTheSameOnAnyNumberOfThreads) {
   OscillationSearch search;
   search.starts = 2;
   search.evaluations = 24;
-  WorldConfig c = arm_world();
+  WorldConfig c = oscillating_arm_world();
   c.episode.max_steps = 40;
   search.threads = 1;
   const OscillationResult one = search_oscillation(c, search);

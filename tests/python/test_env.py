@@ -219,6 +219,17 @@ def test_the_joint_torque_controller_takes_the_arms_four_torques():
         dicestack.DiceStackEnv(controller="joint_torque")
     with pytest.raises(ValueError, match="controller must be"):
         dicestack.DiceStackEnv(embodiment="arm", controller="torque")
+    # Factors drawn in the cup's units, and estimators, are refused (at the reset that asks for them too).
+    with pytest.raises(ValueError, match="action delay, action noise and bias"):
+        dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"action_delay": 2})
+    with pytest.raises(ValueError, match="action delay, action noise and bias"):
+        env.reset(seed=4, options={"perturb": {"action_noise": 0.1}})
+    with pytest.raises(ValueError, match="estimator"):
+        dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", estimator="kalman")
+    late = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"observation_delay": 2})
+    late.reset(seed=3)
+    late.step(held)
+    assert late.pending.shape == (0, 4) and late.unseen.shape == (1, 4)
     # The vector env steps the same episodes.
     vec = dicestack.DiceStackVectorEnv(2, embodiment="arm", controller="joint_torque")
     vec.reset(seed=3)

@@ -28,6 +28,8 @@ State DiceEnv::reset_to(const State& state, std::uint64_t seed) {
 StepResult DiceEnv::step(const Action& action) {
   require_finite(action, "action");
   const auto& c = config();
+  if (action.kind() == ActionKind::joint_torque && c.embodiment != Embodiment::arm)
+    throw InputError("action: joint torques need a world whose embodiment is \"arm\"; in this one the cup floats");
   Action a = action;
   const auto scale = action_scale(c, a.kind()), limit = action_limit(c, a.kind());
   for (std::size_t k = 0; k < a.size(); ++k) {
@@ -133,23 +135,23 @@ Box<kStateDim> DiceEnv::observation_space() const {
   return box;
 }
 
-Box<kActionDim> DiceEnv::action_space() const {
-  Box<kActionDim> box;
-  for (std::size_t k = 0; k < kActionDim; ++k) {
-    box.high[k] = config().action.limit[k];
-    box.low[k] = -box.high[k];
+namespace {
+
+template <std::size_t N>
+Box<N> within(const std::array<double, N>& limit) {
+  Box<N> box;
+  for (std::size_t k = 0; k < N; ++k) {
+    box.high[k] = limit[k];
+    box.low[k] = -limit[k];
   }
   return box;
 }
 
-Box<kJointCount> DiceEnv::torque_space() const {
-  Box<kJointCount> box;
-  for (std::size_t k = 0; k < kJointCount; ++k) {
-    box.high[k] = config().arm.torque_limit[k];
-    box.low[k] = -box.high[k];
-  }
-  return box;
-}
+}  // namespace
+
+Box<kActionDim> DiceEnv::action_space() const { return within(config().action.limit); }
+
+Box<kJointCount> DiceEnv::torque_space() const { return within(config().arm.torque_limit); }
 
 EnvPool::EnvPool(const WorldConfig& world, int threads)
     : world_(world), envs_(static_cast<std::size_t>(resolve_threads(threads))) {

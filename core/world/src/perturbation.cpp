@@ -375,6 +375,15 @@ PerturbationDraw channel_draw_from_json(std::string_view text, const std::string
   return d;
 }
 
+bool takes_joint_torques(const PerturbationDraw& draw) {
+  if (draw.action_delay > 0) return false;
+  for (std::size_t k = 0; k < kActionDim; ++k)
+    if (draw.action_bias[k] != 0.0 || draw.action_noise[k] > 0.0) return false;
+  return true;
+}
+
+bool takes_joint_torques(const Perturbation& p) { return p.action_delay == 0 && p.action_noise == 0.0 && p.action_bias == 0.0; }
+
 PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw)
     : draw_(draw), noise_(draw.noise_seed), chosen_(static_cast<std::size_t>(draw.action_delay), Action{0.0, 0.0, 0.0}) {}
 
@@ -388,19 +397,14 @@ State PerturbedChannel::observe(const State& state) {
 }
 
 Action PerturbedChannel::execute(const Action& chosen) {
+  if (chosen.kind() != ActionKind::cup && !takes_joint_torques(draw_))
+    throw InputError("an action delay, action noise and bias are drawn for the cup's actions; joint torques cannot take them");
   chosen_.push_back(chosen);  // holds action_delay zeros from the start: nothing runs before then
   Action a = chosen_.front();
   chosen_.pop_front();
-  // The zeros the delay starts with are the cup's; for joint torques they are zero torques.
-  if (a.kind() != chosen.kind() && a == Action{}) a = Action::zeros(chosen.kind());
   ran_.push_back(a);
   if (ran_.size() > static_cast<std::size_t>(draw_.observation_delay)) ran_.pop_front();
-  if (a.kind() != ActionKind::cup) {
-    for (std::size_t k = 0; k < kActionDim; ++k)
-      if (draw_.action_bias[k] != 0.0 || draw_.action_noise[k] > 0.0)
-        throw InputError("action noise and bias are drawn for cup actions; joint torques cannot take them");
-    return a;
-  }
+  if (a.kind() != ActionKind::cup) return a;
   for (std::size_t k = 0; k < kActionDim; ++k) {
     a[k] += draw_.action_bias[k];
     if (draw_.action_noise[k] > 0.0) a[k] += draw_.action_noise[k] * noise_.normal();

@@ -2,8 +2,9 @@
 // The open-loop question on the arm: a fixed oscillation of the arm's joints (an offset,
 // amplitude, frequency and phase per joint, and a time to stop), which sees the arm's own
 // joints and never the cup or the dice, searched with CMA-ES over a set of starts. A joint
-// servo (gravity compensation plus a critically damped PD) holds each joint on its pattern
-// through the joint_torque controller. docs/arm.md, "The open-loop question".
+// servo (computed torque: the pattern's acceleration plus a critically damped PD, through the
+// chain's dynamics) holds each joint on its pattern through the joint_torque controller.
+// docs/arm.md, "The open-loop question".
 #include <array>
 #include <cstdint>
 #include <functional>

@@ -87,7 +87,8 @@ class Expert {
   /// Starts a new episode; `seed` seeds every random choice the expert makes.
   void reset(std::uint64_t seed);
 
-  /// The action (dvx, dvy, dw) for env's current state, within config.action.limit.
+  /// The action for env's current state, within its limits (action_limit): the cup's (dvx, dvy,
+  /// dw), or joint torques for an expert whose controller() is joint_torque.
   /// Under an action delay, `pending` holds what runs before this action lands (History's
   /// pending): the expert then acts for the state the simulator says they lead to, as a Smith
   /// predictor does (zeros if the episode ends first). With `sensed`, its feedback acts on that

@@ -21,7 +21,8 @@ using State = std::array<double, kStateDim>;
 /// What an action commands: the cup's velocity change (the paper's "force control", every
 /// embodiment: the arm's operational-space controller realises it), or the arm's four joint
 /// torques (the joint_torque controller).
-enum class ActionKind : std::uint8_t { cup, joint_torque };
+/// Eight bytes, so an Action has no padding: ranks exchange Actions as plain bytes.
+enum class ActionKind : std::uint64_t { cup, joint_torque };
 
 /// One control step's command. A cup action is a velocity change of the cup applied at the
 /// start of the step, (dvx, dvy, dw) in (m/s, m/s, rad/s); a joint-torque action is the four

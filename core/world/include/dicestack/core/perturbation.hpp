@@ -113,6 +113,12 @@ std::string draw_to_json(const PerturbationDraw& draw);
 /// `source` and the field out of range, or when there is observation noise and no noise seed.
 PerturbationDraw channel_draw_from_json(std::string_view text, const std::string& source);
 
+/// Whether joint-torque actions (the arm's joint_torque controller) can run under `draw` or a
+/// perturbation's draws: no action delay (its queue starts with the cup's zeros), no action noise
+/// and no bias (drawn in the cup's units).
+bool takes_joint_torques(const PerturbationDraw& draw);
+bool takes_joint_torques(const Perturbation& perturbation);
+
 /// What a perturbed episode's policy sees and what the world executes (the draw's sensing and
 /// actuation), step by step; rollout() and the Python environment share it, so both give the
 /// same episodes.
