@@ -168,6 +168,17 @@ TrainingPerturbation learner_perturbation(const Params& params, const WorldConfi
   return t;
 }
 
+namespace {
+
+// A map whose row holds the step index of the choices made so far, not of the step its action
+// lands at ("/landing").
+bool reads_choice_clock(const FeatureMap& features) {
+  const auto columns = features.column_names();
+  return std::find(columns.begin(), columns.end(), "t") != columns.end() && !features.name().ends_with(kLandingSuffix);
+}
+
+}  // namespace
+
 void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner,
                         bool own_choices) {
   const Perturbation& t = p.trained;
@@ -184,6 +195,10 @@ void require_labellable(const TrainingPerturbation& p, const FeatureMap& feature
     throw ConfigError(where + delayed + " cannot be labelled on the map " + features.name() +
                       ": the expert answers the state its action lands in, which the row does not show; use an "
                       "\"/ahead\" or \"/landing\" map, or an estimator (estimator=kalman, the default)");
+  if (t.action_delay > 0 && t.delays_drawn && reads_choice_clock(features))
+    throw ConfigError(where + "a drawn action_delay cannot be labelled on the map " + features.name() +
+                      ": its clock counts the choices made, and the label is the reference where the action lands, a "
+                      "drawn number of steps later; use the map's \"/landing\" form, whose clock is that step");
   if (t.observation_delay > 0 && t.delays_drawn)
     throw ConfigError(where + "a drawn observation_delay cannot be labelled: the row does not say how old its state is; "
                               "fix the delay (delays_drawn false) or train behind an estimator");

@@ -111,6 +111,10 @@ TEST(Dart, AFactorTheExpertCannotLabelIsRefusedByName) {
   // The documented recipe: an action delay drawn per episode on a "/landing" map.
   acting.delays_drawn = true;
   EXPECT_NO_THROW(require_labellable(through(acting), feature_map("state+clock+start_state@dice/position/landing"), "dart"));
+  // ... not on its "/ahead" form, whose clock counts the choices and not the landing step.
+  EXPECT_THAT(test::error_of([&] { require_labellable(through(acting), ahead, "dart"); }),
+              HasSubstr("a drawn action_delay cannot be labelled on the map state+clock/ahead"));
+  EXPECT_NO_THROW(require_labellable(through(acting), feature_map("state/ahead"), "dart"));  // no clock to mislead
   seeing.delays_drawn = true;
   EXPECT_THAT(test::error_of([&] { require_labellable(through(seeing), ahead, "dart"); }),
               HasSubstr("a drawn observation_delay cannot be labelled"));

@@ -40,7 +40,8 @@ class JointTorqueExpert final : public Expert {
     return Action::torques(torques);
   }
 
-  static constexpr int kCorrections = 1;  // halves the cup's velocity error in contact (docs/arm.md); more gain nothing
+  // One halves the cup's velocity error in contact; more gained nothing (docs/notebook/2026-11-28-arm-open-loop.md).
+  static constexpr int kCorrections = 1;
 
   std::unique_ptr<Expert> cup_;
   std::optional<DiceEnv> scratch_;  // where each cup action runs once to be told in torques
