@@ -97,9 +97,10 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     if (opt.controller == "joint_torque") config.controller = ActionKind::joint_torque;
     if (opt.expert == "tracker") {
       if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
-      config.recordings =
-          make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, opt.tracker.config(), opt.seed,
-                          opt.threads, cluster);
+      TrackerConfig tracker = opt.tracker.config();
+      tracker.controller = config.controller;  // its simulations choose what stacks as it will answer
+      config.recordings = make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, tracker,
+                                          opt.seed, opt.threads, cluster);
     }
     make_expert(opt.expert, config);  // an unknown name fails here, before any row
     const ExpertFeedback feedback = sensed ? ExpertFeedback::observations : ExpertFeedback::world;

@@ -244,8 +244,15 @@ TEST(Expert, ACupExpertToldInJointTorquesMovesTheHeldCupAsItsCupActionsDo) {
     for (std::size_t k : {state_index::kCupVx, state_index::kCupVy, state_index::kCupW})
       EXPECT_NEAR(got[k], want[k], 0.05) << "step " << t << ", number " << k;
   }
+  // Telling an action in torques leaves the environment exactly where it was.
+  const State before = held.get_state();
+  const int t = held.t();
+  EXPECT_EQ(told_in_torques(held, cup.action(3)).kind(), ActionKind::joint_torque);
+  EXPECT_TRUE(test::bit_equal(held.get_state(), before));
+  EXPECT_EQ(held.t(), t);
   DiceEnv floating{WorldConfig{}};
   EXPECT_THROW(torques->act(floating), InputError);
+  EXPECT_THROW(told_in_torques(floating, cup.action(0)), InputError);
   ExpertConfig config;
   config.controller = ActionKind::joint_torque;
   EXPECT_EQ(make_expert("scripted", config)->controller(), ActionKind::joint_torque);

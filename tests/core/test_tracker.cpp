@@ -263,6 +263,11 @@ TEST(TrackerExpert, ChoosesOnceAndFollows) {
   config.recordings = std::make_shared<const Recordings>(paths, w, c, 0);
   auto tracker = make_expert("tracker", config);
   EXPECT_EQ(tracker->name(), "tracker");
+  {  // answering joint torques, it needs recordings whose simulations were told in them too
+    ExpertConfig torques = config;
+    torques.controller = ActionKind::joint_torque;
+    EXPECT_THROW(make_expert("tracker", torques), ConfigError);
+  }
   // From the recording's own start the tracker reproduces its cup path.
   DiceEnv env(w);
   env.reset_to(paths[0].states.front());
@@ -362,7 +367,7 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   const PathFollower follower(r.paths()[current.path], current.warp, frame, 0, c.gain);
   while (env.t() < 20) env.step(follower.act(env.get_state(), env.t()));
   env.step({0.6, 0.0, 0.0});  // the knock
-  ASSERT_FALSE(still_succeeds(follower, env, sim, c.hold_steps)) << "the knock did not matter";
+  ASSERT_FALSE(still_succeeds(follower, env, sim, c.hold_steps, c.controller)) << "the knock did not matter";
   const TrackerChoice a = rescue_path(r, env, sim, frame, current, follower.phase(env.t()), 5);
   const TrackerChoice b = rescue_path(r, env, sim, frame, current, follower.phase(env.t()), 5);
   ASSERT_TRUE(a.success);
@@ -371,7 +376,7 @@ TEST(RescuePath, JoinsARecordingThatStillSucceedsFromAKnockedState) {
   EXPECT_EQ(a.path, b.path);
   EXPECT_EQ(a.warp.phase, b.warp.phase);
   EXPECT_EQ(a.simulations, b.simulations);
-  EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps));
+  EXPECT_TRUE(still_succeeds(PathFollower(r.paths()[a.path], a.warp, frame, env.t(), c.gain), env, sim, c.hold_steps, c.controller));
 }
 
 // The tracker's episode from paths[0]'s start, knocked at step 20 (dvx 0.6).

@@ -296,7 +296,7 @@ class TrackerExpert final : public Expert {
       follow(t);
     } else if (c.rescue > 0 && t - last_check_ >= c.rescue && t - start_step_ < follower_.length()) {
       last_check_ = t;
-      if (!still_succeeds(follower_, env, planning_sim(sim_, env), c.hold_steps)) {
+      if (!still_succeeds(follower_, env, planning_sim(sim_, env), c.hold_steps, c.controller)) {
         choice_ = rescue_path(*recordings_, env, *sim_, frame_, choice_, follower_.phase(t), seed_);
         follow(t);
       }
@@ -359,6 +359,11 @@ ExpertRegistry& ExpertRegistry::global() {
            [](const ExpertConfig& c) -> std::unique_ptr<Expert> {
              if (!c.recordings)
                throw ConfigError("expert \"tracker\" needs recordings to follow (a demonstration set: --demos)");
+             if (c.recordings->config().controller != c.controller)
+               throw ConfigError(std::string("expert \"tracker\" answers for the ") + std::string(action_kind_name(c.controller)) +
+                                 " controller, its recordings were prepared for the " +
+                                 std::string(action_kind_name(c.recordings->config().controller)) +
+                                 " one: its simulations would choose paths for the other");
              return std::make_unique<TrackerExpert>(c);
            });
     return r;

@@ -102,7 +102,7 @@ std::vector<double> start_values(const std::vector<CupPath>& paths, const WorldC
         const PathFollower follower(paths[p], {}, start, 0, c.gain, c.keep_extremes);
         double value = 0.0;
         for (const bool noisy : {false, true}) {
-          const Trial trial = simulate(follower, sims.at(w), snap, c.hold_steps, noisy ? c.refine_noise : Action{},
+          const Trial trial = simulate(follower, sims.at(w), snap, c.hold_steps, c.controller, noisy ? c.refine_noise : Action{},
                                        derive_seed(derive_seed(seed, kRefineNoiseStream), start_index));
           if (trial.success) value += 1.0;
           else if (trial.score > -1000.0) value += 0.2 / (1.0 - trial.score);

@@ -15,10 +15,10 @@ struct Trial {
   bool success = false;
 };
 
-/// `follower` played from `start` in `sim` for its length plus `hold_steps`. A `noise` component
-/// above 0 adds executed-action noise of that std (x action.scale) on that axis, drawn from
-/// `noise_seed`.
-Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps,
+/// `follower` played from `start` in `sim` for its length plus `hold_steps`, each action told in
+/// joint torques under the joint_torque `controller`. A `noise` component above 0 adds
+/// executed-action noise of that std (x action.scale) on that axis, drawn from `noise_seed`.
+Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps, ActionKind controller,
                const Action& noise = {}, std::uint64_t noise_seed = 0);
 
 /// `path` with each step's action folded into the velocity during the step (the state's plus the

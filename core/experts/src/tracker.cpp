@@ -23,8 +23,8 @@ namespace tracker_detail {
 
 namespace si = state_index;
 
-Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps, const Action& noise,
-               std::uint64_t noise_seed) {
+Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& start, int hold_steps, ActionKind controller,
+               const Action& noise, std::uint64_t noise_seed) {
   sim.restore(start);
   Rng rng(noise_seed);
   const auto& scale = sim.config().action.scale;
@@ -37,7 +37,7 @@ Trial simulate(const PathFollower& follower, DiceEnv& sim, const EnvSnapshot& st
     Action a = follower.act(s, sim.t());
     if (noisy)
       for (std::size_t k = 0; k < kActionDim; ++k) a[k] += noise[k] * scale[k] * rng.normal();
-    const StepResult r = sim.step(a);
+    const StepResult r = sim.step(controller == ActionKind::joint_torque ? told_in_torques(sim, a) : a);
     s = r.observation;
     if (r.terminated) {
       trial.success = true;
@@ -134,7 +134,7 @@ int robust_trial(const CupPath& path, const PathWarp& warp, const State& frame, 
   }
   const PathFollower follower(path, jittered, frame, start_step, c.gain, c.keep_extremes);
   const Action noise{c.robust_noise, c.robust_noise, c.robust_noise};
-  return simulate(follower, sim, start, c.hold_steps, noise, seed).success ? 1 : 0;
+  return simulate(follower, sim, start, c.hold_steps, c.controller, noise, seed).success ? 1 : 0;
 }
 
 // x in [-1, 1]^3 (clipped) to a warp of `base` inside the config's bounds.
@@ -166,7 +166,7 @@ class TrackerSearch {
   // kept aside and reported as a failure, so the search goes on.
   Trial consider(std::size_t p, const PathWarp& w) {
     const PathFollower follower(paths_[p], w, frame_, t_, c_.gain, c_.keep_extremes);
-    Trial trial = simulate(follower, sim_, start_, c_.hold_steps);
+    Trial trial = simulate(follower, sim_, start_, c_.hold_steps, c_.controller);
     ++simulations_;
     if (trial.success && c_.robust > 0) {
       int wins = 0;
@@ -507,7 +507,7 @@ std::vector<int> Recordings::probe_scores(const WorldConfig& world, int threads,
         const PathFollower follower(paths_[path], {}, start, 0, config_.gain, config_.keep_extremes);
         const EnvSnapshot snap = env.snapshot();
         // A probe scores 1 for a success as simulated, plus 1 per noisy trial that succeeds too.
-        if (!simulate(follower, sims.at(w), snap, config_.hold_steps).success) return 0;
+        if (!simulate(follower, sims.at(w), snap, config_.hold_steps, config_.controller).success) return 0;
         // The recordings' own noise seeds are those of the first ranking, which variants left as it was.
         const std::uint64_t noise = variants ? derive_seed(derive_seed(seed_, kVariantNoiseStream), path * 1000003 + probe)
                                              : derive_seed(seed_, kProbeNoiseStream);
@@ -529,8 +529,8 @@ TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, Dice
   return search(recordings, env, sim, env.get_state(), candidates, recordings.config().optimise_evaluations, seed);
 }
 
-bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps) {
-  return simulate(follower, sim, env.snapshot(), hold_steps).success;
+bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps, ActionKind controller) {
+  return simulate(follower, sim, env.snapshot(), hold_steps, controller).success;
 }
 
 TrackerChoice rescue_path(const Recordings& recordings, const DiceEnv& env, DiceEnv& sim, const State& frame,

@@ -108,6 +108,10 @@ struct TrackerConfig {
   std::array<double, 4> refine_range{0.2, 0.2, 0.2, 0.0};
   /// The noise of a refinement's noisy trials: DART's default with the tracker (0.1, 0.5, 0.2).
   Action refine_noise{0.1, 0.5, 0.2};
+  /// What its simulations step on the arm: cup actions, or the same actions told in joint
+  /// torques (told_in_torques), so that the path it chooses stacks under held torques. Not a
+  /// setting by name: it follows the controller its expert answers (`--controller`).
+  ActionKind controller = ActionKind::cup;
 };
 
 /// Throws ConfigError naming the first field of `config` out of its range.
@@ -245,7 +249,13 @@ TrackerChoice choose_path(const Recordings& recordings, const DiceEnv& env, Dice
 /// follower started earlier that is longer than the rest of its path plus the hold: a lenient
 /// check, as measured (docs/notebook/2026-11-27-learners-page-history.md, "A demonstrator that
 /// chooses again: rescue and smoothing").
-bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps);
+bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& sim, int hold_steps, ActionKind controller);
+
+/// A cup action told in joint torques in `env` (an arm's): it runs through the cup controller
+/// from env's state; the torques that step held on average (World::arm_step_torques), corrected
+/// once by the chain's dynamics towards the cup velocity the step ended at (arm_torque_change),
+/// are the answer. `env` is put back exactly where it was. Throws InputError for a floating cup.
+Action told_in_torques(DiceEnv& env, const Action& cup);
 
 /// A rescue, mid-episode, when the followed path (`current`, moved into the frame of `frame`,
 /// the episode's start) no longer simulates to a success from env's state: its rest, then every
