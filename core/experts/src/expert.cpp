@@ -343,9 +343,7 @@ Action Expert::act(const DiceEnv& env, std::span<const Action> pending, const St
     for (std::size_t k = 0; k < kStateDim; ++k) feedback[k] = (*sensed)[k] + feedback[k] - now[k];
   Action a = do_act(*at, feedback);
   require_finite(a, name() + " expert: action");
-  const auto limit = action_limit(env.config(), a.kind());
-  for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::clamp(a[k], -limit[k], limit[k]);
-  return a;
+  return clipped(env.config(), a);
 }
 
 ExpertRegistry& ExpertRegistry::global() {

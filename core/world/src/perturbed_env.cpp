@@ -41,12 +41,7 @@ State PerturbedEnv::reset_to(const State& start, std::uint64_t seed) { return fi
 
 State PerturbedEnv::reset(std::uint64_t seed) { return first_shown(env_->reset(seed)); }
 
-Action PerturbedEnv::clip(const Action& a) const {
-  const auto limit = action_limit(env_->config(), a.kind());
-  Action c = a;
-  for (std::size_t k = 0; k < c.size(); ++k) c[k] = std::clamp(c[k], -limit[k], limit[k]);
-  return c;
-}
+Action PerturbedEnv::clip(const Action& a) const { return clipped(env_->config(), a); }
 
 PerturbedStep PerturbedEnv::step(const Action& chosen) {
   const Action clipped = clip(chosen);

@@ -1,6 +1,7 @@
 #include <dicestack/core/hash.hpp>
 #include <dicestack/core/world_config.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -495,6 +496,12 @@ CostConfig WorldConfig::default_cost() {
 std::span<const double> action_limit(const WorldConfig& config, ActionKind kind) {
   if (kind == ActionKind::joint_torque) return config.arm.torque_limit;
   return config.action.limit;
+}
+
+Action clipped(const WorldConfig& config, Action action) {
+  const auto limit = action_limit(config, action.kind());
+  for (std::size_t k = 0; k < action.size(); ++k) action[k] = std::clamp(action[k], -limit[k], limit[k]);
+  return action;
 }
 
 std::span<const double> action_scale(const WorldConfig& config, ActionKind kind) {

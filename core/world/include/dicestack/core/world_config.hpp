@@ -160,6 +160,8 @@ struct WorldConfig {
 /// The largest |value| an environment passes on, per component of an action of `kind`:
 /// action.limit for the cup, arm.torque_limit for joint torques. Refers into `config`.
 std::span<const double> action_limit(const WorldConfig& config, ActionKind kind);
+/// `action` with each component clipped to action_limit(config, action.kind()).
+Action clipped(const WorldConfig& config, Action action);
 /// One unit of a component of an action of `kind`, what action noise is a fraction of:
 /// action.scale for the cup, arm.torque_limit for joint torques. Refers into `config`.
 std::span<const double> action_scale(const WorldConfig& config, ActionKind kind);
