@@ -103,16 +103,18 @@ void add_bench_arm_open_loop_command(CLI::App& bench) {
       ->check(CLI::IsMember(start_names()))
       ->capture_default_str();
   cmd->add_option("--training-starts", opt->search.starts, "Training starts each evaluation of a pattern runs")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 10000))
       ->capture_default_str();
   cmd->add_option("--evaluations", opt->search.evaluations, "CMA-ES's budget of pattern evaluations")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 10000000))
       ->capture_default_str();
   cmd->add_option("--sigma0", opt->search.sigma0, "CMA-ES's first step, in search units")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--seed", opt->search.seed, "Seed of the training starts and of CMA-ES")->check(seed_check())->capture_default_str();
-  cmd->add_option("--episodes", opt->episodes, "Evaluation starts per evaluation seed")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--episodes", opt->episodes, "Evaluation starts per evaluation seed")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   cmd->add_option("--evaluation-seeds", opt->evaluation_seeds, "Seeds of the evaluation starts (as evaluate --seed)")
       ->check(seed_check())
       ->capture_default_str();
