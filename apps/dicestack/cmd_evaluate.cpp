@@ -30,11 +30,24 @@ struct EvaluateOptions {
   bool json = false;
 };
 
+// Sets and recordings hold the cup's actions: a policy in joint torques can be neither saved as
+// one nor scored on one.
+void check_torque_outputs(const EvaluateOptions& opt, const Model& model) {
+  if (model.features().action_kind() != ActionKind::joint_torque) return;
+  if (!opt.save_rollouts.empty())
+    throw ConfigError("evaluate: --save-rollouts writes a demonstration set, which holds the cup's actions; " +
+                      opt.model.string() + " answers joint torques");
+  if (!opt.demos.empty())
+    throw ConfigError("evaluate: --demos scores a policy on recordings of the cup's actions; " + opt.model.string() +
+                      " answers joint torques");
+}
+
 int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   auto model = std::make_shared<const Model>(load_model(opt.model));
-  check_ahead_world(model->features(), world);
+  check_map_world(model->features(), world);
+  check_torque_outputs(opt, *model);
   const std::string estimator = estimator_for(opt.estimator, *model);
   if (!opt.save_rollouts.empty()) check_demo_set_replaceable(opt.save_rollouts);  // before any work
   // A saved episode keeps the true states and replays what the sensors gave (dataset.cpp); the
@@ -58,6 +71,7 @@ int run_evaluate(const EvaluateOptions& opt, Cluster& cluster) {
   request.push = initial_push_from(opt.push);
   request.perturbation = perturbation;
   request.estimator = estimator_config(estimator);
+  request.actions = model->features().action_kind();
   request.rollouts = keep ? &rollouts : nullptr;
   request.results = &results;
   const EvalStats s = evaluate([&] { return std::make_unique<ModelPolicy>(model); }, world, request, cluster);

@@ -69,9 +69,10 @@ int run_learners(bool markdown) {
     print_line(line);
   }
   print_line("each also as NAME/velocity (the regressor answers the cup velocity to set), NAME/position (the cup pose "
-             "to servo to) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
+             "to servo to), on the arm NAME/torque (its four joint torques) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
              "clock of that step), as in NAME/position/landing");
-  print_line("a name is parts joined by +, each once and in this order: state or cup, clock, start or start_state "
+  print_line("a name is parts joined by +, each once and in this order: state or cup, links (the arm's link angles "
+             "and rates), clock, start or start_state "
              "(either may end in @dice: x measured from the start's mean die x), history, retry (the clock and the "
              "start restart at each attempt); any such name is a map (docs/learners.md, \"Feature-map names\")");
   return 0;

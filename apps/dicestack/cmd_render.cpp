@@ -34,6 +34,7 @@ std::vector<State> trajectory(const RenderOptions& opt, const WorldConfig& world
   }
   DiceEnv env(world);
   auto model = std::make_shared<const Model>(load_model(opt.model));
+  check_map_world(model->features(), world);
   ModelPolicy p(model);
   // The first start of `evaluate --seed S`, so a rendered rollout is one that evaluate counted.
   const std::uint64_t start = evaluation_start_seed(opt.seed, 0);

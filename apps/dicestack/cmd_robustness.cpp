@@ -32,12 +32,9 @@ struct RobustnessOptions {
   TrackerOption tracker;
 };
 
-// An expert in joint torques: on the arm, without the factors drawn in the cup's units or an
-// estimator (its worlds hold no arm links).
-void check_controller(const RobustnessOptions& opt, const WorldConfig& world) {
-  if (opt.controller == "cup") return;
-  const std::string what = "robustness: --controller " + opt.controller;
-  if (opt.expert.empty()) throw ConfigError(what + " is for --expert NAME (a model answers in its own actions)");
+// Joint torques run on the arm, without the factors drawn in the cup's units or an estimator
+// (its worlds hold no arm links). `what` names who answers in them.
+void check_torque_run(const std::string& what, const RobustnessOptions& opt, const WorldConfig& world) {
   if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
   const auto names = [&](const char* factor) { return std::find(opt.factors.begin(), opt.factors.end(), factor) != opt.factors.end(); };
   if (opt.factors.empty() || names("all") || names("action_noise") || names("action_delay"))
@@ -45,6 +42,14 @@ void check_controller(const RobustnessOptions& opt, const WorldConfig& world) {
                            "without action_delay, action_noise and all (--factors none, friction, ...)");
   if (!opt.estimator.empty() && opt.estimator != "none")
     throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; leave --estimator out");
+}
+
+// An expert in joint torques (a model answers in its own actions).
+void check_controller(const RobustnessOptions& opt, const WorldConfig& world) {
+  if (opt.controller == "cup") return;
+  const std::string what = "robustness: --controller " + opt.controller;
+  if (opt.expert.empty()) throw ConfigError(what + " is for --expert NAME (a model answers in its own actions)");
+  check_torque_run(what, opt, world);
 }
 
 // Every option that does not need a file read, checked before any work.
@@ -87,7 +92,9 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
   run.estimator = opt.estimator.empty() ? "none" : opt.estimator;
   if (!opt.model.empty()) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
-    check_ahead_world(model->features(), world);
+    check_map_world(model->features(), world);
+    if (model->features().action_kind() == ActionKind::joint_torque)
+      check_torque_run("robustness: " + opt.model.string() + " (a policy in joint torques)", opt, world);
     run.estimator = estimator_for(opt.estimator, *model);
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
     run.policy = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";

@@ -15,7 +15,7 @@ namespace {
 struct TrainOptions {
   WorldOption world;
   DemosOption demos;
-  std::string regressor, learner = "bc", split = "episodes", features;
+  std::string regressor, learner = "bc", split = "episodes", features, controller;
   std::vector<std::string> sets, options;
   std::filesystem::path out, checkpoint;
   std::uint64_t seed = 0;
@@ -33,6 +33,7 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   request.learner = opt.learner;
   request.learner_options = opt.options;
   request.features = opt.features;
+  request.controller = opt.controller;
   request.split = opt.split;
   request.seed = opt.seed;
   request.threads = opt.threads;
@@ -56,17 +57,23 @@ int run_train(const TrainOptions& opt, Cluster& cluster) {
   const auto& record = r.result.model->record;
   if (opt.json) {
     nlohmann::json j{{"model", opt.out.string()}, {"learner", opt.learner}, {"regressor", opt.regressor},
-                     {"features", r.features},    {"seconds", r.seconds},   {"train_error", r.score.train_error}};
-    if (r.score.test_error) j["test_error"] = *r.score.test_error;
+                     {"features", r.features},    {"seconds", r.seconds}};
+    if (r.score) j["train_error"] = r.score->train_error;
+    if (r.score && r.score->test_error) j["test_error"] = *r.score->test_error;
     if (!r.result.curve.empty()) j["curve"] = curve_path.string();
     if (record.contains("tracker_followed")) j["tracker_followed"] = record.at("tracker_followed");
     print_line(j.dump());
   } else {
+    std::string errors;  // a torque policy has none: the recordings hold cup actions
+    if (r.score) {
+      char train[64];
+      std::snprintf(train, sizeof train, ": train error %.3f", r.score->train_error);
+      errors = train;
+    }
+    if (r.score && r.score->test_error) errors += ", test error " + std::to_string(*r.score->test_error).substr(0, 5);
     char line[256];
-    std::snprintf(line, sizeof line, "trained %s with %s in %.2f s: train error %.3f%s -> %s", opt.regressor.c_str(),
-                  opt.learner.c_str(), r.seconds, r.score.train_error,
-                  r.score.test_error ? (", test error " + std::to_string(*r.score.test_error).substr(0, 5)).c_str() : "",
-                  opt.out.string().c_str());
+    std::snprintf(line, sizeof line, "trained %s with %s in %.2f s%s -> %s", opt.regressor.c_str(), opt.learner.c_str(),
+                  r.seconds, errors.c_str(), opt.out.string().c_str());
     print_line(line);
     // Which recording a policy from recordings plays, and how robust the ranking found it:
     // what to look at first when a policy from a few recordings stacks rarely.
@@ -93,6 +100,11 @@ void add_train_command(CLI::App& app, Cluster& cluster) {
                   "Feature map the policy reads, a name of parts such as state+clock+start_state or "
                   "state+clock+start_state@dice+retry/position (default: the learner's; the grammar: `dicestack "
                   "learners`, docs/reference/learners.md)");
+  cmd->add_option("--controller", opt->controller,
+                  "What the policy's actions drive: cup (velocity changes; on the arm through its operational-space "
+                  "controller) or joint_torque (the arm's four torques: dart only, with --embodiment arm; the default "
+                  "map then reads the arm's links and answers torques). Default: what the feature map answers")
+      ->check(CLI::IsMember({"cup", "joint_torque"}));
   cmd->add_option("--split", opt->split,
                   "episodes: train on episodes i % 5 != 4, report test error and give the rest to learners as "
                   "held-out demonstrations; none: all")

@@ -33,6 +33,19 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
   return PerturbedChannel(d);
 }
 
+// Throws InputError naming the episode if `features` cannot make its rows: a map of the arm's
+// links on an episode without them, or labels of another controller's actions.
+void check_rows_of(const Episode& e, const FeatureMap& features) {
+  if (features.reads_links() && e.links.size() != e.states.size())
+    throw InputError("episode \"" + e.name + "\": feature map \"" + features.name() +
+                     "\" reads the arm's links, and the episode has no readings of them");
+  for (std::size_t t = 0; t < e.actions.size(); ++t)
+    if (e.actions[t].kind() != features.action_kind())
+      throw InputError("episode \"" + e.name + "\" step " + std::to_string(t) + ": feature map \"" + features.name() +
+                       "\" answers " + std::string(action_kind_name(features.action_kind())) + " actions, the step's is for the " +
+                       std::string(action_kind_name(e.actions[t].kind())) + " controller");
+}
+
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features, const RowFilter& rows = {}) {
   std::size_t n = 0;
   for (const Episode* e : episodes)
@@ -40,10 +53,12 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
   const auto width = static_cast<Eigen::Index>(features.width());
   Dataset d;
   d.x.resize(static_cast<Eigen::Index>(n), width);
-  d.y.resize(static_cast<Eigen::Index>(n), kActionDim);
+  const std::size_t outputs = features.outputs();
+  d.y.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(outputs));
   Eigen::Index row = 0;
   for (const Episode* e : episodes) {
     check_episode(*e);
+    check_rows_of(*e, features);
     d.episode_begin.push_back(static_cast<std::size_t>(row));
     d.episode_names.push_back(e->name);
     std::optional<PerturbedChannel> channel = replayed_channel(*e, features);
@@ -57,9 +72,10 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
       }
       if (!rows || rows(*e, t)) {
         const History h{std::span<const State>(channel ? seen.data() : e->states.data(), t + 1),
-                        std::span<const Action>(e->actions.data(), t), pending, unseen};
+                        std::span<const Action>(e->actions.data(), t), pending, unseen,
+                        e->links.empty() ? std::span<const ArmLinks>{} : std::span<const ArmLinks>(e->links.data(), t + 1)};
         features.compute(h, {d.x.row(row).data(), static_cast<std::size_t>(width)});
-        features.label(h, e->actions[t], {d.y.row(row).data(), kActionDim});
+        features.label(h, e->actions[t], {d.y.row(row).data(), outputs});
         ++row;
       }
       if (channel) channel->execute(e->actions[t]);
@@ -71,7 +87,7 @@ Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& fea
 Dataset take_rows(const Dataset& all, const std::vector<std::size_t>& rows) {
   Dataset d;
   d.x.resize(static_cast<Eigen::Index>(rows.size()), all.x.cols());
-  d.y.resize(static_cast<Eigen::Index>(rows.size()), kActionDim);
+  d.y.resize(static_cast<Eigen::Index>(rows.size()), all.y.cols());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     d.x.row(static_cast<Eigen::Index>(i)) = all.x.row(static_cast<Eigen::Index>(rows[i]));
     d.y.row(static_cast<Eigen::Index>(i)) = all.y.row(static_cast<Eigen::Index>(rows[i]));

@@ -34,9 +34,16 @@ void check_episode(const Episode& e) {
   if (e.actions.size() != e.states.size() || e.sources.size() != e.states.size())
     throw InputError(who + ": " + std::to_string(e.states.size()) + " states, " + std::to_string(e.actions.size()) +
                      " actions and " + std::to_string(e.sources.size()) + " sources; they must be equal");
+  if (!e.links.empty() && e.links.size() != e.states.size())
+    throw InputError(who + ": " + std::to_string(e.states.size()) + " states and " + std::to_string(e.links.size()) +
+                     " arm link readings; there must be one per state, or none");
   for (std::size_t t = 0; t < e.states.size(); ++t) {
     require_finite(e.states[t], who + " state " + std::to_string(t));
     require_finite(e.actions[t], who + " action " + std::to_string(t));
+  }
+  for (std::size_t t = 0; t < e.links.size(); ++t) {
+    require_finite(e.links[t].angles, who + " link angles " + std::to_string(t));
+    require_finite(e.links[t].rates, who + " link rates " + std::to_string(t));
   }
   if (!e.final_state) {
     if (!e.rewards.empty()) throw InputError(who + ": has rewards but no final state; they are known together");

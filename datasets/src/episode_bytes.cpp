@@ -3,7 +3,7 @@
 namespace dicestack {
 
 void pack_episode(Packer& out, const Episode& e) {
-  out.put_string(e.name).put(e.seed).put_vector(e.states).put_vector(e.actions).put_vector(e.sources);
+  out.put_string(e.name).put(e.seed).put_vector(e.states).put_vector(e.actions).put_vector(e.sources).put_vector(e.links);
   out.put(e.outcome).put_string(e.origin).put<std::uint8_t>(e.final_state.has_value());
   if (e.final_state) out.put(*e.final_state);
   out.put_vector(e.rewards).put<std::uint8_t>(e.terminated).put<std::uint8_t>(e.truncated).put_string(e.perturbation);
@@ -16,6 +16,7 @@ Episode unpack_episode(Unpacker& in) {
   e.states = in.get_vector<State>();
   e.actions = in.get_vector<Action>();
   e.sources = in.get_vector<StepSource>();
+  e.links = in.get_vector<ArmLinks>();
   e.outcome = in.get<Outcome>();
   e.origin = in.get_string();
   if (in.get<std::uint8_t>()) e.final_state = in.get<State>();

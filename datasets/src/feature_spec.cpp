@@ -12,18 +12,19 @@ namespace {
 
 constexpr std::string_view kDiceFrame = "@dice";
 constexpr std::string_view kGrammarHint =
-    "a map is parts joined by \"+\", each once and in this order: state or cup, clock, start or start_state "
-    "(either may end in @dice), history, retry; then /velocity or /position; then /ahead or /landing";
+    "a map is parts joined by \"+\", each once and in this order: state or cup, links, clock, start or start_state "
+    "(either may end in @dice), history, retry; then /velocity, /position or /torque; then /ahead or /landing";
 
 // An input part's place in a name: parts of one rank exclude each other.
-enum Rank { kCurrentRank, kClockRank, kStartRank, kHistoryRank, kRetryRank };
+enum Rank { kCurrentRank, kLinksRank, kClockRank, kStartRank, kHistoryRank, kRetryRank };
 
 struct PartName {
   std::string_view text;
   Rank rank;
 };
-constexpr std::array<PartName, 7> kParts{{{"state", kCurrentRank},
+constexpr std::array<PartName, 8> kParts{{{"state", kCurrentRank},
                                           {"cup", kCurrentRank},
+                                          {"links", kLinksRank},
                                           {"clock", kClockRank},
                                           {"start", kStartRank},
                                           {"start_state", kStartRank},
@@ -42,6 +43,7 @@ void set_part(FeatureSpec& spec, std::string_view part) {
   using S = FeatureSpec::Start;
   if (part == "state") spec.current = C::state;
   if (part == "cup") spec.current = C::cup;
+  if (part == "links") spec.links = true;
   if (part == "clock") spec.clock = true;
   if (part == "start") spec.start = S::summary;
   if (part == "start_state") spec.start = S::whole;
@@ -80,9 +82,11 @@ void parse_suffix(std::string_view name, std::string_view suffix, int& last_rank
   using T = FeatureSpec::Timing;
   const std::string slash = "/" + std::string(suffix);
   int rank = -1;
-  if (suffix == "velocity" || suffix == "position") {
+  if (suffix == "velocity" || suffix == "position" || suffix == "torque") {
     rank = 0;
-    spec.target = suffix == "velocity" ? ActionTarget::velocity : ActionTarget::position;
+    spec.target = suffix == "velocity"   ? ActionTarget::velocity
+                  : suffix == "position" ? ActionTarget::position
+                                         : ActionTarget::torque;
   } else if (suffix == "ahead" || suffix == "landing") {
     rank = 1;
     spec.timing = suffix == "ahead" ? T::ahead : T::landing;
@@ -91,6 +95,9 @@ void parse_suffix(std::string_view name, std::string_view suffix, int& last_rank
   }
   if (rank == last_rank) bad_feature_name(name, in_quotes(slash) + " given with another " + (rank == 0 ? "target" : "timing"));
   if (rank < last_rank) bad_feature_name(name, in_quotes(slash) + " must come before the timing");
+  // A delay's pending and unseen actions move the cup ahead as cup actions; torques do not.
+  if (rank == 1 && spec.target == ActionTarget::torque)
+    bad_feature_name(name, in_quotes(slash) + " moves the cup ahead by cup actions; a \"/torque\" map takes no timing");
   last_rank = rank;
 }
 
@@ -109,6 +116,14 @@ FeatureSpec parse_feature_spec(std::string_view name) {
   return spec;
 }
 
+std::string torque_map_name(std::string_view name) {
+  FeatureSpec spec = parse_feature_spec(name);
+  spec.links = true;
+  spec.target = ActionTarget::torque;
+  spec.timing = FeatureSpec::Timing::now;
+  return to_string(spec);
+}
+
 std::string to_string(const FeatureSpec& spec) {
   using C = FeatureSpec::Current;
   using S = FeatureSpec::Start;
@@ -116,12 +131,14 @@ std::string to_string(const FeatureSpec& spec) {
   std::string out;
   const auto add = [&out](std::string_view part) { out += (out.empty() ? "" : "+") + std::string(part); };
   if (spec.current != C::none) add(spec.current == C::state ? "state" : "cup");
+  if (spec.links) add("links");
   if (spec.clock) add("clock");
   if (spec.start != S::none) add(std::string(spec.start == S::whole ? "start_state" : "start") + (spec.dice_frame ? "@dice" : ""));
   if (spec.previous) add("history");
   if (spec.restart) add("retry");
   if (spec.target == ActionTarget::velocity) out += kVelocityTargetSuffix;
   if (spec.target == ActionTarget::position) out += kPositionTargetSuffix;
+  if (spec.target == ActionTarget::torque) out += kTorqueTargetSuffix;
   if (spec.timing == T::ahead) out += kAheadSuffix;
   if (spec.timing == T::landing) out += kLandingSuffix;
   return out;

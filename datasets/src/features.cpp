@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/judge.hpp>
@@ -19,6 +20,7 @@ using Current = FeatureSpec::Current;
 using Start = FeatureSpec::Start;
 using Timing = FeatureSpec::Timing;
 constexpr std::size_t kCupParts[] = {si::kCupX, si::kCupY, si::kCupAngle, si::kCupVx, si::kCupVy, si::kCupW};
+constexpr std::size_t kLinkColumns = 6;  // the "links" part: three angles, three rates
 
 // The step the current attempt began at, judged in the default world (a map has no world of its
 // own; the tracker's retries judge in it too, so both agree).
@@ -38,6 +40,7 @@ std::string describe(const FeatureSpec& f) {
   std::string out = f.current == Current::state ? "the 24 state numbers"
                     : f.current == Current::cup ? "the cup's six numbers"
                                                 : "no current state (open loop)";
+  if (f.links) out += ", the arm's link angles and rates";
   if (f.clock) out += ", the step index t";
   if (f.start == Start::summary) out += ", the start's cup x and mean die x";
   if (f.start == Start::whole) out += ", the whole start state";
@@ -46,6 +49,7 @@ std::string describe(const FeatureSpec& f) {
   if (f.restart) out += "; the clock and the start restart where a failed attempt has come to rest";
   if (f.target == ActionTarget::velocity) out += "; answers the cup velocity to set";
   if (f.target == ActionTarget::position) out += "; answers the cup pose to servo to (10/s times the pose error)";
+  if (f.target == ActionTarget::torque) out += "; answers the arm's four joint torques";
   if (f.timing != Timing::now) out += "; under delays, the cup moved ahead to where it is when the action lands";
   if (f.timing == Timing::landing) out += ", and the clock of that step";
   return out;
@@ -61,10 +65,11 @@ class SpecFeatureMap final : public FeatureMap {
   ActionTarget target() const override { return spec_.target; }
   bool ahead() const override { return spec_.timing != Timing::now; }
   bool attempts() const override { return spec_.restart; }
+  bool reads_links() const override { return spec_.links; }
   double origin_x(const History& h) const override { return spec_.dice_frame ? mean_dice_x(start_of(h)) : 0.0; }
 
   std::size_t width() const override {
-    return current_width() + (spec_.clock ? 1 : 0) + (spec_.start == Start::summary ? 2 : 0) +
+    return current_width() + (spec_.links ? kLinkColumns : 0) + (spec_.clock ? 1 : 0) + (spec_.start == Start::summary ? 2 : 0) +
            (spec_.start == Start::whole ? kStateDim : 0) + (spec_.previous ? kStateDim : 0) + (spec_.dice_frame ? 1 : 0);
   }
 
@@ -74,6 +79,9 @@ class SpecFeatureMap final : public FeatureMap {
       for (auto n : state_names()) out.emplace_back(n);
     if (spec_.current == Current::cup)
       for (auto k : kCupParts) out.emplace_back(state_names()[k]);
+    if (spec_.links)
+      for (const char* what : {"angle", "rate"})
+        for (int i = 0; i < 3; ++i) out.push_back("link" + std::to_string(i) + "_" + what);
     if (spec_.clock) out.emplace_back("t");
     if (spec_.start == Start::summary) out.insert(out.end(), {"start_cup_x", "start_dice_mean_x"});
     if (spec_.start == Start::whole)
@@ -102,6 +110,14 @@ class SpecFeatureMap final : public FeatureMap {
     if (spec_.current == Current::cup)
       for (auto k : kCupParts) out[at++] = s[k] - (k == si::kCupX ? x0 : 0.0);
     at = current_width();
+    if (spec_.links) {
+      if (h.links.size() != h.states.size())
+        throw InputError("feature map \"" + name_ + "\" reads the arm's links, and this episode has no readings of them");
+      const ArmLinks& l = h.links.back();
+      std::copy(l.angles.begin(), l.angles.end(), out.begin() + static_cast<std::ptrdiff_t>(at));
+      std::copy(l.rates.begin(), l.rates.end(), out.begin() + static_cast<std::ptrdiff_t>(at + 3));
+      at += kLinkColumns;
+    }
     if (spec_.clock) out[at++] = static_cast<double>(h.t() - begin + (spec_.timing == Timing::landing ? h.pending.size() : 0));
     if (spec_.start == Start::summary) {
       out[at++] = start[si::kCupX] - x0;
@@ -168,7 +184,11 @@ State cup_ahead(const History& h) {
   return s;
 }
 
-void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
+void check_map_world(const FeatureMap& map, const WorldConfig& world) {
+  if ((map.reads_links() || map.action_kind() == ActionKind::joint_torque) && world.embodiment != Embodiment::arm)
+    throw ConfigError("feature map \"" + map.name() + "\" " +
+                      (map.reads_links() ? "reads the arm's links" : "answers the arm's joint torques") +
+                      "; this world's cup floats: run it with the arm (--embodiment arm)");
   if (!map.ahead()) return;
   const PhysicsConfig nominal{}, &p = world.physics;
   if (p.gravity.x != nominal.gravity.x || p.gravity.y != nominal.gravity.y || p.control_dt != nominal.control_dt ||
@@ -180,11 +200,19 @@ void check_ahead_world(const FeatureMap& map, const WorldConfig& world) {
 }
 
 void FeatureMap::label(const History& h, const Action& action, std::span<double> out) const {
+  if (action.kind() != action_kind())
+    throw InputError("feature map \"" + name() + "\" answers " + std::string(action_kind_name(action_kind())) +
+                     " actions; a label is for the " + std::string(action_kind_name(action.kind())) + " controller");
+  if (target() == ActionTarget::torque) {
+    std::copy(action.begin(), action.end(), out.begin());
+    return;
+  }
   State scratch;
   const State& s = acting_state(*this, h, scratch);
   for (std::size_t k = 0; k < kActionDim; ++k) {
     switch (target()) {
-      case ActionTarget::impulse: out[k] = action[k]; break;
+      case ActionTarget::impulse:
+      case ActionTarget::torque: out[k] = action[k]; break;
       case ActionTarget::velocity: out[k] = action[k] + s[kCupVelocity[k]]; break;
       case ActionTarget::position:
         out[k] = s[kCupPose[k]] + (action[k] + s[kCupVelocity[k]]) / kPositionGain - (k == 0 ? origin_x(h) : 0.0);
@@ -194,12 +222,14 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
 }
 
 Action FeatureMap::action(const History& h, std::span<const double> output) const {
+  if (target() == ActionTarget::torque) return Action::torques({output[0], output[1], output[2], output[3]});
   State scratch;
   const State& s = acting_state(*this, h, scratch);
   Action a;
   for (std::size_t k = 0; k < kActionDim; ++k) {
     switch (target()) {
-      case ActionTarget::impulse: a[k] = output[k]; break;
+      case ActionTarget::impulse:
+      case ActionTarget::torque: a[k] = output[k]; break;
       case ActionTarget::velocity: a[k] = output[k] - s[kCupVelocity[k]]; break;
       case ActionTarget::position:
         a[k] = kPositionGain * (output[k] + (k == 0 ? origin_x(h) : 0.0) - s[kCupPose[k]]) - s[kCupVelocity[k]];

@@ -530,7 +530,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   }
   plan.combos = row_combos(plan, say);  // a row that cannot train is refused before the demonstrations are read
   plan.set = read_demo_set(opt.demos);
-  for (const auto& [learner, features] : plan.combos) check_ahead_world(feature_map(features), opt.world);
+  for (const auto& [learner, features] : plan.combos) check_map_world(feature_map(features), opt.world);
   // The table keeps every row's rollouts of every seed (the pages' per-episode results).
   const double rollouts = static_cast<double>(plan.combos.size()) * opt.seeds * plan.episodes;
   require_memory("leaderboard", static_cast<std::uint64_t>(std::min(rollouts, 1e18)),

@@ -10,18 +10,40 @@
 
 namespace dicestack {
 
+namespace {
+
+// The map a request trains: the one it names, else the learner's default (in joint torques when
+// the controller says so). A map that contradicts the controller is refused.
+std::string train_features(const TrainRequest& request) {
+  const bool torques = request.controller == "joint_torque";
+  if (!request.controller.empty() && !torques && request.controller != "cup")
+    throw ConfigError("train: controller \"" + request.controller + "\" is not one of cup, joint_torque");
+  if (request.features.empty()) {
+    const std::string fallback = default_features(request.learner, request.learner_options);
+    return torques ? torque_map_name(fallback) : fallback;
+  }
+  const FeatureMap& given = feature_map(request.features);
+  if (!request.controller.empty() && (given.action_kind() == ActionKind::joint_torque) != torques)
+    throw ConfigError("train: feature map \"" + given.name() + "\" answers " +
+                      std::string(action_kind_name(given.action_kind())) + " actions, not the " + request.controller +
+                      " controller's");
+  return given.name();
+}
+
+}  // namespace
+
 std::string check_train_settings(const TrainRequest& request) {
   const auto learner = LearnerRegistry::global().create(request.learner, request.learner_options);
   // An unknown regressor or a bad --set value would otherwise surface only at the first fit,
   // after DART had recorded its episodes.
   RegressorRegistry::global().create(request.regressor, request.regressor_sets);
-  const FeatureMap& features = feature_map(
-      request.features.empty() ? default_features(request.learner, request.learner_options) : request.features);
+  const FeatureMap& features = feature_map(train_features(request));
+  check_map_world(features, request.world);
+  require_learnable_map(request.learner, learner->params(), features);
   for (const auto& [key, value] : learner->params().as_text())
     if (key == "perturb")
       require_labellable(learner_perturbation(learner->params(), request.world, request.learner), features, request.learner,
                          request.learner == "dagger");
-  check_ahead_world(features, request.world);
   if (request.split != "episodes" && request.split != "none")
     throw ConfigError("split \"" + request.split + "\" is not one of episodes, none");
   return features.name();
@@ -64,7 +86,7 @@ TrainReport train_model(const TrainRequest& request) {
   model.record["recordings"] = std::to_string(c.demos.size()) + ": " + names;
   model.record["split"] = request.split;
   model.record["seed"] = std::to_string(request.seed);
-  report.score = score(model, split);
+  if (!model.features().reads_links() && model.features().action_kind() == ActionKind::cup) report.score = score(model, split);
   return report;
 }
 

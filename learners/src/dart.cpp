@@ -15,16 +15,22 @@ namespace {
 struct DartSettings {
   std::string expert;
   int episodes = 0;
-  Action noise{};  // per action dimension, as fractions of action.scale
+  Action noise{};  // per action dimension, as fractions of action_scale (a torque: of its limit)
   bool replan = false, retry = false, successes_only = true, include_demos = false;
   int mpc_robust = 0;
 
   std::string summary() const {
-    char text[256];
+    std::string per_dim;
+    for (const double n : noise) {
+      char one[32];
+      std::snprintf(one, sizeof one, "%s%g", per_dim.empty() ? "" : "/", n);
+      per_dim += one;
+    }
+    char text[320];
     std::snprintf(text, sizeof text,
-                  "expert=%s, episodes=%d, noise=%g/%g/%g, replan=%s, retry=%s, mpc_robust=%d, successes_only=%s, "
+                  "expert=%s, episodes=%d, noise=%s, replan=%s, retry=%s, mpc_robust=%d, successes_only=%s, "
                   "include_demos=%s",
-                  expert.c_str(), episodes, noise[0], noise[1], noise[2], replan ? "true" : "false", retry ? "true" : "false",
+                  expert.c_str(), episodes, per_dim.c_str(), replan ? "true" : "false", retry ? "true" : "false",
                   mpc_robust, successes_only ? "true" : "false", include_demos ? "true" : "false");
     return text;
   }
@@ -32,11 +38,14 @@ struct DartSettings {
 
 // DART's noise in dvy and dw when the tracker demonstrates (fractions of action.scale).
 constexpr double kDartTrackerNoiseDvy = 0.5, kDartTrackerNoiseDw = 0.2;
+// DART's noise on joint torques (a fraction of each torque limit) unless noise= is given.
+constexpr double kDartTorqueNoise = 0.001;
 // Noisy demonstrations by default, in randomised worlds, and with the tracker for a "/position"
 // map.
 constexpr int kDartEpisodes = 300, kDartRandomisedEpisodes = 900, kDartServoEpisodes = 1200;
 
-DartSettings dart_settings(const Params& params, const std::string& features, bool randomised) {
+DartSettings dart_settings(const Learner& learner, const std::string& features, bool randomised) {
+  const Params& params = learner.params();
   DartSettings d;
   d.expert = params.choice("expert");
   d.episodes = static_cast<int>(params.integer("episodes"));
@@ -53,13 +62,24 @@ DartSettings dart_settings(const Params& params, const std::string& features, bo
                                                                   : kDartEpisodes;
   const double noise = params.real("noise");
   d.noise = {noise, noise, noise};
+  const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
+  if (feature_map(features).action_kind() == ActionKind::joint_torque) {
+    // A policy in joint torques: the same fraction of each joint's torque limit.
+    for (const char* key : per_dim)
+      if (params.real(key) >= 0.0)
+        throw ConfigError(std::string("dart: ") + key + " is a cup action's noise; a \"/torque\" map's noise is noise=");
+    // Any noise leaves the tracker on the arm in its less robust regime, more noise fewer
+    // successes to learn from (docs/arm.md, "Policies in joint torques").
+    const double torque_noise = learner.given("noise") ? noise : kDartTorqueNoise;
+    d.noise = Action::torques({torque_noise, torque_noise, torque_noise, torque_noise});
+  }
   // Following recordings, the learner errs most in dvy and dw: its noise there is matched to
   // that (docs/notebook/2026-11-27-learners-page-history.md, "Policies from the human recordings":
   // 64.8 -> 67.0 % on the report protocol, walls 17.5 -> 13.0 %).
-  if (d.expert == "tracker") d.noise = {noise, kDartTrackerNoiseDvy, kDartTrackerNoiseDw};
-  const char* per_dim[] = {"noise_dvx", "noise_dvy", "noise_dw"};
-  for (std::size_t k = 0; k < kActionDim; ++k)
-    if (params.real(per_dim[k]) >= 0.0) d.noise[k] = params.real(per_dim[k]);
+  if (d.expert == "tracker" && d.noise.kind() == ActionKind::cup) d.noise = {noise, kDartTrackerNoiseDvy, kDartTrackerNoiseDw};
+  if (d.noise.kind() == ActionKind::cup)
+    for (std::size_t k = 0; k < kActionDim; ++k)
+      if (params.real(per_dim[k]) >= 0.0) d.noise[k] = params.real(per_dim[k]);
   d.replan = params.boolean("replan");
   d.retry = expert_retries(params.choice("retry"), features);
   d.mpc_robust = static_cast<int>(params.integer("mpc_robust"));
@@ -76,9 +96,10 @@ class Dart final : public Learner {
   using Learner::Learner;
 
   LearnResult learn(const LearnContext& c) const override {
-    const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dart");  // before any work
+    require_learnable_map("dart", params(), feature_map(c.features));  // before any work
+    const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dart");
     require_labellable(perturbation, feature_map(c.features), "dart");
-    const DartSettings d = dart_settings(params(), c.features, !perturbation.trained.nominal());
+    const DartSettings d = dart_settings(*this, c.features, !perturbation.trained.nominal());
     const int episodes = d.episodes;
     std::vector<Episode> data = d.include_demos ? c.demos : std::vector<Episode>{};
     ExpertConfig expert = learner_expert_config(d.expert, *this, c);  // the tracker shows its preparation
@@ -142,7 +163,7 @@ class Dart final : public Learner {
     for (const auto& e : expert_list()) names.push_back(e.name);
     const std::vector<ParamSpec> specs{{"expert", ParamType::choice, "mpc", 0, 0, "the expert that demonstrates and labels (tracker: follows the recordings of --demos; its default --features is state+clock+start_state@dice+retry/position)", names},
             {"noise", ParamType::real, "0.1", 0, 10,
-             "std of the noise added to each executed action, as a fraction of action.scale (every dimension)", {}},
+             "std of the noise added to each executed action, as a fraction of action.scale (every dimension; a /torque map's: of each torque limit, default 0.001)", {}},
             {"noise_dvx", ParamType::real, "-1", -1, 10, "the same for dvx alone (-1: noise)", {}},
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise; with expert=tracker, 0.5)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise; with expert=tracker, 0.2)", {}},

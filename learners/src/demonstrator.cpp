@@ -105,7 +105,8 @@ std::vector<ParamSpec> tracker_param_specs() {
            "the 4 best paths again from 4 x tracker_probes more probe starts, and follow the best", {}},
           {"tracker_refine", ParamType::integer, std::to_string(d.refine), 0, 10000,
            "tracker: CMA-ES generations that move the leading path by smooth offsets to succeed from the most "
-           "starts, clean and under DART's noise; the refined path leads if it beats the leading path from fresh starts (0: off)", {}},
+           "starts, clean and under DART's noise; the refined path leads if it beats the leading path from fresh starts (0: off; "
+           "with a /torque map 0 unless given)", {}},
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
           {"tracker_refine_restarts", ParamType::integer, std::to_string(d.refine_restarts), 1, 100,
@@ -159,6 +160,10 @@ TrackerConfig learner_tracker_config(const Learner& learner, const std::string& 
   }
   const int paths = static_cast<int>(params.integer("tracker_paths"));
   if (learner.given("tracker_paths") || preset == kLearnerPreset) tracker.paths = tracker_paths_for(paths, features);
+  tracker.controller = feature_map(features).action_kind();  // paths chosen in the controller the labels are for
+  // Refining a path in held torques costs two more simulated steps per step: about 10 s a
+  // generation on 2 cores, 40 min for the preset's refinements.
+  if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_refine")) tracker.refine = 0;
   validate(tracker);
   return tracker;
 }
@@ -181,6 +186,7 @@ std::vector<std::pair<std::string, std::string>> effective_options(const Learner
 
 ExpertConfig learner_expert_config(const std::string& name, const Learner& learner, const LearnContext& c) {
   ExpertConfig config;
+  config.controller = feature_map(c.features).action_kind();  // labels in the actions the map answers
   const Params& params = learner.params();
   if (name == "tracker") {
     const TrackerConfig tracker = learner_tracker_config(learner, c.features);

@@ -34,7 +34,11 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
   std::vector<Action> applied, pending, unseen;
   policy.attach(env);
   const State shown = world.reset_to(start, seed);
+  // An arm's joint encoders read its links exactly and at once: only the scene's sensing is
+  // perturbed.
+  const bool arm = env.config().embodiment == Embodiment::arm;
   e.states.push_back(env.get_state());
+  if (arm) e.links.push_back(env.world().arm_links());
   if (channelled) seen.push_back(shown);
   policy.reset(seed);
   while (true) {
@@ -43,8 +47,11 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
       pending.assign(world.pending().begin(), world.pending().end());
       unseen.assign(world.unseen().begin(), world.unseen().end());
     }
-    Action a = policy.act(History{channelled ? seen : e.states, applied, pending, unseen});
-    if (applied.empty() && options.push != InitialPush::none) a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
+    Action a = policy.act(History{channelled ? seen : e.states, applied, pending, unseen, e.links});
+    if (applied.empty() && options.push != InitialPush::none) {
+      if (a.kind() != ActionKind::cup) throw InputError("an initial push is a cup velocity change; this policy answers joint torques");
+      a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
+    }
     a = world.clip(a);
     const auto label = policy.label();
     e.actions.push_back(label ? label->label : a);
@@ -60,6 +67,7 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
       break;
     }
     e.states.push_back(r.observation);
+    if (arm) e.links.push_back(env.world().arm_links());
     if (channelled) seen.push_back(step.shown);
   }
   e.outcome = env.outcome();
@@ -178,6 +186,15 @@ std::string estimator_for(const std::string& asked, const Model& model) {
 
 void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   validate(request.perturbation, world);
+  if (request.actions == ActionKind::joint_torque) {
+    const std::string what = "evaluate: a policy in joint torques";
+    if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
+    if (!takes_joint_torques(request.perturbation))
+      throw ConfigError(what + ": the perturbation's action delay, action noise and bias are drawn for the cup's actions");
+    if (request.estimator.kind != EstimatorKind::none)
+      throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; use --estimator none");
+    if (request.push != InitialPush::none) throw ConfigError(what + ": an initial push is a cup velocity change");
+  }
   require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "rollouts");
   check_threads(request.threads, "evaluate: threads");

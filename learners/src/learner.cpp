@@ -204,8 +204,22 @@ void require_labellable(const TrainingPerturbation& p, const FeatureMap& feature
                               "fix the delay (delays_drawn false) or train behind an estimator");
 }
 
+void require_learnable_map(const std::string& learner, const Params& params, const FeatureMap& map) {
+  if (!map.reads_links() && map.action_kind() == ActionKind::cup) return;
+  const std::string what = "learner \"" + learner + "\" on feature map \"" + map.name() + "\"";
+  if (learner != "dart")
+    throw ConfigError(what + ": a map of the arm's links or joint torques is learned by dart alone, whose expert runs "
+                             "on the arm (the recordings hold no links, and the cup's actions)");
+  if (params.boolean("include_demos")) throw ConfigError(what + ": include_demos adds recordings without the arm's links");
+  if (params.choice("perturb") != "none")
+    throw ConfigError(what + ": perturb= is not built for a policy of the arm's links yet; leave it at none");
+}
+
 void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
                         const FeatureMap& features, const std::string& learner) {
+  if (features.reads_links() || features.action_kind() != ActionKind::cup)
+    throw ConfigError("leaderboard: feature map \"" + features.name() + "\" is for the arm's links or joint torques, and "
+                      "the rows are scored on recordings of the cup; train such a policy with `dicestack train`");
   if (std::none_of(schema.begin(), schema.end(), [](const ParamSpec& s) { return s.name == "perturb"; })) return;
   require_labellable(learner_perturbation(params, world, learner), features, learner, learner == "dagger");
 }

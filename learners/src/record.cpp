@@ -1,5 +1,6 @@
 #include <dicestack/learners/record.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -14,23 +15,39 @@
 #include <dicestack/learners/policy.hpp>
 
 namespace dicestack {
+namespace {
+
+// The noise `fractions` asks for in world units (fractions of action_scale) for the actions of
+// `kind` the expert answers. Zeros of the other kind are no noise.
+Action executed_noise(const Action& fractions, ActionKind kind, const WorldConfig& world) {
+  const bool none = std::all_of(fractions.begin(), fractions.end(), [](double f) { return f == 0.0; });
+  if (fractions.kind() != kind && !none)
+    throw ConfigError("record: the noise is given for " + std::string(action_kind_name(fractions.kind())) +
+                      " actions, and the expert answers for the " + std::string(action_kind_name(kind)) + " controller");
+  Action noise = Action::zeros(kind);
+  if (none) return noise;
+  const auto scale = action_scale(world, kind);
+  for (std::size_t k = 0; k < noise.size(); ++k) {
+    const double fraction = fractions[k];
+    if (!(fraction >= 0.0) || !std::isfinite(fraction))
+      throw ConfigError("noise for " + std::string(action_names(kind)[k]) + " must be a finite fraction >= 0, got " +
+                        std::to_string(fraction));
+    noise[k] = fraction * scale[k];
+  }
+  return noise;
+}
+
+}  // namespace
 
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
-  if (config.controller != ActionKind::cup)
-    throw ConfigError("record: demonstration sets hold the cup's actions; an expert answering joint torques cannot be recorded");
+  if (config.controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
+    throw ConfigError("record: an expert answering joint torques drives an arm's joints; this world's cup floats");
   validate(request.perturbation, world);
   require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "episodes");
-  Action noise{0.0, 0.0, 0.0};  // world units
-  for (std::size_t k = 0; k < kActionDim; ++k) {
-    const double fraction = request.noise[k];
-    if (!(fraction >= 0.0) || !std::isfinite(fraction))
-      throw ConfigError("noise for " + std::string(action_names()[k]) + " must be a finite fraction >= 0, got " +
-                        std::to_string(fraction));
-    noise[k] = fraction * world.action.scale[k];
-  }
+  const Action noise = executed_noise(request.noise, config.controller, world);
   const int threads = request.threads;
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
   EnvPool envs(world, threads);

@@ -41,13 +41,28 @@ struct PyModel {
 class PyPolicy {
  public:
   explicit PyPolicy(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
-  void reset() { states_.clear(); }
-  Action act(const py::handle& observation, const py::handle& pending, const py::handle& unseen) {
+  void reset() {
+    states_.clear();
+    links_.clear();
+  }
+  Action act(const py::handle& observation, const py::handle& pending, const py::handle& unseen, const py::handle& angles,
+             const py::handle& rates) {
     const auto ahead = actions_from(pending, "pending");
     const auto since = actions_from(unseen, "unseen");
-    states_.push_back(state_from(observation, "observation"));
+    const bool reads_links = model_->features().reads_links();
+    if (reads_links && (angles.is_none() || rates.is_none()))
+      throw py::value_error("feature map \"" + model_->features().name() +
+                            "\" reads the arm's links: give link_angles and link_rates (the arm's info[\"link_angles\"], "
+                            "info[\"link_rates\"])");
+    State state = state_from(observation, "observation");
+    if (reads_links) {
+      const auto a = vector_from(angles, 3, "link_angles");
+      const auto r = vector_from(rates, 3, "link_rates");
+      links_.push_back({{a[0], a[1], a[2]}, {r[0], r[1], r[2]}});
+    }
+    states_.push_back(state);
     // The world's applied actions are not known here; no built-in feature map reads them.
-    return model_->act(History{states_, {}, ahead, since});
+    return model_->act(History{states_, {}, ahead, since, links_});
   }
   std::size_t t() const { return states_.empty() ? 0 : states_.size() - 1; }
 
@@ -66,7 +81,15 @@ class PyPolicy {
 
   std::shared_ptr<const Model> model_;
   std::vector<State> states_;
+  std::vector<ArmLinks> links_;  // with each state, for a map that reads them
 };
+
+// Policy.act and Policy.__call__: the action as a NumPy array of its size.
+py::array_t<double> act_as_array(PyPolicy& p, const py::handle& obs, const py::handle& pending, const py::handle& unseen,
+                                 const py::handle& angles, const py::handle& rates) {
+  const Action a = p.act(obs, pending, unseen, angles, rates);
+  return to_array(std::span<const double>(a.begin(), a.end()));
+}
 
 /// Demonstrations given as a name or folder ("builtin", "human", a path) or as episodes.
 std::vector<Episode> demos_from(const py::handle& demos, const WorldConfig& world, std::string* name) {
@@ -172,8 +195,8 @@ PyModel train(const WorldConfig& world, const py::handle& demos, const std::stri
   training["learner"] = learner;
   training["features"] = report->features;
   training["seconds"] = report->seconds;
-  training["train_error"] = report->score.train_error;
-  if (report->score.test_error) training["test_error"] = *report->score.test_error;
+  if (report->score) training["train_error"] = report->score->train_error;
+  if (report->score && report->score->test_error) training["test_error"] = *report->score->test_error;
   return {report->result.model, out, training};
 }
 
@@ -192,7 +215,9 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   std::optional<std::vector<Episode>> demo_episodes;
   if (!demos.is_none()) demo_episodes = demos_from(demos, world, nullptr);
   std::shared_ptr<const Model> model = m.model;
-  check_ahead_world(model->features(), world);
+  check_map_world(model->features(), world);
+  if (demo_episodes && model->features().action_kind() == ActionKind::joint_torque)
+    throw py::value_error("demos: a policy in joint torques cannot be scored on recordings of the cup's actions");
   LongCall call(std::move(bar));
   py::gil_scoped_release nogil;
   std::vector<Episode> rollouts;
@@ -204,6 +229,7 @@ std::string evaluate_model(const PyModel& m, const WorldConfig& world, int episo
   request.push = initial_push;
   request.perturbation = perturbation;
   request.estimator = shown;
+  request.actions = model->features().action_kind();
   request.rollouts = report.empty() ? nullptr : &rollouts;  // the report's previews and per-episode results
   request.results = report.empty() ? nullptr : &results;
   request.progress = [&](int finished, int of) {
@@ -265,18 +291,15 @@ void bind_models(py::module_& m) {
           py::arg("seed") = py::none(), "Starts a new episode")
       .def(
           "act",
-          [](PyPolicy& p, const py::handle& obs, const py::handle& pending, const py::handle& unseen) {
-            return to_array(p.act(obs, pending, unseen));
-          },
-          py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none(),
-          "The action (dvx, dvy, dw) after this observation; under delays, an \"/ahead\" map also reads the "
-          "environment's pending and unseen actions (DiceStackEnv.pending, .unseen)")
+          &act_as_array, py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none(),
+          py::arg("link_angles") = py::none(), py::arg("link_rates") = py::none(),
+          "The action after this observation: (dvx, dvy, dw), or a torque map's four joint torques. Under delays, "
+          "an \"/ahead\" map also reads the environment's pending and unseen actions (DiceStackEnv.pending, "
+          ".unseen); a map that reads the arm's links takes info[\"link_angles\"] and info[\"link_rates\"]")
       .def(
           "__call__",
-          [](PyPolicy& p, const py::handle& obs, const py::handle& pending, const py::handle& unseen) {
-            return to_array(p.act(obs, pending, unseen));
-          },
-          py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none())
+          &act_as_array, py::arg("observation"), py::arg("pending") = py::none(), py::arg("unseen") = py::none(),
+          py::arg("link_angles") = py::none(), py::arg("link_rates") = py::none())
       .def_property_readonly("t", &PyPolicy::t);
 
   py::class_<PyModel>(m, "Model", "A trained model: a feature map, a regressor and their standardisers")
@@ -284,7 +307,7 @@ void bind_models(py::module_& m) {
              const Matrix rows = matrix_from(x, pm.model->features().width(), "X");
              return to_array(pm.model->predict(rows));
            }, py::arg("X"),
-           "The regressor's answers (N x 3) for rows of the model's feature map (N x input_dim): actions, or the cup "
+           "The regressor's answers (N x 3; N x 4 for a /torque map) for rows of the model's feature map (N x input_dim): actions, or the cup "
            "velocities to set for a '/velocity' map (its policy acts with their difference from the cup's velocity), or "
            "the cup poses to servo to for a '/position' map (x measured from the start's mean die x for an '@dice' map)")
       .def("policy", [](const PyModel& pm) { return PyPolicy(pm.model); }, "A fresh policy acting with this model")

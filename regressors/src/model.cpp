@@ -120,14 +120,14 @@ Model::Model(std::unique_ptr<Regressor> regressor, Standardizer x, Standardizer 
 
 Model Model::train(std::unique_ptr<Regressor> regressor, const Matrix& x, const Matrix& y, std::uint64_t seed,
                    std::vector<std::string>* warnings, const FeatureMap& features) {
-  if (x.cols() != static_cast<Eigen::Index>(features.width()) || y.cols() != static_cast<Eigen::Index>(kActionDim))
+  if (x.cols() != static_cast<Eigen::Index>(features.width()) || y.cols() != static_cast<Eigen::Index>(features.outputs()))
     throw InputError("training data is " + std::to_string(x.cols()) + " -> " + std::to_string(y.cols()) +
                      " columns; a policy on features \"" + features.name() + "\" maps " +
-                     std::to_string(features.width()) + " inputs to 3 action values");
+                     std::to_string(features.width()) + " inputs to " + std::to_string(features.outputs()) + " action values");
   std::vector<std::string> names = features.column_names();
   Standardizer xs = Standardizer::fit(x, warnings, &names);
   names.clear();
-  for (auto n : action_names()) names.emplace_back(n);
+  for (auto n : action_names(features.action_kind())) names.emplace_back(n);
   Standardizer ys = Standardizer::fit(y, warnings, &names);
   regressor->fit(xs.apply(x), ys.apply(y), seed);
   return Model(std::move(regressor), std::move(xs), std::move(ys), features);
@@ -138,11 +138,11 @@ Action Model::act(const History& history) const {
   std::array<double, kMaxFeatureWidth> row, z;
   features_->compute(history, {row.data(), width});
   x_.apply_row({row.data(), width}, {z.data(), width});
-  std::array<double, kActionDim> out;
-  regressor_->predict_row({z.data(), width}, out);
-  std::array<double, kActionDim> answer;
-  y_.invert_row(out, answer);
-  return features_->action(history, answer);
+  const std::size_t outputs = features_->outputs();
+  std::array<double, kMaxOutputWidth> out, answer;
+  regressor_->predict_row({z.data(), width}, {out.data(), outputs});
+  y_.invert_row({out.data(), outputs}, {answer.data(), outputs});
+  return features_->action(history, {answer.data(), outputs});
 }
 
 Action Model::act(const State& state) const { return act(History{{&state, 1}, {}}); }
@@ -159,13 +159,19 @@ Ownership model_ownership() { return Ownership::json_first_line("dicestack model
 
 namespace {
 
+// The version a model of `features` is written as: the oldest that holds it, so that older
+// dicestacks keep reading every model they can run.
+int model_file_version(const FeatureMap& features) {
+  return features.reads_links() || features.action_kind() != ActionKind::cup ? kModelFormatVersion : 2;
+}
+
 // The model file's first line: its JSON header, which describes `payload`.
 std::string model_header(const Model& model, const std::string& payload) {
   const Regressor& r = model.regressor();
   json params = json::object();
   for (const auto& [k, v] : r.params().as_text()) params[k] = v;
   json header{{"format", kModelFormat},
-                    {"version", kModelFormatVersion},
+                    {"version", model_file_version(model.features())},
                     {"dicestack_version", DICESTACK_VERSION},
                     {"regressor", r.name()},
                     {"params", params},
@@ -176,7 +182,7 @@ std::string model_header(const Model& model, const std::string& payload) {
                     {"state_dim", kStateDim},
                     {"action_dim", r.output_dim()},
                     {"state_names", state_names()},
-                    {"action_names", action_names()},
+                    {"action_names", action_names(model.features().action_kind())},
                     {"x_standardizer", scaler_json(model.x_scaler())},
                     {"y_standardizer", scaler_json(model.y_scaler())},
                     {"record", model.record},
@@ -289,9 +295,12 @@ ModelShape read_model_shape(const json& h, int version, const std::string& where
   if (state_dim != kStateDim)
     throw InputError(where + "trained on " + std::to_string(state_dim) + "-d states, this world produces " +
                      std::to_string(kStateDim) + "-d");
-  if (action_dim != kActionDim)
-    throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, this world takes " +
-                     std::to_string(kActionDim) + "-d");
+  if (version < 3 && model_file_version(features) >= 3)
+    throw InputError(where + "feature map \"" + features.name() + "\" (the arm's links or torques) came with format version 3; "
+                     "this file says " + std::to_string(version));
+  if (action_dim != features.outputs())
+    throw InputError(where + "predicts " + std::to_string(action_dim) + "-d actions, feature map \"" + features.name() +
+                     "\" answers " + std::to_string(features.outputs()) + "-d");
   return {&features, input_dim, action_dim};
 }
 

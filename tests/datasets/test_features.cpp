@@ -483,15 +483,15 @@ TEST(Features, DatasetRowsOfAnAheadMapRunThroughTheEpisodesOwnDelay) {
 
 TEST(Features, AheadMapsRefuseAWorldWhosePhysicsTheyDoNotPredict) {
   WorldConfig w;
-  EXPECT_NO_THROW(check_ahead_world(feature_map("state/ahead"), w));
+  EXPECT_NO_THROW(check_map_world(feature_map("state/ahead"), w));
   w.physics.gravity.y = -9.81;
-  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state/ahead"), w); }), HasSubstr("default world's physics"));
-  EXPECT_NO_THROW(check_ahead_world(feature_map("state"), w));
+  EXPECT_THAT(test::error_of([&] { check_map_world(feature_map("state/ahead"), w); }), HasSubstr("default world's physics"));
+  EXPECT_NO_THROW(check_map_world(feature_map("state"), w));
   w = WorldConfig{};
   w.physics.substeps = 8;
-  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state+clock/velocity/ahead"), w); }),
+  EXPECT_THAT(test::error_of([&] { check_map_world(feature_map("state+clock/velocity/ahead"), w); }),
               HasSubstr("state+clock/velocity/ahead"));
-  EXPECT_THAT(test::error_of([&] { check_ahead_world(feature_map("state+clock/position/landing"), w); }),
+  EXPECT_THAT(test::error_of([&] { check_map_world(feature_map("state+clock/position/landing"), w); }),
               HasSubstr("use the map without \"/landing\""));
 }
 

@@ -18,6 +18,7 @@ TEST(ClusterBytes, EpisodeRoundTripsEveryField) {
   eps[1].final_state.reset();
   eps[1].rewards.clear();
   eps[1].name = "episode_0001";
+  eps[0].links.assign(eps[0].size(), ArmLinks{{1, 2, 3}, {4, 5, 6}});  // an arm's joint readings travel too
   for (const Episode& e : eps) {
     test::expect_same_episode(episode_from_bytes(episode_to_bytes(e)), e);
   }

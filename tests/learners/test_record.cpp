@@ -33,7 +33,7 @@ TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
     EXPECT_EQ(a[i].sources.front(), StepSource::expert);
   }
   EXPECT_THROW(record_expert("nobody", {}, w, test::record_request(1, 0, 1)), ConfigError);
-  ExpertConfig torques;  // a set holds the cup's actions
+  ExpertConfig torques;  // joint torques drive an arm, and this world's cup floats
   torques.controller = ActionKind::joint_torque;
   EXPECT_THROW(record_expert("scripted", torques, w, test::record_request(1, 0, 1)), ConfigError);
 }

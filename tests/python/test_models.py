@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import dicestack
+from conftest import short_world
 
 
 @pytest.fixture(scope="module")
@@ -159,3 +160,23 @@ def test_the_trackers_preset_and_settings_go_by_the_learners_names(builtin_episo
         dicestack.expert("tracker", demos=few, preset="tuned")
     with pytest.raises(ValueError, match="has no tracker settings"):
         dicestack.expert("mpc", settings={"smooth": 2})
+
+
+def test_a_torque_policy_reads_the_arms_links_beside_each_observation():
+    world = short_world(30)
+    world["embodiment"] = "arm"
+    recordings = dicestack.load_demos("human")[:2]
+    options = {"expert": "tracker", "episodes": 2, "successes_only": False, "tracker_probes": 1, "tracker_robust": 1,
+               "tracker_variants": False, "tracker_refine": 0}
+    model = dicestack.train("knn", "dart", demos=recordings, options=options, world=world,
+                            features="state+links+clock+start_state@dice+retry/torque", params={"k": 1})
+    assert "train_error" not in model.training  # the recordings hold cup actions: nothing to score
+    env = dicestack.DiceStackEnv(world=world, controller="joint_torque")
+    obs, info = env.reset(seed=3)
+    policy = model.policy()
+    action = policy.act(obs, link_angles=info["link_angles"], link_rates=info["link_rates"])
+    assert action.shape == (4,)
+    obs, _, _, _, info = env.step(action)
+    assert policy.act(obs, link_angles=info["link_angles"], link_rates=info["link_rates"]).shape == (4,)
+    with pytest.raises(ValueError, match="give link_angles and link_rates"):
+        model.policy().act(obs)

@@ -86,6 +86,43 @@ TEST(ModelFile, StoresItsFeatureMapAndActsOnHistories) {
   fs::remove(path);
 }
 
+TEST(ModelFile, ATorquePolicyIsVersionThreeWithFourAnswersAndReadsBack) {
+  const FeatureMap& f = feature_map("state+links+clock/torque");
+  const Matrix x = random_rows(200, static_cast<Eigen::Index>(f.width()), 4);
+  Matrix y(x.rows(), 4);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) y.row(i) << 100 * x(i, 0), -50 * x(i, 25), 20 * x(i, 30), 5.0;
+  const Model m = Model::train(RegressorRegistry::global().create("linear_svr"), x, y, 3, nullptr, f);
+  const fs::path path = temp_model("torque");
+  save_model(m, path);
+  const auto [header, payload] = read_parts(path);
+  EXPECT_EQ(header.at("version"), 3) << "a map reading links and answering torques needs the newer format";
+  EXPECT_EQ(header.at("action_dim"), 4);
+  EXPECT_EQ(header.at("action_names")[3], "tau3");
+  const Model back = load_model(path);
+  const std::vector<State> states{State{}};
+  const std::vector<ArmLinks> links{{{0.1, 0.2, 0.3}, {0.0, 0.0, 0.0}}};
+  const Action a = back.act(History{states, {}, {}, {}, links});
+  EXPECT_EQ(a.kind(), ActionKind::joint_torque);
+  EXPECT_EQ(a, m.act(History{states, {}, {}, {}, links}));
+  // Four answers under a map of three is a broken file, said as such.
+  auto [edited, bytes] = read_parts(path);
+  edited["features"] = "state+links+clock";
+  reseal(edited, bytes);
+  write_parts(path, edited, bytes);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("predicts 4-d actions, feature map \"state+links+clock\" answers 3-d"));
+  // A version 2 file never held such a map.
+  auto [older, payload2] = read_parts(path);
+  older["features"] = "state+links+clock/torque";
+  older["version"] = 2;
+  reseal(older, payload2);
+  write_parts(path, older, payload2);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }), HasSubstr("came with format version 3; this file says 2"));
+  // Without the fitted data's widths: 3 labels for a torque map.
+  EXPECT_THAT(test::error_of([&] { Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3, nullptr, f); }),
+              HasSubstr("to 4 action values"));
+  fs::remove(path);
+}
+
 TEST(ModelFile, AVelocityMapActsWithTheCupVelocityItsRegressorAnswersLessTheCupsVelocityNow) {
   // A regressor fitted on velocity labels answers a velocity; the model's action is that less the
   // current cup velocity, and the file keeps the map.
@@ -363,7 +400,7 @@ TEST(ModelFile, TruncatedCorruptedOrForeignFilesAreRejected) {
   newer.replace(newer.find("\"version\":2"), 11, "\"version\":7");
   rewrite(newer);
   EXPECT_THAT(test::error_of([&] { load_model(path); }),
-              HasSubstr("format version 7 is newer than this dicestack reads (2); upgrade dicestack"));
+              HasSubstr("format version 7 is newer than this dicestack reads (3); upgrade dicestack"));
   std::string dims = bytes;
   dims.replace(dims.find("\"state_dim\":24"), 14, "\"state_dim\":26");
   rewrite(dims);

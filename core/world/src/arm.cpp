@@ -152,6 +152,23 @@ std::array<double, 4> joint_torques_of(const ArmConfig& arm, const Vec4& force) 
   return torque;
 }
 
+// The task's Jacobian: the cup's centre (the wrist) and its angle by the chain's absolute angles.
+Eigen::Matrix<double, 3, 4> task_jacobian(const ArmConfig& arm, const std::array<double, 4>& angles) {
+  Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
+  for (std::size_t j = 0; j < 3; ++j) {
+    task(0, static_cast<Eigen::Index>(j)) = -arm.link_lengths[j] * std::sin(angles[j]);
+    task(1, static_cast<Eigen::Index>(j)) = arm.link_lengths[j] * std::cos(angles[j]);
+  }
+  task(2, 3) = 1.0;
+  return task;
+}
+
+// The damped least-norm inverse of `task`.
+Eigen::Matrix<double, 4, 3> task_inverse(const Eigen::Matrix<double, 3, 4>& task) {
+  const Eigen::Matrix3d tt = task * task.transpose() + kDamping * kDamping * Eigen::Matrix3d::Identity();
+  return task.transpose() * tt.inverse();
+}
+
 }  // namespace
 
 std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
@@ -167,12 +184,7 @@ std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& n
   // before it back), then to the cup's velocity and turn through the task's Jacobian.
   Eigen::Matrix4d forces = Eigen::Matrix4d::Identity();
   for (Eigen::Index j = 1; j < 4; ++j) forces(j - 1, j) = -1.0;
-  Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
-  for (std::size_t j = 0; j < 3; ++j) {
-    task(0, static_cast<Eigen::Index>(j)) = -arm.link_lengths[j] * std::sin(now.angles[j]);
-    task(1, static_cast<Eigen::Index>(j)) = arm.link_lengths[j] * std::cos(now.angles[j]);
-  }
-  task(2, 3) = 1.0;
+  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, now.angles);
   const Eigen::Matrix<double, 3, 4> a = dt * task * d.m.inverse() * forces;
   const Eigen::Matrix3d aat = a * a.transpose() + 1e-12 * Eigen::Matrix3d::Identity();
   const Vec4 change = a.transpose() * aat.ldlt().solve(Eigen::Vector3d(velocity_change.x, velocity_change.y, turn_change));
@@ -185,23 +197,19 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   const auto& w = now.rates;
   const ChainDynamics d = chain_dynamics(arm, now, gravity);
   // The task: the cup's centre (the wrist) and its angle.
-  Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
+  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
   Eigen::Vector3d drift = Eigen::Vector3d::Zero();  // the task's acceleration at zero angular acceleration
   for (std::size_t j = 0; j < 3; ++j) {
     const double l = arm.link_lengths[j];
-    task(0, static_cast<Eigen::Index>(j)) = -l * std::sin(a[j]);
-    task(1, static_cast<Eigen::Index>(j)) = l * std::cos(a[j]);
     drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
     drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
   }
-  task(2, 3) = 1.0;
   // The cup's own velocity, not the links' rates through the chain: what the joints let drift
   // is corrected too.
   const Eigen::Vector3d cup_rate(now.cup_velocity.x, now.cup_velocity.y, w[3]);
   const Eigen::Vector3d wanted = (Eigen::Vector3d(velocity.x, velocity.y, angular_velocity) - cup_rate) / dt - drift;
   // Damped least-norm angular accelerations for the task, plus the posture's in its null space.
-  const Eigen::Matrix3d tt = task * task.transpose() + kDamping * kDamping * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix<double, 4, 3> pinv = task.transpose() * tt.inverse();
+  const Eigen::Matrix<double, 4, 3> pinv = task_inverse(task);
   Vec4 accel = pinv * wanted;
   Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
   posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];

@@ -29,6 +29,9 @@ struct Episode {
   std::vector<State> states;   ///< state before each action; states[0] is the initial state
   std::vector<Action> actions; ///< the action applied in each state
   std::vector<StepSource> sources;  ///< who chose each action
+  /// On an arm, its links before each action (one per state: what a policy's joint encoders
+  /// read); empty for the floating cup and for recordings that did not keep them.
+  std::vector<ArmLinks> links;
   Outcome outcome;             ///< the judge's outcome of the whole episode
   std::string origin;          ///< where it came from (a source file, an expert's name); may be empty
   /// The state after the last action: with `states`, the T + 1 observations Minari and
@@ -49,15 +52,15 @@ struct Episode {
 };
 
 /// An upper bound of the memory an episode of `steps` steps holds while a run keeps it (states,
-/// actions, sources, rewards, and a packed copy on its way between ranks): for refusing counts
+/// an arm's link readings, actions, sources, rewards, and a packed copy on its way between ranks): for refusing counts
 /// that cannot fit (require_memory) before any work.
 inline double episode_memory_bound(int steps) {
-  return 2.0 * (steps + 1.0) * static_cast<double>(sizeof(State) + sizeof(Action) + sizeof(StepSource) + sizeof(double)) +
+  return 2.0 * (steps + 1.0) * static_cast<double>(sizeof(State) + sizeof(ArmLinks) + sizeof(Action) + sizeof(StepSource) + sizeof(double)) +
          1024.0;
 }
 
 /// Throws InputError naming the episode unless states, actions and sources have one equal,
-/// non-zero length and every value is finite; with a final state, rewards has that length too,
+/// non-zero length (links that length too, or none) and every value is finite; with a final state, rewards has that length too,
 /// the final state and rewards are finite and at most one of terminated and truncated is set;
 /// without one, rewards is empty.
 void check_episode(const Episode& episode);

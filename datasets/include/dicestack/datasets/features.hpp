@@ -30,15 +30,20 @@ struct History {
   /// Under an observation delay, what ran (as chosen, before noise) since the state shown:
   /// states.back() is that many steps old. Empty without a delay.
   std::span<const Action> unseen = {};
+  /// On an arm, its links' readings with each state (as many as states); empty for the floating
+  /// cup. Read by maps with the "links" part.
+  std::span<const ArmLinks> links = {};
   /// Step index of the current state (0 at the start).
   std::size_t t() const { return states.size() - 1; }
   const State& current() const { return states.back(); }
   const State& start() const { return states.front(); }
 };
 
-/// The widest row any map produces (a stack buffer on the hot path): the state, the clock, the
-/// whole start, the previous state and the dice frame's origin.
+/// The widest row any map produces (a stack buffer on the hot path): the state, the arm's links,
+/// the clock, the whole start, the previous state and the dice frame's origin.
 inline constexpr std::size_t kMaxFeatureWidth = 80;
+/// The most answers a regressor gives: the arm's four joint torques.
+inline constexpr std::size_t kMaxOutputWidth = kJointCount;
 
 /// What a policy's regressor answers: the action itself (the cup's velocity change, the paper's
 /// impulse), the cup velocity the action is to set (the action is then that velocity minus
@@ -46,8 +51,9 @@ inline constexpr std::size_t kMaxFeatureWidth = 80;
 /// velocity kPositionGain (r - p) on x, y and angle). An expert that tracks a reference by
 /// cancelling the cup's velocity error gives labels that hold the noise of the last step; as
 /// velocities they are smooth; as poses, for a tracker of the same gain, the same wherever the
-/// cup is (so a learner's errors do not add up into a drift).
-enum class ActionTarget { impulse, velocity, position };
+/// cup is (so a learner's errors do not add up into a drift). On an arm, a policy may answer the
+/// joint torques its four joints hold through the step instead (the joint_torque controller).
+enum class ActionTarget { impulse, velocity, position, torque };
 
 /// What a feature map is made of: its name, read part by part. The grammar of a name
 /// (docs/learners.md, "Feature-map names"):
@@ -62,6 +68,7 @@ enum class ActionTarget { impulse, velocity, position };
 ///     START  := "start"               the start's cup x and mean die x
 ///             | "start_state"         the whole start state
 ///     TARGET := "/velocity" | "/position"   the regressor answers a cup velocity or a pose
+///             | "/torque"                 the arm's four joint torques (no TIMING)
 ///     TIMING := "/ahead" | "/landing"       under delays, the cup where the action lands
 ///
 /// A map with no current-state part is open loop. "retry" needs a clock or a start to restart.
@@ -70,6 +77,7 @@ struct FeatureSpec {
   enum class Start { none, summary, whole };
   enum class Timing { now, ahead, landing };
   Current current = Current::none;
+  bool links = false;       ///< "links"
   bool clock = false;
   Start start = Start::none;
   bool dice_frame = false;  ///< "@dice": x measured from the start's mean die x, that origin the last column
@@ -85,6 +93,10 @@ struct FeatureSpec {
 FeatureSpec parse_feature_spec(std::string_view name);
 /// The name of `spec`: parse_feature_spec's inverse, so a model file's name reads back the same.
 std::string to_string(const FeatureSpec& spec);
+/// The map for a policy in joint torques made from map `name`: its inputs, the arm's links
+/// added, answering the four torques ("/torque", no timing). "state+clock/position" gives
+/// "state+links+clock/torque". Throws ConfigError as parse_feature_spec.
+std::string torque_map_name(std::string_view name);
 
 /// A named, versioned map from a History to one input row, and from the regressor's answer to
 /// an action. Immutable; thread-safe.
@@ -103,8 +115,14 @@ class FeatureMap {
   virtual std::string description() const = 0;
   /// Writes the row for `history` into `out` (width() values). Hot path: never allocates.
   virtual void compute(const History& history, std::span<double> out) const = 0;
-  /// What the regressor's kActionDim outputs are (default: the action).
+  /// What the regressor's outputs are (default: the action).
   virtual ActionTarget target() const { return ActionTarget::impulse; }
+  /// The controller its actions are for: joint_torque for a "/torque" map, else cup.
+  ActionKind action_kind() const { return target() == ActionTarget::torque ? ActionKind::joint_torque : ActionKind::cup; }
+  /// The regressor's answers per row: the action's size (3, or 4 torques).
+  std::size_t outputs() const { return action_dim(action_kind()); }
+  /// True for a map that reads the arm's links (History::links): it runs only on an arm.
+  virtual bool reads_links() const { return false; }
 
   /// True for a map that acts for the moment its action lands (kAheadSuffix, kLandingSuffix).
   virtual bool ahead() const { return false; }
@@ -127,9 +145,10 @@ class FeatureMap {
 /// shown. The current state itself when nothing is unseen or pending.
 State cup_ahead(const History& history);
 
-/// Throws ConfigError if `map` is an "/ahead" map and `world`'s physics (gravity, control step,
-/// substeps) is not the default world's, which cup_ahead() moves the cup in.
-void check_ahead_world(const FeatureMap& map, const WorldConfig& world);
+/// Throws ConfigError if `map` cannot run in `world`: an "/ahead" map whose physics (gravity,
+/// control step, substeps) is not the default world's, which cup_ahead() moves the cup in; a
+/// map that reads the arm's links or answers joint torques, in a world without the arm.
+void check_map_world(const FeatureMap& map, const WorldConfig& world);
 
 /// The map a name describes (FeatureSpec's grammar), e.g. "state+clock+start_state@dice+retry/position",
 /// dart's default with the tracker. Every valid name is a map; the same name, the same object.
@@ -145,6 +164,9 @@ inline constexpr std::string_view kPositionTargetSuffix = "/position";
 /// The servo gain of "/position" maps, 1/s: the tracker's default gain, so that its labels are
 /// one pose per step wherever the cup is.
 inline constexpr double kPositionGain = 10.0;
+
+/// The suffix of a map whose regressor answers the arm's joint torques (ActionTarget::torque).
+inline constexpr std::string_view kTorqueTargetSuffix = "/torque";
 
 /// The suffix of a map that acts for the moment its action lands (FeatureMap::ahead()).
 inline constexpr std::string_view kAheadSuffix = "/ahead";

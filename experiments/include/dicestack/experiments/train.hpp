@@ -25,6 +25,9 @@ struct TrainRequest {
   std::string learner = "bc";
   std::vector<std::string> learner_options; ///< "key=value" for the learner
   std::string features;                     ///< feature map; empty: the learner's default
+  /// "cup" or "joint_torque": what the policy's actions are for; empty: what the map answers.
+  /// joint_torque without a map takes the learner's default in torques (torque_map_name).
+  std::string controller;
   /// "episodes": train on episodes i % 5 != 4, report test error and give the rest to the
   /// learner as held-out demonstrations; "none": train on all.
   std::string split = "episodes";
@@ -42,7 +45,9 @@ struct TrainReport {
   LearnResult result;
   std::string features;              ///< the feature map used
   double seconds = 0.0;              ///< the learner's wall time
-  Score score;                       ///< eq. 9 on the training and held-out episodes
+  /// Eq. 9 on the training and held-out episodes; empty when the map cannot read them (a torque
+  /// policy: the recordings hold cup actions and no arm links).
+  std::optional<Score> score;
 };
 
 /// Checks what a request names, without its demonstrations: the learner and its options (a

@@ -106,6 +106,9 @@ struct EvalRequest {
   /// What the policy is shown under sensing factors: the observation (none) or an estimate.
   EstimatorConfig estimator;
   std::size_t max_steps = 0;  ///< 0: the world's time limit
+  /// What the policy answers. Joint torques run only on the arm, without an initial push, an
+  /// estimator or a perturbation's action delay, noise or bias (each in the cup's units).
+  ActionKind actions = ActionKind::cup;
   std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
   std::vector<EpisodeResult>* results = nullptr;  ///< if set, receives every rollout's results in index order
   RolloutProgress progress;
@@ -118,7 +121,7 @@ struct EvalRequest {
 std::string estimator_for(const std::string& asked, const Model& model);
 
 /// Throws ConfigError, before any work, for an evaluation that could not run: a perturbation
-/// the world cannot take, more rollouts than this machine's memory holds, a thread count out of
+/// the world cannot take, a policy in joint torques where they cannot run, more rollouts than this machine's memory holds, a thread count out of
 /// range. evaluate() calls it, and so does every command that evaluates after other work (the
 /// leaderboard, the robustness table), so that it refuses before that work.
 void check_evaluation(const WorldConfig& world, const EvalRequest& request);

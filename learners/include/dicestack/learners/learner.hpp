@@ -183,7 +183,12 @@ TrainingPerturbation learner_perturbation(const Params& params, const WorldConfi
 /// was pending under a delay: every delay is refused.
 void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner,
                         bool own_choices = false);
-/// The same for a learner's options: nothing when `schema` has no "perturb" (a leaderboard's row).
+/// Throws ConfigError unless `learner` (with `params`) can learn a policy on `map` when the map
+/// reads the arm's links or answers joint torques: dart alone, whose expert runs on the arm
+/// (recordings hold neither links nor torques), without include_demos, in the nominal world.
+void require_learnable_map(const std::string& learner, const Params& params, const FeatureMap& map);
+/// The same for a learner's options: nothing when `schema` has no "perturb" (a leaderboard's row,
+/// which also refuses a map of the arm's links or torques: its rows are scored on recordings).
 void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
                         const FeatureMap& features, const std::string& learner);
 /// Names `p` in the model's record: "perturb", and "estimator" when the policy runs behind one.

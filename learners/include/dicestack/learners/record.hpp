@@ -19,8 +19,9 @@ struct RecordRequest {
   /// Where in the seeded sequence the request starts: a long recording asks for it in batches.
   std::uint64_t first = 0;
   int threads = 0;         ///< 0: every core; the result does not depend on it
-  /// DART's noise: per action dimension, a fraction of world.action.scale; the executed actions
-  /// are perturbed and the expert's clean actions recorded.
+  /// DART's noise: per action dimension, a fraction of action_scale (the cup's action.scale, or
+  /// the arm's torque limits for an expert answering joint torques, whose noise is then given as
+  /// Action::torques); the executed actions are perturbed and the expert's clean actions recorded.
   Action noise{0.0, 0.0, 0.0};
   /// Domain randomisation: each episode runs in its own draw (draw_perturbation from its seed);
   /// nominal: today's recordings, byte for byte.

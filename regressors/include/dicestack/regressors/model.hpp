@@ -22,8 +22,9 @@ namespace dicestack {
 
 inline constexpr const char* kModelFormat = "dicestack-model";
 /// 2 added the feature map ("features", "features_version", "input_dim", "input_names");
-/// version 1 files are read as the "state" map.
-inline constexpr int kModelFormatVersion = 2;
+/// version 1 files are read as the "state" map. 3: the map may read the arm's links and answer
+/// its four joint torques ("action_dim" 4); a model whose map does neither is written as version 2.
+inline constexpr int kModelFormatVersion = 3;
 
 /// Feature map + regressor + standardisers: maps what an episode has shown to a raw action.
 class Model {

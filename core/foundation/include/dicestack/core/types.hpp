@@ -18,6 +18,15 @@ inline constexpr std::size_t kDiceCount = 3;
 /// The cup position is its centre of mass.
 using State = std::array<double, kStateDim>;
 
+/// The arm's three links as its joint encoders give them: each link's absolute direction (rad)
+/// and rate (rad/s), shoulder link first. With the cup's pose and velocity (in the State) they
+/// fix the whole arm, whose spare degree of freedom the State alone does not show.
+struct ArmLinks {
+  std::array<double, 3> angles{};
+  std::array<double, 3> rates{};
+  friend constexpr bool operator==(const ArmLinks&, const ArmLinks&) = default;
+};
+
 /// What an action commands: the cup's velocity change (the paper's "force control", every
 /// embodiment: the arm's operational-space controller realises it), or the arm's four joint
 /// torques (the joint_torque controller).

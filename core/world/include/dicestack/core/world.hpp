@@ -115,6 +115,8 @@ class World {
   std::array<double, 3> arm_link_angles() const;
   /// The arm's link rates now (absolute, rad/s); zeros for the floating cup.
   std::array<double, 3> arm_link_rates() const;
+  /// Both, as a policy's joint encoders read them (zeros for the floating cup).
+  ArmLinks arm_links() const { return {arm_link_angles(), arm_link_rates()}; }
   /// The arm and the cup as one chain now (arm.hpp's ArmMotion: the links' and the cup's angles
   /// and rates, the cup's velocity, mass and inertia), for joint-space control.
   ArmMotion arm_motion() const;

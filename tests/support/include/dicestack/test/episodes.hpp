@@ -45,6 +45,7 @@ inline void expect_same_episode(const Episode& x, const Episode& y) {
   EXPECT_EQ(x.states, y.states);
   EXPECT_EQ(x.actions, y.actions);
   EXPECT_EQ(x.sources, y.sources);
+  EXPECT_EQ(x.links, y.links);
   EXPECT_EQ(x.final_state, y.final_state);
   EXPECT_EQ(x.rewards, y.rewards);
   EXPECT_EQ(x.terminated, y.terminated);

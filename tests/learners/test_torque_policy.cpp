@@ -1,0 +1,97 @@
+// A policy in joint torques on the arm: DART taught by the tracker told in torques, its model
+// reading the arm's links, rolled out with only the regressor acting.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/learners/evaluate.hpp>
+#include <dicestack/learners/learner.hpp>
+#include <dicestack/learners/policy.hpp>
+
+#include <dicestack/test/demos.hpp>
+#include <dicestack/test/helpers.hpp>
+
+namespace dicestack {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr const char* kTorqueMap = "state+links+clock+start_state@dice+retry/torque";
+
+// The tracker in its cheapest form: one probe, no variants, no refinement.
+std::vector<std::string> quick_dart(std::vector<std::string> more = {}) {
+  std::vector<std::string> out{"expert=tracker",  "episodes=2",          "noise=0.002",          "successes_only=false",
+                               "tracker_probes=1", "tracker_robust=1", "tracker_variants=false", "tracker_refine=0"};
+  out.insert(out.end(), more.begin(), more.end());
+  return out;
+}
+
+LearnContext arm_context() {
+  LearnContext c;
+  c.world = test::short_world(40);
+  c.world.embodiment = Embodiment::arm;
+  c.demos = test::human_six();
+  c.demos.resize(2);
+  c.regressor = "knn";
+  c.features = kTorqueMap;
+  c.seed = 4;
+  c.threads = 1;
+  return c;
+}
+
+TEST(TorquePolicy, DartLearnsTheTrackersTorquesTheSameOnAnyThreadCount) {
+  LearnContext c = arm_context();
+  const auto learner = LearnerRegistry::global().create("dart", quick_dart());
+  const LearnResult one = learner->learn(c);
+  c.threads = 2;
+  const LearnResult two = learner->learn(c);
+  EXPECT_EQ(one.model->regressor().save_payload(), two.model->regressor().save_payload());
+  EXPECT_EQ(one.model->features().action_kind(), ActionKind::joint_torque);
+  EXPECT_THAT(one.model->record.at("dart_settings"), HasSubstr("noise=0.002/0.002/0.002/0.002"));
+
+  // Rolled out on the arm, the regressor alone answers torques; the episode keeps the links it read.
+  DiceEnv env(c.world);
+  ModelPolicy policy(one.model);
+  const std::uint64_t seed = 17;
+  const Episode e = rollout(env, policy, random_start_state(c.world, seed), seed, StepSource::policy);
+  ASSERT_EQ(e.links.size(), e.states.size());
+  EXPECT_EQ(e.actions.front().kind(), ActionKind::joint_torque);
+  EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
+}
+
+TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
+  LearnContext c = arm_context();
+  const auto refused = [&](const std::string& learner, const std::vector<std::string>& options) {
+    return test::error_of([&] { LearnerRegistry::global().create(learner, options)->learn(c); });
+  };
+  EXPECT_THAT(refused("dart", quick_dart({"noise_dvy=0.5"})), HasSubstr("noise_dvy is a cup action's noise"));
+  EXPECT_THAT(refused("dart", quick_dart({"include_demos=true"})), HasSubstr("include_demos adds recordings without"));
+  EXPECT_THAT(refused("dart", quick_dart({"perturb=easy"})), HasSubstr("perturb= is not built for a policy of the arm's links"));
+  EXPECT_THAT(test::error_of([] {
+                require_learnable_map("bc", LearnerRegistry::global().create("bc", {})->params(), feature_map(kTorqueMap));
+              }),
+              HasSubstr("learned by dart alone"));
+  // Where torques cannot run, an evaluation refuses before any rollout.
+  EvalRequest request;
+  request.actions = ActionKind::joint_torque;
+  EXPECT_THAT(test::error_of([&] { check_evaluation(WorldConfig{}, request); }), HasSubstr("give --embodiment arm"));
+  request.push = InitialPush::left;
+  EXPECT_THAT(test::error_of([&] { check_evaluation(c.world, request); }), HasSubstr("an initial push is a cup velocity change"));
+}
+
+TEST(TorquePolicy, AFloatingCupsRolloutKeepsNoLinks) {
+  LearnContext c = arm_context();
+  c.world.embodiment = Embodiment::cup;
+  DiceEnv env(c.world);
+  const auto expert = make_expert("scripted");
+  ExpertPolicy scripted(*expert, env);
+  const Episode e = rollout(env, scripted, random_start_state(c.world, 3), 3, StepSource::expert);
+  EXPECT_TRUE(e.links.empty());
+}
+
+}  // namespace
+}  // namespace dicestack
