@@ -114,6 +114,7 @@ class FeatureMap {
   /// One line for listings.
   virtual std::string description() const = 0;
   /// Writes the row for `history` into `out` (width() values). Hot path: never allocates.
+  /// Throws InputError for a map that reads the arm's links when the history has none.
   virtual void compute(const History& history, std::span<double> out) const = 0;
   /// What the regressor's outputs are (default: the action).
   virtual ActionTarget target() const { return ActionTarget::impulse; }
@@ -133,7 +134,8 @@ class FeatureMap {
   /// Where x is measured from in this map's rows and pose answers (0: the world's origin).
   virtual double origin_x(const History&) const { return 0.0; }
 
-  /// The regressor's answer for `action` taken after `history`: a training label.
+  /// The regressor's answer for `action` taken after `history`: a training label (outputs()
+  /// values). Throws InputError when the action is for another controller than action_kind().
   void label(const History& history, const Action& action, std::span<double> out) const;
   /// The action for the regressor's answer `output` after `history`. Hot path.
   Action action(const History& history, std::span<const double> output) const;
