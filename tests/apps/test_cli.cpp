@@ -792,6 +792,39 @@ TEST(CliLearning, RecordThroughATrackerPresetWithSettingsSaysSoAndABadSettingIsR
   EXPECT_FALSE(std::filesystem::exists(dir));
 }
 
+TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dicestack_cli_torque_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  nlohmann::json world = nlohmann::json::parse(run("config", false).output);
+  world["episode"]["max_steps"] = 30;
+  world["embodiment"] = "arm";
+  std::ofstream(dir / "arm.json") << world.dump();
+  const std::string arm = " --world " + (dir / "arm.json").string();
+  const std::string model = (dir / "t.dsm").string();
+  Process p = run("train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --learner dart "
+                  "--option expert=tracker --option episodes=2 --option successes_only=false --option tracker_probes=1 "
+                  "--option tracker_robust=1 --option tracker_variants=false --out " + model + " --json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+links+clock+start_state@dice+retry/torque");
+  EXPECT_FALSE(nlohmann::json::parse(p.output).contains("train_error")) << "recordings hold cup actions: no score";
+  p = run("evaluate --model " + model + arm + " --episodes 2 --json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  const std::vector<std::pair<std::string, std::string>> refused{
+      {"evaluate --model " + model + " --episodes 1", "--embodiment arm"},
+      {"evaluate --model " + model + arm + " --episodes 1 --save-rollouts " + (dir / "set").string(), "--save-rollouts writes a demonstration set"},
+      {"evaluate --model " + model + arm + " --episodes 1 --demos " + kTinyDemos, "--demos scores a policy on recordings"},
+      {"evaluate --model " + model + arm + " --episodes 1 --initial-push left", "an initial push is a cup velocity change"},
+      {"robustness --model " + model + arm + " --factors action_noise", "without action_delay, action_noise and all"},
+      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "learned by dart alone"}};
+  for (const auto& [args, message] : refused) {
+    p = run(args);
+    EXPECT_EQ(p.status, 1) << args;
+    EXPECT_THAT(p.output, HasSubstr(message)) << args;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "set"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliLearning, LeaderboardRowsCanBeLearnersWithOptions) {
   const Process p = run("leaderboard --demos " + kTinyDemos + " --regressors linear_svr "
                         "--learners bc,dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1:tracker_refine=0 "

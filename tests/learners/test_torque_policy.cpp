@@ -22,10 +22,10 @@ using ::testing::HasSubstr;
 
 constexpr const char* kTorqueMap = "state+links+clock+start_state@dice+retry/torque";
 
-// The tracker in its cheapest form: one probe, no variants, no refinement.
+// The tracker in its cheapest form: one probe, no variants (and, in torques, no refinement).
 std::vector<std::string> quick_dart(std::vector<std::string> more = {}) {
-  std::vector<std::string> out{"expert=tracker",  "episodes=2",          "noise=0.002",          "successes_only=false",
-                               "tracker_probes=1", "tracker_robust=1", "tracker_variants=false", "tracker_refine=0"};
+  std::vector<std::string> out{"expert=tracker",   "episodes=2",       "successes_only=false",
+                               "tracker_probes=1", "tracker_robust=1", "tracker_variants=false"};
   out.insert(out.end(), more.begin(), more.end());
   return out;
 }
@@ -51,7 +51,9 @@ TEST(TorquePolicy, DartLearnsTheTrackersTorquesTheSameOnAnyThreadCount) {
   const LearnResult two = learner->learn(c);
   EXPECT_EQ(one.model->regressor().save_payload(), two.model->regressor().save_payload());
   EXPECT_EQ(one.model->features().action_kind(), ActionKind::joint_torque);
-  EXPECT_THAT(one.model->record.at("dart_settings"), HasSubstr("noise=0.002/0.002/0.002/0.002"));
+  // In torques DART's noise and the tracker's refinement have their own defaults.
+  EXPECT_THAT(one.model->record.at("dart_settings"), HasSubstr("noise=0.001/0.001/0.001/0.001"));
+  EXPECT_THAT(one.model->record.at("tracker_settings"), HasSubstr("refine=0,"));
 
   // Rolled out on the arm, the regressor alone answers torques; the episode keeps the links it read.
   DiceEnv env(c.world);
