@@ -57,27 +57,43 @@ json episode_entry(const Episode& e, const std::string& file) {
              {"terminated", e.terminated},
              {"truncated", e.truncated}};
   if (!e.perturbation.empty()) entry["perturbation"] = json::parse(e.perturbation);
+  // Only an arm's episode has the key (version 4), so other sets keep their bytes.
+  if (!e.links.empty())
+    entry["final_links"] = e.final_links ? json{{"angles", e.final_links->angles}, {"rates", e.final_links->rates}} : json(nullptr);
   return entry;
+}
+
+// An arm's readings belong to an arm's world.
+void check_links_world(const Episode& e, const WorldConfig& world, const std::string& where) {
+  if (!e.links.empty() && world.embodiment != Embodiment::arm)
+    throw InputError(where + ": holds an arm's link readings, but the set's world has no arm (\"embodiment\": \"cup\")");
 }
 
 // meta.json of `set` (its episodes not read) with these episode entries.
 json meta_with_entries(const DemoSet& set, json episodes) {
   const bool perturbed = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("perturbation"); });
-  // Version 3 only adds the perturbation: a set without one is written as version 2.
+  const bool arm = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("final_links"); });
+  // Version 3 only adds the perturbation, version 4 an arm's readings: a set without either is
+  // written as the version before them.
+  json units{{"length", "m"},
+             {"angle", "rad"},
+             {"time", "s"},
+             {"control_dt", set.world.physics.control_dt},
+             {"state", "before the step's action; cup x, y at its centre of mass"},
+             {"action", "velocity change of the cup applied at the start of the step: dvx, dvy (m/s), dw (rad/s)"},
+             {"reward", "DiceEnv::step's reward for arriving at the next state (empty: unknown)"},
+             {"final_state", "the state after the last action (null: unknown)"}};
+  if (arm) {
+    units["links"] = "each arm link's absolute angle (rad) and rate (rad/s) before the step's action, shoulder link first";
+    units["joint_torques"] = "the torques the four joints held on average over the step, N m, shoulder first (empty: unknown)";
+    units["final_links"] = "the links after the last action (null: unknown)";
+  }
   return {{"format", kDemoFormat},
-          {"version", perturbed ? kDemoFormatVersion : 2},
+          {"version", arm ? kDemoFormatVersion : perturbed ? 3 : 2},
           {"dicestack_version", DICESTACK_VERSION},
           {"description", set.description},
           {"provenance", set.provenance},
-          {"units",
-           {{"length", "m"},
-            {"angle", "rad"},
-            {"time", "s"},
-            {"control_dt", set.world.physics.control_dt},
-            {"state", "before the step's action; cup x, y at its centre of mass"},
-            {"action", "velocity change of the cup applied at the start of the step: dvx, dvy (m/s), dw (rad/s)"},
-            {"reward", "DiceEnv::step's reward for arriving at the next state (empty: unknown)"},
-            {"final_state", "the state after the last action (null: unknown)"}}},
+          {"units", std::move(units)},
           {"world", json::parse(to_json(set.world))},
           {"episodes", std::move(episodes)}};
 }
@@ -160,6 +176,26 @@ void transitions_from(const json& entry, const fs::path& meta, DemoMetaEntry& e)
     meta_error(meta, e.file + " has no final state, so terminated and truncated must be false (unknown)");
 }
 
+// Version 4's "final_links" of an arm's episode: null (unknown) or {"angles": [3], "rates": [3]}.
+void final_links_from(const json& f, const fs::path& meta, DemoMetaEntry& e) {
+  e.arm = true;
+  if (f.is_null()) return;
+  const std::string what = "\"final_links\" of " + e.file;
+  if (!f.is_object() || !f.contains("angles") || !f.contains("rates"))
+    meta_error(meta, what + " must be null or an object with \"angles\" and \"rates\" (3 numbers each)");
+  ArmLinks l;
+  for (const auto& [key, out] : {std::pair<const char*, std::array<double, 3>*>{"angles", &l.angles}, {"rates", &l.rates}}) {
+    const json& v = f[key];
+    if (!v.is_array() || v.size() != 3) meta_error(meta, what + ": \"" + key + "\" must be a list of 3 numbers");
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
+        meta_error(meta, what + ": \"" + key + "\" item " + std::to_string(i) + " is not a finite number");
+      (*out)[i] = v[i].get<double>();
+    }
+  }
+  e.final_links = l;
+}
+
 Ownership meta_ownership() { return Ownership::json_object("dicestack demonstration meta.json", kDemoFormat); }
 
 // Our scratch files and folders: ".<name>.tmp-<digits>-..." or ".<name>.old-<digits>-...".
@@ -217,6 +253,7 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
         meta_error(meta_path, "\"perturbation\" of " + e.file + " must be an object (the values its world drew)");
       e.perturbation = entry["perturbation"].dump();
     }
+    if (version >= 4 && entry.contains("final_links")) final_links_from(entry["final_links"], meta_path, e);
     out.episodes.push_back(std::move(e));
   }
   return out;
@@ -244,8 +281,15 @@ DemoSet read_demo_set(const fs::path& dir) {
     Episode e = episode_csv::parse(read_file(path), path.string(), path.stem().string(), csv_version);
     // A version-2 set may hold version-1 files (appended to an old set): episodes without transitions.
     if (csv_version > meta.version)
-      throw InputError(path.string() + ":1: the header is format version " + std::to_string(csv_version) +
-                       "'s (with reward), but meta.json says version " + std::to_string(meta.version));
+      throw InputError(path.string() + ":1: the header is format version " + std::to_string(csv_version) + "'s (" +
+                       (csv_version >= 4 ? "with the arm's links and joint torques" : "with reward") + "), but meta.json says version " +
+                       std::to_string(meta.version));
+    check_links_world(e, set.world, path.string());
+    if (entry.arm != !e.links.empty())
+      meta_error(meta_path, entry.file + (entry.arm ? " has \"final_links\", but its file holds no arm links"
+                                                    : " holds an arm's links, but its entry has no \"final_links\" (null when unknown)"));
+    if (entry.final_links && !entry.final_state)
+      meta_error(meta_path, entry.file + " has final links but no final state; they are known together");
     if (entry.final_state && e.rewards.empty())
       throw InputError(path.string() + ": meta.json gives a final state, so every row needs a reward");
     if (!entry.final_state && !e.rewards.empty())
@@ -256,6 +300,7 @@ DemoSet read_demo_set(const fs::path& dir) {
     e.seed = entry.seed;
     e.origin = std::move(entry.origin);
     e.perturbation = std::move(entry.perturbation);
+    e.final_links = entry.final_links;
     if (entry.steps != e.size())
       meta_error(meta_path, "says " + entry.file + " has " + std::to_string(entry.steps) + " steps; the file has " +
                                 std::to_string(e.size()));
@@ -349,6 +394,7 @@ void write_demo_set(const DemoSet& set, const fs::path& dir, const std::map<std:
   std::vector<std::string> files;
   for (std::size_t i = 0; i < set.episodes.size(); ++i) {
     check_episode(set.episodes[i]);
+    check_links_world(set.episodes[i], set.world, dir.string() + ": episode " + std::to_string(i));
     files.push_back(episode_file_name(i));
   }
   const auto ours = [](const fs::path& p) { return is_own_demo_set(p); };
@@ -374,6 +420,7 @@ std::size_t write_demo_set_streaming(const DemoSet& header, const fs::path& dir,
     json episodes = json::array();
     produce([&](const Episode& e) {
       check_episode(e);
+      check_links_world(e, header.world, dir.string() + ": episode " + std::to_string(written));
       const std::string file = episode_file_name(written);
       episode_csv::write(e, tmp / file, AtomicFile::Leftovers::skip);
       episodes.push_back(episode_entry(e, file));
@@ -402,6 +449,7 @@ std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Epi
   std::size_t next = set.episodes.size();
   for (auto& e : episodes) {
     check_episode(e);
+    check_links_world(e, set.world, dir.string());
     std::string file;
     do file = episode_file_name(next++);
     while (fs::exists(dir / file));

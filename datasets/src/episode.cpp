@@ -24,9 +24,32 @@ StepSource step_source_from(std::string_view text) {
 
 void Episode::clear_transitions() {
   final_state.reset();
+  final_links.reset();
   rewards.clear();
   terminated = truncated = false;
 }
+
+namespace {
+
+// The arm's readings beyond the links of each state: the joints' torques (one per action, only
+// beside links) and the links after the last action (only beside links and a final state).
+void check_arm_readings(const Episode& e, const std::string& who) {
+  if (!e.joint_torques.empty()) {
+    if (e.links.empty()) throw InputError(who + ": has joint torques but no arm link readings; an arm episode has both");
+    if (e.joint_torques.size() != e.actions.size())
+      throw InputError(who + ": " + std::to_string(e.actions.size()) + " actions and " + std::to_string(e.joint_torques.size()) +
+                       " joint torque readings; there must be one per action, or none");
+    for (std::size_t t = 0; t < e.joint_torques.size(); ++t) require_finite(e.joint_torques[t], who + " joint torques " + std::to_string(t));
+  }
+  if (!e.final_links) return;
+  if (e.links.empty() || !e.final_state)
+    throw InputError(who + ": has final arm links but " + (e.links.empty() ? "no arm link readings" : "no final state") +
+                     "; they are known together");
+  require_finite(e.final_links->angles, who + " final link angles");
+  require_finite(e.final_links->rates, who + " final link rates");
+}
+
+}  // namespace
 
 void check_episode(const Episode& e) {
   const std::string who = "episode " + (e.name.empty() ? std::string("(unnamed)") : e.name);
@@ -45,6 +68,7 @@ void check_episode(const Episode& e) {
     require_finite(e.links[t].angles, who + " link angles " + std::to_string(t));
     require_finite(e.links[t].rates, who + " link rates " + std::to_string(t));
   }
+  check_arm_readings(e, who);
   if (!e.final_state) {
     if (!e.rewards.empty()) throw InputError(who + ": has rewards but no final state; they are known together");
     return;

@@ -7,6 +7,8 @@ void pack_episode(Packer& out, const Episode& e) {
   out.put(e.outcome).put_string(e.origin).put<std::uint8_t>(e.final_state.has_value());
   if (e.final_state) out.put(*e.final_state);
   out.put_vector(e.rewards).put<std::uint8_t>(e.terminated).put<std::uint8_t>(e.truncated).put_string(e.perturbation);
+  out.put_vector(e.joint_torques).put<std::uint8_t>(e.final_links.has_value());
+  if (e.final_links) out.put(*e.final_links);
 }
 
 Episode unpack_episode(Unpacker& in) {
@@ -24,6 +26,8 @@ Episode unpack_episode(Unpacker& in) {
   e.terminated = in.get<std::uint8_t>() != 0;
   e.truncated = in.get<std::uint8_t>() != 0;
   e.perturbation = in.get_string();
+  e.joint_torques = in.get_vector<std::array<double, 4>>();
+  if (in.get<std::uint8_t>()) e.final_links = in.get<ArmLinks>();
   return e;
 }
 

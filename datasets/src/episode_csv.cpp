@@ -20,6 +20,9 @@ namespace fs = std::filesystem;
 constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
 constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
 constexpr std::size_t kNumbers = 1 + kStateDim + kActionDim;         // t, state, action
+constexpr std::size_t kLinkColumns = 6;                              // an arm's three link angles, then their rates
+constexpr std::size_t kTorqueColumns = 4;                            // the torques its four joints held
+constexpr std::size_t kColumnsV4 = kColumnsV2 + kLinkColumns + kTorqueColumns;  // and, on an arm, those
 
 // Splits one CSV line on commas (no quoting: none of our fields contain commas).
 void split_fields(std::string_view line, std::vector<std::string_view>& out) {
@@ -40,15 +43,16 @@ std::string_view trim(std::string_view s) {
 }
 
 
-// Checks a CSV header row (either layout version's columns, in order); sets `columns` to its
-// column names and returns the version.
+// Checks a CSV header row (any layout version's columns, in order); sets `columns` to its
+// column names and returns the version (1, 2, or 4 for an arm's episode).
 int check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
-  if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2)
+  if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2 && fields.size() != kColumnsV4)
     throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
-                     std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1) or " +
-                     std::to_string(kColumnsV2) + " (the same and reward: version 2)");
+                     std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1), " +
+                     std::to_string(kColumnsV2) + " (the same and reward: version 2) or " + std::to_string(kColumnsV4) +
+                     " (those, the arm's link angles and rates and its joint torques: version 4)");
   const std::size_t width = fields.size();
-  const int version = width == kColumnsV1 ? 1 : 2;
+  const int version = width == kColumnsV1 ? 1 : width == kColumnsV2 ? 2 : 4;
   columns = episode_csv_columns(version);
   for (std::size_t c = 0; c < width; ++c)
     if (trim(fields[c]) != columns[c])
@@ -57,23 +61,49 @@ int check_csv_header(const std::vector<std::string_view>& fields, const std::str
   return version;
 }
 
+// Column `c` of a row, a finite number.
+double parse_csv_number(const std::vector<std::string_view>& fields, std::size_t c, const std::string& prefix,
+                        const std::vector<std::string>& columns) {
+  const std::string_view f = trim(fields[c]);
+  double v = 0.0;
+  const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+  if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
+    throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
+                     (f.size() > 40 ? "...\"" : "\"") + " is not a number");
+  if (!std::isfinite(v))
+    throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
+                     "; demonstrations must be finite");
+  return v;
+}
+
 // The numeric columns of a row (t, state, action), each a finite number.
 std::array<double, kNumbers> parse_csv_numbers(const std::vector<std::string_view>& fields, const std::string& prefix,
                                                const std::vector<std::string>& columns) {
   std::array<double, kNumbers> values{};
-  for (std::size_t c = 0; c < kNumbers; ++c) {
-    const std::string_view f = trim(fields[c]);
-    double v = 0.0;
-    const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
-    if (f.empty() || r.ec != std::errc() || r.ptr != f.data() + f.size())
-      throw InputError(prefix + "column \"" + columns[c] + "\": \"" + std::string(f.substr(0, 40)) +
-                       (f.size() > 40 ? "...\"" : "\"") + " is not a number");
-    if (!std::isfinite(v))
-      throw InputError(prefix + "column \"" + columns[c] + "\" is " + (std::isnan(v) ? "NaN" : "infinite") +
-                       "; demonstrations must be finite");
-    values[c] = v;
-  }
+  for (std::size_t c = 0; c < kNumbers; ++c) values[c] = parse_csv_number(fields, c, prefix, columns);
   return values;
+}
+
+// A version-4 row's arm columns, after the reward: the links (numbers) and the joint torques,
+// numbers in every row or (unknown) empty in every row, as line 2's (`torques_empty`).
+void parse_csv_arm(const std::vector<std::string_view>& fields, const std::string& prefix,
+                   const std::vector<std::string>& columns, bool& torques_empty, Episode& e) {
+  const std::size_t first = kColumnsV2;
+  ArmLinks& l = e.links.emplace_back();
+  for (std::size_t i = 0; i < 3; ++i) {
+    l.angles[i] = parse_csv_number(fields, first + i, prefix, columns);
+    l.rates[i] = parse_csv_number(fields, first + 3 + i, prefix, columns);
+  }
+  const std::size_t torque = first + kLinkColumns;
+  bool empty = true;
+  for (std::size_t j = 0; j < kTorqueColumns; ++j) empty = empty && trim(fields[torque + j]).empty();
+  if (e.states.size() == 1) torques_empty = empty;
+  if (empty != torques_empty)
+    throw InputError(prefix + "the joint torques are " + (empty ? "empty" : "numbers") + " but line 2's are " +
+                     (torques_empty ? "empty" : "numbers") + "; an episode's joint torques are all known or all empty");
+  if (empty) return;
+  std::array<double, kTorqueColumns>& tau = e.joint_torques.emplace_back();
+  for (std::size_t j = 0; j < kTorqueColumns; ++j) tau[j] = parse_csv_number(fields, torque + j, prefix, columns);
 }
 
 // The reward cell `f` of the row just appended to `e`: empty in every row (unknown, as in the
@@ -95,9 +125,9 @@ void parse_csv_reward(std::string_view f, const std::string& prefix, bool& rewar
 }
 
 // Appends one data row (its width already checked) to `e`: the next step's state, action,
-// source and, in version 2, reward.
+// source, from version 2 its reward and in version 4 the arm's links and joint torques.
 void append_csv_row(const std::vector<std::string_view>& fields, const std::string& prefix,
-                    const std::vector<std::string>& columns, int version, bool& reward_empty, Episode& e) {
+                    const std::vector<std::string>& columns, int version, bool& reward_empty, bool& torques_empty, Episode& e) {
   const std::array<double, kNumbers> values = parse_csv_numbers(fields, prefix, columns);
   const double expected_t = static_cast<double>(e.states.size());
   if (values[0] != expected_t)
@@ -115,6 +145,7 @@ void append_csv_row(const std::vector<std::string_view>& fields, const std::stri
     throw InputError(prefix + "column \"source\": " + err.what());
   }
   if (version >= 2) parse_csv_reward(trim(fields[kNumbers + 1]), prefix, reward_empty, e);
+  if (version >= 4) parse_csv_arm(fields, prefix, columns, torques_empty, e);
 }
 
 std::string csv_header(int version) {
@@ -140,28 +171,35 @@ void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftove
                                        "written to it");
   AtomicFile file(path, ownership(), leftovers);
   auto& out = file.stream();
-  const auto columns = episode_csv_columns();
-  for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
-  out << '\n';
+  // An arm's episode adds its links and joint torques; any other keeps version 2's columns, byte
+  // for byte.
+  const bool arm = !e.links.empty();
+  out << csv_header(arm ? 4 : 2) << '\n';
   for (std::size_t t = 0; t < e.states.size(); ++t) {
     out << t;
     for (double v : e.states[t]) out << ',' << number_text(v);
     for (double v : e.actions[t]) out << ',' << number_text(v);
     out << ',' << to_string(e.sources[t]) << ',';
     if (e.has_transitions()) out << number_text(e.rewards[t]);  // empty cell: unknown
+    if (arm) {
+      for (double v : e.links[t].angles) out << ',' << number_text(v);
+      for (double v : e.links[t].rates) out << ',' << number_text(v);
+      for (std::size_t j = 0; j < kTorqueColumns; ++j)
+        out << ',' << (e.joint_torques.empty() ? std::string() : number_text(e.joint_torques[t][j]));  // empty: unknown
+    }
     out << '\n';
   }
   file.commit();
 }
 
 Ownership ownership() {
-  return Ownership::first_line("dicestack episode CSV", {csv_header(1), csv_header(2)});
+  return Ownership::first_line("dicestack episode CSV", {csv_header(1), csv_header(2), csv_header(4)});
 }
 
 Episode parse(std::string_view text, const std::string& where, std::string name, int& version) {
   std::vector<std::string> columns;
   std::size_t width = 0;
-  bool reward_empty = false;
+  bool reward_empty = false, torques_empty = false;
   Episode e;
   e.name = std::move(name);
   std::vector<std::string_view> fields;
@@ -185,7 +223,7 @@ Episode parse(std::string_view text, const std::string& where, std::string name,
     if (fields.size() != width)
       throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
                        std::to_string(width) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
-    append_csv_row(fields, prefix, columns, version, reward_empty, e);
+    append_csv_row(fields, prefix, columns, version, reward_empty, torques_empty, e);
   }
   if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
   if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");
@@ -200,6 +238,10 @@ std::vector<std::string> episode_csv_columns(int version) {
   for (auto n : action_names()) cols.emplace_back(n);
   cols.emplace_back("source");
   if (version >= 2) cols.emplace_back("reward");
+  if (version < 4) return cols;
+  for (const char* what : {"angle", "rate"})
+    for (int i = 0; i < 3; ++i) cols.push_back("link" + std::to_string(i) + "_" + what);
+  for (int j = 0; j < 4; ++j) cols.push_back("joint" + std::to_string(j) + "_torque");
   return cols;
 }
 

@@ -180,6 +180,40 @@ nlohmann::json set_record(const DemoSet& set, const char* format) {
           {"provenance", set.provenance}};
 }
 
+bool arm_episodes(const std::vector<Episode>& episodes, const std::string& where) {
+  std::vector<std::string> without;
+  std::size_t arm = 0;
+  for (const auto& e : episodes) {
+    arm += !e.links.empty();
+    if (e.links.empty() || !e.final_links) without.push_back(e.name.empty() ? "(unnamed)" : e.name);
+  }
+  if (arm == 0) return false;
+  if (without.empty()) return true;
+  std::string list;
+  for (std::size_t i = 0; i < without.size() && i < 10; ++i) list += (i ? ", " : "") + without[i];
+  if (without.size() > 10) list += " and " + std::to_string(without.size() - 10) + " more";
+  throw InputError(where + ": " + std::to_string(without.size()) + " of " + std::to_string(episodes.size()) +
+                   " episodes lack the arm's links or its links after the last action, which the others have: " + list);
+}
+
+std::vector<double> link_rows(const Episode& e, bool rates) {
+  std::vector<double> out;
+  out.reserve(3 * (e.links.size() + 1));
+  for (const auto& l : e.links) out.insert(out.end(), (rates ? l.rates : l.angles).begin(), (rates ? l.rates : l.angles).end());
+  const auto& last = rates ? e.final_links->rates : e.final_links->angles;
+  out.insert(out.end(), last.begin(), last.end());
+  return out;
+}
+
+void links_from_rows(const h5::Array& angles, const h5::Array& rates, Episode& e) {
+  const std::size_t rows = angles.values.size() / 3;
+  e.links.assign(rows - 1, ArmLinks{});
+  for (std::size_t t = 0; t < rows; ++t) {
+    ArmLinks& l = t + 1 < rows ? e.links[t] : e.final_links.emplace();
+    std::copy_n(angles.values.begin() + static_cast<std::ptrdiff_t>(3 * t), 3, l.angles.begin());
+    std::copy_n(rates.values.begin() + static_cast<std::ptrdiff_t>(3 * t), 3, l.rates.begin());
+  }
+}
 
 }  // namespace interop
 }  // namespace dicestack

@@ -46,5 +46,14 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& where
 /// The "dicestack" object both exports carry: marker, version, the writer's version, description, provenance.
 nlohmann::json set_record(const DemoSet& set, const char* format);
 
+/// True when the episodes are an arm's: each has its links and its final links (the T + 1th
+/// observation both exports carry); false when none has links. Throws InputError naming `where`
+/// and the episodes otherwise.
+bool arm_episodes(const std::vector<Episode>& episodes, const std::string& where);
+/// An arm episode's link angles (or rates) at t = 0..T, the last its final links: 3 per row.
+std::vector<double> link_rows(const Episode& e, bool rates);
+/// The inverse of link_rows: T + 1 rows of angles and of rates into e.links and e.final_links.
+void links_from_rows(const h5::Array& angles, const h5::Array& rates, Episode& e);
+
 
 }  // namespace dicestack::interop

@@ -183,6 +183,36 @@ std::vector<std::string> list_minari_episodes(const h5::ReadFile& f, const std::
   return names;
 }
 
+// An arm's readings as the environment's infos give them at reset and after each step: the links,
+// and the torques the joints held over the step (none before the first).
+void write_minari_arm(hid_t episode, const Episode& e) {
+  const hsize_t rows = e.size() + 1;
+  const h5::Id infos = h5::create_group(episode, "infos");
+  h5::write_f64(infos.get(), "link_angles", {rows, 3}, link_rows(e, false).data());
+  h5::write_f64(infos.get(), "link_rates", {rows, 3}, link_rows(e, true).data());
+  if (e.joint_torques.empty()) return;
+  std::vector<double> torques(4, 0.0);
+  for (const auto& tau : e.joint_torques) torques.insert(torques.end(), tau.begin(), tau.end());
+  h5::write_f64(infos.get(), "joint_torques", {rows, 4}, torques.data());
+}
+
+// write_minari_arm's infos back, where the episode has them.
+void read_minari_arm(hid_t episode, const std::string& where, std::size_t steps, Episode& e) {
+  if (!h5::exists(episode, "infos/link_angles")) {
+    if (h5::exists(episode, "infos/joint_torques"))
+      throw InputError(where + "/infos/joint_torques: an arm's joint torques need its links (infos/link_angles, infos/link_rates)");
+    return;
+  }
+  const h5::Array angles = read_shaped(episode, "infos/link_angles", where + "/infos/link_angles", steps + 1, 3);
+  const h5::Array rates = read_shaped(episode, "infos/link_rates", where + "/infos/link_rates", steps + 1, 3);
+  links_from_rows(angles, rates, e);
+  if (!h5::exists(episode, "infos/joint_torques")) return;
+  const h5::Array torques = read_shaped(episode, "infos/joint_torques", where + "/infos/joint_torques", steps + 1, 4);
+  e.joint_torques.assign(steps, {});
+  for (std::size_t t = 0; t < steps; ++t)
+    std::copy_n(torques.values.begin() + static_cast<std::ptrdiff_t>(4 * (t + 1)), 4, e.joint_torques[t].begin());
+}
+
 // Reads and checks the main file's group `name`, the episode at `index` of the dataset in `dir`.
 Episode read_minari_episode(const h5::ReadFile& f, const std::string& name, std::size_t index, const fs::path& dir,
                             const WorldConfig& world) {
@@ -219,6 +249,7 @@ Episode read_minari_episode(const h5::ReadFile& f, const std::string& name, std:
   e.rewards = rewards.values;
   e.terminated = terminations.back() != 0.0;
   e.truncated = truncations.back() != 0.0;
+  read_minari_arm(g.get(), where, steps, e);
   read_episode_record(g.get(), where, index, "seed", "minari " + dir.string() + " " + name, world, e);
   check_read_episode(e, where);
   return e;
@@ -241,6 +272,7 @@ void export_minari(const DemoSet& set, const fs::path& dir, const std::string& d
   validate(set.world);
   require_transitions(set.episodes, dir.string());
   for (const auto& e : set.episodes) check_episode(e);
+  const bool arm = arm_episodes(set.episodes, dir.string());
   check_minari_replaceable(dir);
 
   h5::MemoryFile f;
@@ -265,6 +297,7 @@ void export_minari(const DemoSet& set, const fs::path& dir, const std::string& d
     h5::write_f64(g.get(), "rewards", {steps}, e.rewards.data());
     h5::write_bool(g.get(), "terminations", terminations);
     h5::write_bool(g.get(), "truncations", truncations);
+    if (arm) write_minari_arm(g.get(), e);
     h5::attr_string(g.get(), "dicestack_name", e.name);
     h5::attr_string(g.get(), "dicestack_origin", e.origin);
     h5::attr_string(g.get(), "dicestack_sources", sources_text(e.sources));

@@ -156,6 +156,83 @@ std::vector<Action> read_robomimic_actions(hid_t demo, const std::string& where,
   return out;
 }
 
+// robosuite's robot0_joint_pos (or, with `rates`, robot0_joint_vel) of an arm at each state:
+// each joint's angle is its body's less the body's before it, the cup (the wrist's body) from
+// the state.
+std::vector<double> joint_rows(const std::vector<State>& states, const std::vector<ArmLinks>& links, bool rates) {
+  std::vector<double> out;
+  out.reserve(4 * states.size());
+  for (std::size_t t = 0; t < states.size(); ++t) {
+    const auto& a = rates ? links[t].rates : links[t].angles;
+    const double cup = states[t][rates ? state_index::kCupW : state_index::kCupAngle];
+    out.insert(out.end(), {a[0], a[1] - a[0], a[2] - a[1], cup - a[2]});
+  }
+  return out;
+}
+
+// An arm's readings: robosuite's joint observations (obs/ and next_obs/), the torques its joints
+// held as an action of their own (action_dict/joint_torques, N m) and, for an exact round trip,
+// our links (dicestack/links: angles then rates; dicestack/final_links).
+void write_robomimic_arm(hid_t demo, hid_t obs, hid_t next_obs, hid_t ours, const Episode& e) {
+  const hsize_t steps = e.size();
+  std::vector<State> next(e.states.begin() + 1, e.states.end());
+  next.push_back(*e.final_state);
+  std::vector<ArmLinks> next_links(e.links.begin() + 1, e.links.end());
+  next_links.push_back(*e.final_links);
+  for (const bool rates : {false, true}) {
+    const char* key = rates ? "robot0_joint_vel" : "robot0_joint_pos";
+    h5::write_f64(obs, key, {steps, 4}, joint_rows(e.states, e.links, rates).data());
+    h5::write_f64(next_obs, key, {steps, 4}, joint_rows(next, next_links, rates).data());
+  }
+  std::vector<double> links;
+  for (const auto& l : e.links) {
+    links.insert(links.end(), l.angles.begin(), l.angles.end());
+    links.insert(links.end(), l.rates.begin(), l.rates.end());
+  }
+  h5::write_f64(ours, "links", {steps, 6}, links.data());
+  std::vector<double> last(e.final_links->angles.begin(), e.final_links->angles.end());
+  last.insert(last.end(), e.final_links->rates.begin(), e.final_links->rates.end());
+  h5::write_f64(ours, "final_links", {6}, last.data());
+  if (e.joint_torques.empty()) return;
+  std::vector<double> torques;
+  for (const auto& tau : e.joint_torques) torques.insert(torques.end(), tau.begin(), tau.end());
+  const h5::Id actions = h5::create_group(demo, "action_dict");
+  h5::write_f64(actions.get(), "joint_torques", {steps, 4}, torques.data());
+}
+
+// write_robomimic_arm's readings back, where the demo has them.
+void read_robomimic_arm(hid_t demo, const std::string& where, Episode& e) {
+  const std::size_t steps = e.size();
+  if (!h5::exists(demo, "dicestack/links")) {
+    if (h5::exists(demo, "action_dict/joint_torques"))
+      throw InputError(where + "/action_dict/joint_torques: an arm's joint torques need its links (dicestack/links)");
+    return;
+  }
+  const h5::Array links = read_shaped(demo, "dicestack/links", where + "/dicestack/links", steps, 6);
+  const h5::Array last = read_shaped(demo, "dicestack/final_links", where + "/dicestack/final_links", 6, 0);
+  h5::Array angles, rates;
+  for (std::size_t t = 0; t <= steps; ++t)
+    for (std::size_t i = 0; i < 3; ++i) {
+      angles.values.push_back(t < steps ? links.values[6 * t + i] : last.values[i]);
+      rates.values.push_back(t < steps ? links.values[6 * t + 3 + i] : last.values[3 + i]);
+    }
+  links_from_rows(angles, rates, e);
+  for (const bool r : {false, true}) {
+    const std::string key = std::string("obs/") + (r ? "robot0_joint_vel" : "robot0_joint_pos");
+    if (!h5::exists(demo, key)) continue;
+    const h5::Array seen = read_shaped(demo, key, where + "/" + key, steps, 4);
+    const std::vector<double> expected = joint_rows(e.states, e.links, r);
+    for (std::size_t k = 0; k < expected.size(); ++k)
+      if (!(std::abs(seen.values[k] - expected[k]) <= 1e-9))
+        throw InputError(where + "/" + key + ": " + row_col(k / 4, k % 4) + " disagrees with dicestack/links and the states");
+  }
+  if (!h5::exists(demo, "action_dict/joint_torques")) return;
+  const h5::Array torques = read_shaped(demo, "action_dict/joint_torques", where + "/action_dict/joint_torques", steps, 4);
+  e.joint_torques.assign(steps, {});
+  for (std::size_t t = 0; t < steps; ++t)
+    std::copy_n(torques.values.begin() + static_cast<std::ptrdiff_t>(4 * t), 4, e.joint_torques[t].begin());
+}
+
 // Reads and checks the group data/<name>, the episode at `index`.
 Episode read_robomimic_demo(const h5::ReadFile& f, const std::string& name, std::size_t index, const WorldConfig& world) {
   const std::string& F = f.name();
@@ -183,6 +260,7 @@ Episode read_robomimic_demo(const h5::ReadFile& f, const std::string& name, std:
   e.final_state = check_robomimic_observations(demo.get(), where, path, e.states);
   e.rewards = rewards.values;
   e.actions = read_robomimic_actions(demo.get(), where, path, actions, world.action.limit);
+  read_robomimic_arm(demo.get(), where, e);
 
   read_episode_record(demo.get(), where, index, "dicestack_seed", "robomimic " + F + " " + name, world, e);
   const auto terminated = h5::read_attr_int(demo.get(), "dicestack_terminated", where);
@@ -199,6 +277,7 @@ void export_robomimic(const DemoSet& set, const fs::path& file) {
   validate(set.world);
   require_transitions(set.episodes, file.string());
   for (const auto& e : set.episodes) check_episode(e);
+  const bool arm = arm_episodes(set.episodes, file.string());
   check_replaceable(file, robomimic_ownership());  // before any work
   const auto& limit = set.world.action.limit;
 
@@ -239,6 +318,7 @@ void export_robomimic(const DemoSet& set, const fs::path& file) {
     // The world-unit actions, so that the round trip is exact (a / limit * limit is not always a).
     const h5::Id ours = h5::create_group(demo.get(), "dicestack");
     h5::write_f64(ours.get(), "actions", {steps, kActionDim}, raw.data());
+    if (arm) write_robomimic_arm(demo.get(), obs.get(), next_obs.get(), ours.get(), e);
 
     h5::attr_i64(demo.get(), "num_samples", static_cast<std::int64_t>(steps));
     h5::attr_string(demo.get(), "dicestack_name", e.name);

@@ -60,8 +60,10 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
     const StepResult& r = step.result;
     applied.push_back(r.applied);
     e.rewards.push_back(r.reward);
+    if (arm) e.joint_torques.push_back(env.world().arm_step_torques());
     if (r.terminated || r.truncated || applied.size() == options.max_steps) {
       e.final_state = r.observation;
+      if (arm) e.final_links = env.world().arm_links();
       e.terminated = r.terminated;
       e.truncated = !r.terminated;  // the time limit or options.max_steps
       break;

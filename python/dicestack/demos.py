@@ -20,7 +20,10 @@ class Episode:
     the outcome fields are what the judge saw over the whole episode. Format v2's transitions:
     `final_state` (the state after the last action, shape (24,)), `rewards` (T) and the end flags
     `terminated` / `truncated`; `final_state` and `rewards` are None where unknown (a format-v1
-    set whose final state could not be recovered by replay).
+    set whose final state could not be recovered by replay). On the arm (format v4):
+    `link_angles` and `link_rates` (T x 3, each link's absolute angle and rate before each
+    action), `joint_torques` (T x 4, N m, what the joints held over each step) and
+    `final_link_angles` / `final_link_rates` (3 each, after the last action); None elsewhere.
     """
 
     states: np.ndarray
@@ -39,8 +42,18 @@ class Episode:
     rewards: np.ndarray = None
     terminated: bool = False
     truncated: bool = False
+    link_angles: np.ndarray = None
+    link_rates: np.ndarray = None
+    joint_torques: np.ndarray = None
+    final_link_angles: np.ndarray = None
+    final_link_rates: np.ndarray = None
+
+    _ARM_FIELDS = ("link_angles", "link_rates", "joint_torques", "final_link_angles", "final_link_rates")
 
     def __post_init__(self):
+        for field in self._ARM_FIELDS:
+            if getattr(self, field) is not None:
+                setattr(self, field, np.asarray(getattr(self, field), dtype=np.float64))
         self.states = np.asarray(self.states, dtype=np.float64)
         self.actions = np.asarray(self.actions, dtype=np.float64)
         if self.final_state is not None:
@@ -90,6 +103,7 @@ class Episode:
             "rewards": self.rewards,
             "terminated": bool(self.terminated),
             "truncated": bool(self.truncated),
+            **{field: getattr(self, field) for field in self._ARM_FIELDS},
         }
 
     @classmethod

@@ -94,7 +94,7 @@ class DiceStackEnv(_EnvBase):
     "joint_torque" (the arm only: the action is the four joint torques in N m, shoulder first,
     held through the step and clipped to the arm's limits, which `action_space` gives). On the
     arm, info also holds link_angles and link_rates (each link's absolute direction and rate)
-    and joint_torques (what the joints gave in the last substep).
+    and joint_torques (what the joints held on average over the last step, N m).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}

@@ -15,6 +15,50 @@
 
 namespace dicestack::python {
 
+namespace {
+
+// An arm's readings (format v4): each None where the episode has none.
+void add_arm_readings(py::dict& d, const Episode& e) {
+  const py::object none = py::none();
+  std::vector<std::array<double, 3>> angles, rates;
+  for (const auto& l : e.links) {
+    angles.push_back(l.angles);
+    rates.push_back(l.rates);
+  }
+  d["link_angles"] = e.links.empty() ? none : py::object(rows_to_array(angles));
+  d["link_rates"] = e.links.empty() ? none : py::object(rows_to_array(rates));
+  d["joint_torques"] = e.joint_torques.empty() ? none : py::object(rows_to_array(e.joint_torques));
+  d["final_link_angles"] = e.final_links ? py::object(to_array(e.final_links->angles)) : none;
+  d["final_link_rates"] = e.final_links ? py::object(to_array(e.final_links->rates)) : none;
+}
+
+// add_arm_readings's keys back into `e` (absent or None: none); the lengths are check_episode's.
+void arm_readings_from(const py::dict& d, Episode& e) {
+  const auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
+  if (given("link_angles") != given("link_rates"))
+    throw py::value_error("episode " + e.name + ": link_angles and link_rates go together (both None, or both given)");
+  if (given("link_angles")) {
+    const auto angles = rows_from<3>(d["link_angles"], "episode link_angles");
+    const auto rates = rows_from<3>(d["link_rates"], "episode link_rates");
+    if (angles.size() != rates.size())
+      throw py::value_error("episode " + e.name + ": link_angles and link_rates have different lengths");
+    for (std::size_t t = 0; t < angles.size(); ++t) e.links.push_back({angles[t], rates[t]});
+  }
+  if (given("joint_torques")) e.joint_torques = rows_from<4>(d["joint_torques"], "episode joint_torques");
+  if (given("final_link_angles") != given("final_link_rates"))
+    throw py::value_error("episode " + e.name + ": final_link_angles and final_link_rates go together (both None, or both given)");
+  if (given("final_link_angles")) {
+    ArmLinks l;
+    const auto a = vector_from(d["final_link_angles"], 3, "episode final_link_angles");
+    const auto r = vector_from(d["final_link_rates"], 3, "episode final_link_rates");
+    std::copy(a.begin(), a.end(), l.angles.begin());
+    std::copy(r.begin(), r.end(), l.rates.begin());
+    e.final_links = l;
+  }
+}
+
+}  // namespace
+
 py::dict episode_dict(const Episode& e) {
   py::list sources;
   for (StepSource s : e.sources) sources.append(std::string(to_string(s)));
@@ -35,6 +79,7 @@ py::dict episode_dict(const Episode& e) {
   d["rewards"] = e.final_state ? py::object(to_array(e.rewards)) : py::object(py::none());
   d["terminated"] = e.terminated;
   d["truncated"] = e.truncated;
+  add_arm_readings(d, e);
   return d;
 }
 
@@ -63,6 +108,7 @@ Episode episode_from(const py::handle& obj) {
   }
   e.terminated = d.contains("terminated") && d["terminated"].cast<bool>();
   e.truncated = d.contains("truncated") && d["truncated"].cast<bool>();
+  arm_readings_from(d, e);
   check_episode(e);
   return e;
 }

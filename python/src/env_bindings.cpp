@@ -88,7 +88,7 @@ py::dict with_arm(py::dict info, const EnvCore& core) {
   if (w.config().embodiment != Embodiment::arm) return info;
   info["link_angles"] = to_array(w.arm_link_angles());
   info["link_rates"] = to_array(w.arm_link_rates());
-  info["joint_torques"] = to_array(w.arm_joint_torques());
+  info["joint_torques"] = to_array(w.arm_step_torques());  // as demonstration sets keep them
   return info;
 }
 

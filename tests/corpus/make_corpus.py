@@ -105,7 +105,7 @@ def demo_cases():
         "inf": "episode_0001.csv:3: column \"dw\" is infinite",
         "missing_file": "meta.json: lists episode_0009.csv, which does not exist",
         "nan": "episode_0001.csv:3: column \"cup_x\" is NaN",
-        "newer_version": "meta.json: format version 3 is newer than this dicestack reads",
+        "newer_version": "meta.json: format version 99 is newer than this dicestack reads",
         "no_meta": "meta.json: missing; not a dicestack demonstration folder",
         "not_a_number": "episode_0001.csv:3: column \"die2_vy\": \"1.2.3\" is not a number",
         "row_columns": "episode_0001.csv:3: row has 30 columns, expected 29",

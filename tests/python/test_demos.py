@@ -129,3 +129,26 @@ def test_a_minari_export_recovers_its_environment(tmp_path, cli, builtin_episode
     for a in actions:
         obs, *_ = env.step(a)
     np.testing.assert_array_equal(obs, observations[-1])
+
+
+def test_an_arm_set_keeps_its_links_and_joint_torques(tmp_path, cli):
+    import subprocess
+
+    subprocess.run([cli, "record", "--expert", "scripted", "--episodes", "2", "--embodiment", "arm", "--threads", "1",
+                    "--out", str(tmp_path / "arm")], check=True, capture_output=True)
+    episodes = dicestack.load_demos(tmp_path / "arm")
+    for e in episodes:
+        assert e.link_angles.shape == (len(e), 3) and e.link_rates.shape == (len(e), 3)
+        assert e.joint_torques.shape == (len(e), 4) and np.any(e.joint_torques[:, 0])
+        assert e.final_link_angles.shape == (3,) and e.final_link_rates.shape == (3,)
+    import json
+
+    world = json.loads((tmp_path / "arm" / "meta.json").read_text())["world"]
+    dicestack.save_demos(episodes, tmp_path / "again", world=world)
+    for a, b in zip(episodes, dicestack.load_demos(tmp_path / "again")):
+        for field in ("link_angles", "link_rates", "joint_torques", "final_link_angles", "final_link_rates"):
+            assert np.array_equal(getattr(a, field), getattr(b, field))
+    with pytest.raises(ValueError, match="link_angles and link_rates go together"):
+        dicestack.save_demos([dicestack.Episode(np.zeros((1, 24)), np.zeros((1, 3)), link_angles=np.zeros((1, 3)))],
+                             tmp_path / "bad")
+    assert all(e.link_angles is None for e in dicestack.load_demos("builtin")[:2])

@@ -63,7 +63,7 @@ def test_ctrl_c_stops_a_python_regressor_in_its_own_code(few):
 
 
 def test_ctrl_c_stops_an_evaluation(knn):
-    assert interrupted(lambda: dicestack.evaluate(knn, episodes=50000, threads=2, progress=False)) < 5
+    assert interrupted(lambda: dicestack.evaluate(knn, episodes=30000, threads=2, progress=False)) < 5
 
 
 def test_ctrl_c_stops_a_leaderboard_and_keeps_no_table(few, tmp_path):

@@ -20,8 +20,10 @@ inline constexpr const char* kDemoFormat = "dicestack-demos";
 /// Version 2 adds each episode's final state, terminated and truncated (meta.json) and the
 /// reward of each step (a `reward` column); version 3 each episode's perturbation (the values
 /// its perturbed world drew), written only by sets that hold one, so that nominal sets stay
-/// byte for byte version 2. Older folders stay readable (docs/formats.md).
-inline constexpr int kDemoFormatVersion = 3;
+/// byte for byte version 2; version 4 an arm's readings (its links and joint torques at each
+/// step, columns of their own, and its final links), written only by sets that hold an arm's
+/// episode. Older folders stay readable (docs/formats.md).
+inline constexpr int kDemoFormatVersion = 4;
 /// Format marker of the JSON summaries the baselines (optimise, reinforce, rrt) write into a set.
 inline constexpr const char* kBaselineFormat = "dicestack-baseline";
 
@@ -34,7 +36,8 @@ struct DemoSet {
 };
 
 /// The header row of an episode CSV of format `version` (1: t, 24 state names, dvx, dvy, dw,
-/// source; 2: those and reward).
+/// source; 2 and 3: those and reward; 4, an arm's episode: those, link0_angle to link2_angle,
+/// link0_rate to link2_rate and joint0_torque to joint3_torque).
 std::vector<std::string> episode_csv_columns(int version = kDemoFormatVersion);
 
 /// Reads a whole set, checking everything: meta.json's format and version, that its episode
@@ -64,11 +67,13 @@ struct DemoMetaEntry {
   bool terminated = false;           ///< version 2's "terminated"
   bool truncated = false;            ///< version 2's "truncated"
   std::string perturbation;          ///< version 3's "perturbation" (a JSON object), or empty
+  bool arm = false;                  ///< version 4: the entry has "final_links" (an arm's episode)
+  std::optional<ArmLinks> final_links;  ///< version 4's "final_links" (null: unknown)
 };
 
 /// What a set's meta.json says, checked on its own (no episode file is opened).
 struct DemoMeta {
-  int version = kDemoFormatVersion;  ///< the file's format version (1, 2 or 3)
+  int version = kDemoFormatVersion;  ///< the file's format version (1 to 4)
   WorldConfig world;
   std::string description;
   std::string provenance;

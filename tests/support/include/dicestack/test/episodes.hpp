@@ -46,6 +46,8 @@ inline void expect_same_episode(const Episode& x, const Episode& y) {
   EXPECT_EQ(x.actions, y.actions);
   EXPECT_EQ(x.sources, y.sources);
   EXPECT_EQ(x.links, y.links);
+  EXPECT_EQ(x.joint_torques, y.joint_torques);
+  EXPECT_EQ(x.final_links, y.final_links);
   EXPECT_EQ(x.final_state, y.final_state);
   EXPECT_EQ(x.rewards, y.rewards);
   EXPECT_EQ(x.terminated, y.terminated);
