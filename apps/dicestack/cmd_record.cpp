@@ -28,6 +28,8 @@ struct RecordOptions {
   int threads = 0;
   double noise = 0.0;
   std::string perturb = "none";
+  std::string expert_feedback = "world";
+  std::string estimator = "none";
   TrackerOption tracker;
   bool successes_only = false, no_replan = false, retry = false;
   bool json = false;
@@ -36,10 +38,36 @@ struct RecordOptions {
 // Episodes recorded (and held) at a time.
 constexpr int kRecordBatch = 256;
 
+// How the set was made, for its meta.json: the command's options and what they mean.
+std::string record_provenance(const RecordOptions& opt, const Perturbation& perturbation, const std::string& recordings) {
+  const bool sensed = opt.expert_feedback == "observations";
+  return "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
+         std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
+         (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
+         (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) + (sensed ? " --expert-feedback observations" : "") +
+         (opt.estimator == "none" ? "" : " --estimator " + opt.estimator) +
+         (opt.world.start == "random" ? "" : " --start " + opt.world.start) +
+         (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) + opt.tracker.as_arguments() +
+         "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
+         (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " + std::to_string(opt.noise) +
+                                " x action.scale per dimension, clean expert actions recorded"
+                          : "") +
+         (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its seed (" +
+                                            perturbation_summary(perturbation) + ")") +
+         (sensed ? "; the expert's feedback acted on " +
+                       std::string(opt.estimator == "none" ? "the observations" : "the " + opt.estimator + " estimator's estimate") +
+                       ", the states recorded are the world's"
+                 : "");
+}
+
 int run_record(const RecordOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
+  RecordRequest request;
+  request.feedback = opt.expert_feedback == "observations" ? ExpertFeedback::observations : ExpertFeedback::world;
+  request.estimator = estimator_config(opt.estimator);
+  check_record_sensing(ActionKind::cup, request);
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
@@ -57,7 +85,6 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   } else if (opt.tracker.given()) {
     throw ConfigError("record: --tracker-preset and --tracker set --expert tracker; expert " + opt.expert + " has neither");
   }
-  RecordRequest request;
   request.seed = opt.seed;
   request.threads = opt.threads;
   request.noise = {opt.noise, opt.noise, opt.noise};
@@ -69,19 +96,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   header.world = world;
   header.description = "dicestack record --expert " + opt.expert + (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) +
                        opt.tracker.as_arguments();
-  header.provenance = "dicestack record --expert " + opt.expert + " --episodes " + std::to_string(opt.episodes) + " --seed " +
-                      std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") +
-                      (opt.no_replan ? " --no-replan" : "") + (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
-                      (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) +
-                      (opt.world.start == "random" ? "" : " --start " + opt.world.start) +
-                      (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) + opt.tracker.as_arguments() +
-                      "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
-                      (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " +
-                                             std::to_string(opt.noise) + " x action.scale per dimension, clean expert "
-                                             "actions recorded"
-                                       : "") +
-                      (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its "
-                                                     "seed (" + perturbation_summary(perturbation) + ")");
+  header.provenance = record_provenance(opt, perturbation, recordings);
   int success = 0, stacked = 0, walls = 0;
   double cup = 0.0;
   // Batches of kRecordBatch episodes, each written as it comes and dropped: memory stays that
@@ -153,6 +168,16 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--perturb", opt->perturb,
                   "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "
                   "medium, hard or a perturbation file (docs/robustness.md)")
+      ->capture_default_str();
+  cmd->add_option("--expert-feedback", opt->expert_feedback,
+                  "What the expert's feedback acts on: world (its own privilege) or observations (what a policy is "
+                  "shown under the perturbation's sensing factors, or with --estimator the estimate; its choices "
+                  "still read the world). The states recorded are the world's either way")
+      ->check(CLI::IsMember({"world", "observations"}))
+      ->capture_default_str();
+  add_estimator_option(*cmd, opt->estimator)
+      ->description("With --expert-feedback observations, what stands between the sensors and the expert: none (the "
+                    "observations), kalman or particle[:N] (docs/robustness.md)")
       ->capture_default_str();
   cmd->add_option("--noise", opt->noise,
                   "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "

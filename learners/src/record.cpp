@@ -39,14 +39,27 @@ Action executed_noise(const Action& fractions, ActionKind kind, const WorldConfi
 
 }  // namespace
 
+void check_record_sensing(ActionKind controller, const RecordRequest& request) {
+  if (request.estimator.kind == EstimatorKind::none) return;
+  if (request.feedback != ExpertFeedback::observations)
+    throw ConfigError("record: an estimator stands between the sensors and the expert's feedback, which reads the world; "
+                      "give --expert-feedback observations");
+  if (controller == ActionKind::joint_torque)
+    throw ConfigError("record: an expert answering joint torques runs without an estimator (it rebuilds worlds without "
+                      "the arm's links)");
+}
+
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
   if (config.controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
     throw ConfigError("record: an expert answering joint torques drives an arm's joints; this world's cup floats");
   validate(request.perturbation, world);
+  check_record_sensing(config.controller, request);
   require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "episodes");
+  require_memory("record: the estimators of the episodes running at once",
+                 static_cast<std::uint64_t>(resolve_threads(request.threads)), estimator_bytes(request.estimator), "episodes");
   const Action noise = executed_noise(request.noise, config.controller, world);
   const int threads = request.threads;
   const auto workers = static_cast<std::size_t>(resolve_threads(threads));
@@ -62,7 +75,8 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
         const std::uint64_t s = training_start_seed(request.seed, request.first + i);
         PerturbedEnv episode(envs.at(w), request.perturbation, s);
         episode.add_executed_noise(noise, derive_seed(s, 2));
-        ExpertPolicy policy(*expert, episode.env());
+        episode.use_estimator(request.estimator);
+        ExpertPolicy policy(*expert, episode.env(), request.feedback);
         Episode e = rollout(episode, policy, episode.random_start(s), s, StepSource::expert);
         e.origin = "expert " + name;
         const int done = std::min(total, ++finished * ranks);

@@ -733,6 +733,22 @@ TEST(CliLearning, RecordWithNoiseRecordsTheCleanActionsAndSaysSo) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(CliLearning, RecordBehindTheEstimatorSaysSoAndAnEstimatorNothingReadsIsRefused) {
+  const auto dir = test::scratch_path("dicestack_cli_record_estimator");
+  std::filesystem::remove_all(dir);
+  const Process p = run("record --expert scripted --episodes 2 --perturb medium --expert-feedback observations "
+                        "--estimator kalman --out " + dir.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  std::ifstream meta(dir / "meta.json");
+  EXPECT_THAT(nlohmann::json::parse(meta)["provenance"].get<std::string>(),
+              HasSubstr("--expert-feedback observations --estimator kalman"));
+  std::filesystem::remove_all(dir);
+  const Process bad = run("record --expert scripted --episodes 1 --estimator kalman --out " + dir.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("give --expert-feedback observations"));
+  EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
 TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
   const auto dir = test::scratch_path("dicestack_cli_tracker");
   const Process p = run("record --expert tracker --demos " + kTinyDemos + " --episodes 2 --out " + dir.string(), false);
@@ -1037,7 +1053,7 @@ TEST(CliInterrupt, CtrlCStopsALongRunAtOnceAndLeavesTheOldOutput) {
   std::filesystem::remove_all(out);
 
   const auto model = test::scratch_path("dicestack_cli_interrupt.dsm");
-  pid = start("train --regressor gbt --learner dart --option episodes=50000 --out " + model.string());
+  pid = start("train --regressor gbt --learner dart --option episodes=30000 --out " + model.string());
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   kill(pid, SIGINT);
   EXPECT_EQ(wait_for(pid, 10.0), 130);

@@ -1,5 +1,6 @@
 // Recording an expert's episodes: seeded, the same on any thread count, and through the tracker
 // naming it.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <dicestack/learners/record.hpp>
 
 #include <dicestack/test/demos.hpp>
+#include <dicestack/test/helpers.hpp>
 #include <dicestack/test/requests.hpp>
 
 namespace dicestack {
@@ -36,6 +38,35 @@ TEST(Record, ExpertEpisodesAreSeededAndThreadIndependent) {
   ExpertConfig torques;  // joint torques drive an arm, and this world's cup floats
   torques.controller = ActionKind::joint_torque;
   EXPECT_THROW(record_expert("scripted", torques, w, test::record_request(1, 0, 1)), ConfigError);
+}
+
+TEST(Record, BehindAnEstimatorTheExpertsFeedbackReadsTheEstimateTheSameOnAnyThreadCount) {
+  WorldConfig w;
+  w.episode.max_steps = 40;
+  auto request = [](int threads, ExpertFeedback feedback, const char* estimator) {
+    RecordRequest r = test::record_request(2, 7, threads);
+    r.perturbation.observation_noise = 0.05;  // medium
+    r.feedback = feedback;
+    r.estimator = estimator_config(estimator);
+    return r;
+  };
+  const auto world = record_expert("mpc", {}, w, request(1, ExpertFeedback::world, "none"));
+  const auto seen = record_expert("mpc", {}, w, request(1, ExpertFeedback::observations, "none"));
+  const auto one = record_expert("mpc", {}, w, request(1, ExpertFeedback::observations, "kalman"));
+  const auto two = record_expert("mpc", {}, w, request(2, ExpertFeedback::observations, "kalman"));
+  ASSERT_EQ(one.size(), 2u);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states);
+    EXPECT_EQ(one[i].actions, two[i].actions);
+    EXPECT_EQ(one[i].states.front(), world[i].states.front());  // the states recorded are the world's
+    EXPECT_NE(one[i].actions, world[i].actions);
+    EXPECT_NE(one[i].actions, seen[i].actions);
+  }
+  // An estimator nothing reads, or that an expert in joint torques cannot run behind, is refused.
+  EXPECT_THAT(test::error_of([&] { record_expert("mpc", {}, w, request(1, ExpertFeedback::world, "kalman")); }),
+              ::testing::HasSubstr("give --expert-feedback observations"));
+  EXPECT_THAT(test::error_of([&] { check_record_sensing(ActionKind::joint_torque, request(1, ExpertFeedback::observations, "kalman")); }),
+              ::testing::HasSubstr("runs without an estimator"));
 }
 
 TEST(Record, ReportsEachFinishedEpisodeOnOneThread) {

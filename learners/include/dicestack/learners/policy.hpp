@@ -65,24 +65,29 @@ class PlaybackPolicy final : public Policy {
   std::vector<Action> actions_;
 };
 
-/// An automatic expert acting in `env` (which must be the environment the rollout steps).
+/// What an expert's feedback acts on: the world's own state (its privilege), or what the
+/// rollout shows a policy (noisy or late under a perturbation's sensing).
+enum class ExpertFeedback { world, observations };
+
+/// An automatic expert acting in `env` (which must be the environment the rollout steps); its
+/// feedback reads the world, or what the rollout shows a policy.
 class ExpertPolicy final : public Policy {
  public:
   /// Acts in `env` until rollout attaches another.
-  ExpertPolicy(Expert& expert, const DiceEnv& env) : expert_(expert), env_(&env) {}
+  ExpertPolicy(Expert& expert, const DiceEnv& env, ExpertFeedback feedback = ExpertFeedback::world)
+      : expert_(expert), env_(&env), feedback_(feedback) {}
   void attach(const DiceEnv& env) override { env_ = &env; }
   void reset(std::uint64_t seed) override { expert_.reset(seed); }
-  Action act(const History& h) override { return expert_.act(*env_, h.pending); }
+  Action act(const History& h) override {
+    return expert_.act(*env_, h.pending, feedback_ == ExpertFeedback::observations ? &h.current() : nullptr);
+  }
   std::string name() const override { return "expert " + expert_.name(); }
 
  private:
   Expert& expert_;
   const DiceEnv* env_;
+  ExpertFeedback feedback_;
 };
-
-/// What an expert's feedback acts on: the world's own state (its privilege), or what the
-/// rollout shows a policy (noisy or late under a perturbation's sensing).
-enum class ExpertFeedback { world, observations };
 
 /// An expert of its own, acting in whichever environment rollout attaches (evaluation of an
 /// expert, the robustness table). Its choices read the world itself; its feedback too, unless

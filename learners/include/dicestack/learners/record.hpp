@@ -6,9 +6,11 @@
 #include <vector>
 
 #include <dicestack/core/cluster.hpp>
+#include <dicestack/core/estimator.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/demo_set.hpp>
+#include <dicestack/learners/policy.hpp>
 
 namespace dicestack {
 
@@ -26,6 +28,11 @@ struct RecordRequest {
   /// Domain randomisation: each episode runs in its own draw (draw_perturbation from its seed);
   /// nominal: today's recordings, byte for byte.
   Perturbation perturbation;
+  /// What the expert's feedback acts on: the world (its privilege), or what a policy is shown
+  /// (under the perturbation's sensing factors: the observations, or `estimator`'s estimate).
+  ExpertFeedback feedback = ExpertFeedback::world;
+  /// Between the sensors and the expert's feedback (only with ExpertFeedback::observations).
+  EstimatorConfig estimator;
   /// Called with (episodes finished, request.episodes) from one worker as episodes finish (may be
   /// empty); the counts are estimates across ranks.
   std::function<void(int, int)> progress;
@@ -33,12 +40,19 @@ struct RecordRequest {
 
 /// Runs expert `name` from request.episodes random starts, in parallel with one world and one
 /// expert per thread. Returns every episode, successes and failures, each with its outcome (and,
-/// when perturbed, the values drawn). Throws ConfigError for an unknown expert, a negative noise
-/// or a perturbation the world cannot take, before any episode. Collective over `cluster`:
+/// when perturbed, the values drawn). Throws ConfigError for an unknown expert, a negative noise,
+/// a perturbation the world cannot take, or an estimator that nothing reads (the feedback on the
+/// world) or cannot run (an expert in joint torques), before any episode. Collective over `cluster`:
 /// episodes dealt round-robin among its ranks, every rank gets all of them in index order, the
 /// same for any number of ranks.
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster = local_cluster());
+
+/// Throws ConfigError for an estimator nothing reads (the expert's feedback on the world) or
+/// that cannot run (an expert answering joint torques: its worlds are rebuilt from the 24
+/// observed numbers, without an arm's links): what record_expert checks first, for callers that
+/// check before other work.
+void check_record_sensing(ActionKind controller, const RecordRequest& request);
 
 /// Seed and size of the built-in set.
 inline constexpr std::uint64_t kBuiltinSeed = 2026;
