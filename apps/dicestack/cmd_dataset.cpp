@@ -87,7 +87,10 @@ int run_import(const ImportOptions& opt) {
 
 int run_info(const DatasetOptions& opt) {
   const DemoSet set = read_demo_set(opt.dir);
-  const Dataset all = make_dataset(set.episodes);
+  // The columns' ranges: the states and the actions, the cup's or (an arm's episodes in joint
+  // torques) the torques.
+  const ActionKind kind = set.episodes.empty() ? ActionKind::cup : set.episodes.front().actions.front().kind();
+  const Dataset all = make_dataset(set.episodes, feature_map(kind == ActionKind::cup ? "state" : "state/torque"));
   std::map<std::string, std::size_t> sources;
   std::size_t stacked = 0, success = 0, walls = 0, in_cup = 0, shortest = SIZE_MAX, longest = 0, transitions = 0;
   for (const auto& e : set.episodes) {
@@ -103,7 +106,7 @@ int run_info(const DatasetOptions& opt) {
   const double n = static_cast<double>(set.episodes.size());
   if (opt.json) {
     nlohmann::json columns = nlohmann::json::object();
-    const auto names = episode_csv_columns();
+    const auto names = episode_csv_columns(kDemoFormatVersion, kind);
     for (Eigen::Index j = 0; j < all.x.cols(); ++j)
       columns[names[static_cast<std::size_t>(j) + 1]] = {{"min", all.x.col(j).minCoeff()}, {"max", all.x.col(j).maxCoeff()}};
     for (Eigen::Index j = 0; j < all.y.cols(); ++j)
@@ -136,7 +139,7 @@ int run_info(const DatasetOptions& opt) {
   print_line("  final state, rewards and end flags (format v2): " + std::to_string(transitions) + " of " +
              std::to_string(set.episodes.size()) + " episodes");
   print_line("  column            min          max");
-  const auto names = episode_csv_columns();
+  const auto names = episode_csv_columns(kDemoFormatVersion, kind);
   for (Eigen::Index j = 0; j < all.x.cols() + all.y.cols(); ++j) {
     const bool is_x = j < all.x.cols();
     const auto col = is_x ? all.x.col(j) : all.y.col(j - all.x.cols());

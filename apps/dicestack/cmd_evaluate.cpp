@@ -30,13 +30,10 @@ struct EvaluateOptions {
   bool json = false;
 };
 
-// Sets and recordings hold the cup's actions: a policy in joint torques can be neither saved as
-// one nor scored on one.
+// Recordings hold the cup's actions: a policy in joint torques cannot be scored on them (its
+// rollouts are saved as an arm's episodes in joint torques).
 void check_torque_outputs(const EvaluateOptions& opt, const Model& model) {
   if (model.features().action_kind() != ActionKind::joint_torque) return;
-  if (!opt.save_rollouts.empty())
-    throw ConfigError("evaluate: --save-rollouts writes a demonstration set, which holds the cup's actions; " +
-                      opt.model.string() + " answers joint torques");
   if (!opt.demos.empty())
     throw ConfigError("evaluate: --demos scores a policy on recordings of the cup's actions; " + opt.model.string() +
                       " answers joint torques");

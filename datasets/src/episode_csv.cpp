@@ -19,10 +19,18 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
 constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
-constexpr std::size_t kNumbers = 1 + kStateDim + kActionDim;         // t, state, action
 constexpr std::size_t kLinkColumns = 6;                              // an arm's three link angles, then their rates
 constexpr std::size_t kTorqueColumns = 4;                            // the torques its four joints held
 constexpr std::size_t kColumnsV4 = kColumnsV2 + kLinkColumns + kTorqueColumns;  // and, on an arm, those
+constexpr std::size_t kColumnsV4Torques = kColumnsV4 + kJointCount - kActionDim;  // the same, its actions joint torques
+
+// A file's columns: its format version and what its actions command.
+struct Layout {
+  int version = 2;
+  ActionKind actions = ActionKind::cup;
+  std::size_t source() const { return 1 + kStateDim + action_dim(actions); }  // t, state, action, then source
+  std::size_t arm() const { return source() + 2; }                            // after source and reward
+};
 
 // Splits one CSV line on commas (no quoting: none of our fields contain commas).
 void split_fields(std::string_view line, std::vector<std::string_view>& out) {
@@ -43,22 +51,25 @@ std::string_view trim(std::string_view s) {
 }
 
 
-// Checks a CSV header row (any layout version's columns, in order); sets `columns` to its
-// column names and returns the version (1, 2, or 4 for an arm's episode).
-int check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
-  if (fields.size() != kColumnsV1 && fields.size() != kColumnsV2 && fields.size() != kColumnsV4)
-    throw InputError(prefix + "header has " + std::to_string(fields.size()) + " columns, expected " +
-                     std::to_string(kColumnsV1) + " (t, 24 state names, dvx, dvy, dw, source: format version 1), " +
-                     std::to_string(kColumnsV2) + " (the same and reward: version 2) or " + std::to_string(kColumnsV4) +
-                     " (those, the arm's link angles and rates and its joint torques: version 4)");
+// Checks a CSV header row (any layout's columns, in order); sets `columns` to its column names
+// and returns its layout (version 1, 2, or 4 for an arm's episode, whose actions may be torques).
+Layout check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
   const std::size_t width = fields.size();
-  const int version = width == kColumnsV1 ? 1 : width == kColumnsV2 ? 2 : 4;
-  columns = episode_csv_columns(version);
+  if (width != kColumnsV1 && width != kColumnsV2 && width != kColumnsV4 && width != kColumnsV4Torques)
+    throw InputError(prefix + "header has " + std::to_string(width) + " columns, expected " + std::to_string(kColumnsV1) +
+                     " (t, 24 state names, dvx, dvy, dw, source: format version 1), " + std::to_string(kColumnsV2) +
+                     " (the same and reward: version 2), " + std::to_string(kColumnsV4) +
+                     " (those, the arm's link angles and rates and its joint torques: version 4) or " +
+                     std::to_string(kColumnsV4Torques) + " (the same with joint0_action to joint3_action: an arm's episode in joint torques)");
+  Layout layout;
+  layout.version = width == kColumnsV1 ? 1 : width == kColumnsV2 ? 2 : 4;
+  if (width == kColumnsV4Torques) layout.actions = ActionKind::joint_torque;
+  columns = episode_csv_columns(layout.version, layout.actions);
   for (std::size_t c = 0; c < width; ++c)
     if (trim(fields[c]) != columns[c])
       throw InputError(prefix + "column " + std::to_string(c + 1) + " is \"" + std::string(trim(fields[c]).substr(0, 40)) +
                        "\", expected \"" + columns[c] + "\"");
-  return version;
+  return layout;
 }
 
 // Column `c` of a row, a finite number.
@@ -76,19 +87,11 @@ double parse_csv_number(const std::vector<std::string_view>& fields, std::size_t
   return v;
 }
 
-// The numeric columns of a row (t, state, action), each a finite number.
-std::array<double, kNumbers> parse_csv_numbers(const std::vector<std::string_view>& fields, const std::string& prefix,
-                                               const std::vector<std::string>& columns) {
-  std::array<double, kNumbers> values{};
-  for (std::size_t c = 0; c < kNumbers; ++c) values[c] = parse_csv_number(fields, c, prefix, columns);
-  return values;
-}
 
 // A version-4 row's arm columns, after the reward: the links (numbers) and the joint torques,
 // numbers in every row or (unknown) empty in every row, as line 2's (`torques_empty`).
-void parse_csv_arm(const std::vector<std::string_view>& fields, const std::string& prefix,
+void parse_csv_arm(const std::vector<std::string_view>& fields, std::size_t first, const std::string& prefix,
                    const std::vector<std::string>& columns, bool& torques_empty, Episode& e) {
-  const std::size_t first = kColumnsV2;
   ArmLinks& l = e.links.emplace_back();
   for (std::size_t i = 0; i < 3; ++i) {
     l.angles[i] = parse_csv_number(fields, first + i, prefix, columns);
@@ -127,30 +130,31 @@ void parse_csv_reward(std::string_view f, const std::string& prefix, bool& rewar
 // Appends one data row (its width already checked) to `e`: the next step's state, action,
 // source, from version 2 its reward and in version 4 the arm's links and joint torques.
 void append_csv_row(const std::vector<std::string_view>& fields, const std::string& prefix,
-                    const std::vector<std::string>& columns, int version, bool& reward_empty, bool& torques_empty, Episode& e) {
-  const std::array<double, kNumbers> values = parse_csv_numbers(fields, prefix, columns);
+                    const std::vector<std::string>& columns, const Layout& layout, bool& reward_empty, bool& torques_empty,
+                    Episode& e) {
+  const double t = parse_csv_number(fields, 0, prefix, columns);
   const double expected_t = static_cast<double>(e.states.size());
-  if (values[0] != expected_t)
-    throw InputError(prefix + "column \"t\" is " + episode_csv::number_text(values[0]) + ", expected " + episode_csv::number_text(expected_t) +
+  if (t != expected_t)
+    throw InputError(prefix + "column \"t\" is " + episode_csv::number_text(t) + ", expected " + episode_csv::number_text(expected_t) +
                      " (rows are consecutive steps from 0)");
   State s;
-  std::copy(values.begin() + 1, values.begin() + 1 + kStateDim, s.begin());
-  Action a;
-  std::copy(values.begin() + 1 + kStateDim, values.end(), a.begin());
+  for (std::size_t k = 0; k < kStateDim; ++k) s[k] = parse_csv_number(fields, 1 + k, prefix, columns);
+  Action a = Action::zeros(layout.actions);
+  for (std::size_t k = 0; k < a.size(); ++k) a[k] = parse_csv_number(fields, 1 + kStateDim + k, prefix, columns);
   e.states.push_back(s);
   e.actions.push_back(a);
   try {
-    e.sources.push_back(step_source_from(trim(fields[kNumbers])));
+    e.sources.push_back(step_source_from(trim(fields[layout.source()])));
   } catch (const InputError& err) {
     throw InputError(prefix + "column \"source\": " + err.what());
   }
-  if (version >= 2) parse_csv_reward(trim(fields[kNumbers + 1]), prefix, reward_empty, e);
-  if (version >= 4) parse_csv_arm(fields, prefix, columns, torques_empty, e);
+  if (layout.version >= 2) parse_csv_reward(trim(fields[layout.source() + 1]), prefix, reward_empty, e);
+  if (layout.version >= 4) parse_csv_arm(fields, layout.arm(), prefix, columns, torques_empty, e);
 }
 
-std::string csv_header(int version) {
+std::string csv_header(int version, ActionKind actions = ActionKind::cup) {
   std::string header;
-  for (const auto& c : episode_csv_columns(version)) header += (header.empty() ? "" : ",") + c;
+  for (const auto& c : episode_csv_columns(version, actions)) header += (header.empty() ? "" : ",") + c;
   return header;
 }
 
@@ -165,16 +169,20 @@ std::string number_text(double v) {
 }
 
 void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftovers) {
-  for (const Action& a : e.actions)  // before the file is made: nothing half-written
-    if (a.kind() != ActionKind::cup)
-      throw InputError(path.string() + ": an episode's file holds the cup's actions (dvx, dvy, dw); joint torques cannot be "
-                                       "written to it");
+  // Before the file is made: nothing half-written. Joint torques command an arm, whose links
+  // the episode holds.
+  const ActionKind kind = e.actions.empty() ? ActionKind::cup : e.actions.front().kind();
+  for (const Action& a : e.actions)
+    if (a.kind() != kind)
+      throw InputError(path.string() + ": an episode's actions are all the cup's (dvx, dvy, dw) or all joint torques");
+  if (kind == ActionKind::joint_torque && e.links.empty())
+    throw InputError(path.string() + ": an episode in joint torques needs the arm's link readings beside its states");
   AtomicFile file(path, ownership(), leftovers);
   auto& out = file.stream();
   // An arm's episode adds its links and joint torques; any other keeps version 2's columns, byte
   // for byte.
   const bool arm = !e.links.empty();
-  out << csv_header(arm ? 4 : 2) << '\n';
+  out << csv_header(arm ? 4 : 2, kind) << '\n';
   for (std::size_t t = 0; t < e.states.size(); ++t) {
     out << t;
     for (double v : e.states[t]) out << ',' << number_text(v);
@@ -193,13 +201,15 @@ void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftove
 }
 
 Ownership ownership() {
-  return Ownership::first_line("dicestack episode CSV", {csv_header(1), csv_header(2), csv_header(4)});
+  return Ownership::first_line("dicestack episode CSV",
+                               {csv_header(1), csv_header(2), csv_header(4), csv_header(4, ActionKind::joint_torque)});
 }
 
 Episode parse(std::string_view text, const std::string& where, std::string name, int& version) {
   std::vector<std::string> columns;
   std::size_t width = 0;
   bool reward_empty = false, torques_empty = false;
+  Layout layout;
   Episode e;
   e.name = std::move(name);
   std::vector<std::string_view> fields;
@@ -216,14 +226,15 @@ Episode parse(std::string_view text, const std::string& where, std::string name,
     }
     split_fields(line, fields);
     if (line_no == 1) {
-      version = check_csv_header(fields, prefix, columns);
+      layout = check_csv_header(fields, prefix, columns);
+      version = layout.version;
       width = fields.size();
       continue;
     }
     if (fields.size() != width)
       throw InputError(prefix + "row has " + std::to_string(fields.size()) + " columns, expected " +
                        std::to_string(width) + (nl == std::string_view::npos ? " (truncated last line?)" : ""));
-    append_csv_row(fields, prefix, columns, version, reward_empty, torques_empty, e);
+    append_csv_row(fields, prefix, columns, layout, reward_empty, torques_empty, e);
   }
   if (line_no == 0) throw InputError(where + ": empty file (expected a header row)");
   if (e.states.empty()) throw InputError(where + ": no steps (an episode needs at least one row)");
@@ -232,10 +243,13 @@ Episode parse(std::string_view text, const std::string& where, std::string name,
 
 }  // namespace episode_csv
 
-std::vector<std::string> episode_csv_columns(int version) {
+std::vector<std::string> episode_csv_columns(int version, ActionKind actions) {
   std::vector<std::string> cols{"t"};
   for (auto n : state_names()) cols.emplace_back(n);
-  for (auto n : action_names()) cols.emplace_back(n);
+  if (actions == ActionKind::cup)
+    for (auto n : action_names()) cols.emplace_back(n);
+  else
+    for (int j = 0; j < 4; ++j) cols.push_back("joint" + std::to_string(j) + "_action");
   cols.emplace_back("source");
   if (version >= 2) cols.emplace_back("reward");
   if (version < 4) return cols;

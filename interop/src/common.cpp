@@ -180,6 +180,13 @@ nlohmann::json set_record(const DemoSet& set, const char* format) {
           {"provenance", set.provenance}};
 }
 
+void require_cup_actions(const std::vector<Episode>& episodes, const std::string& where) {
+  for (const auto& e : episodes)
+    if (!e.actions.empty() && e.actions.front().kind() != ActionKind::cup)
+      throw InputError(where + ": episode " + (e.name.empty() ? std::string("(unnamed)") : e.name) +
+                       " acts in joint torques; the export carries the cup's actions (dvx, dvy, dw)");
+}
+
 bool arm_episodes(const std::vector<Episode>& episodes, const std::string& where) {
   std::vector<std::string> without;
   std::size_t arm = 0;

@@ -46,6 +46,9 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& where
 /// The "dicestack" object both exports carry: marker, version, the writer's version, description, provenance.
 nlohmann::json set_record(const DemoSet& set, const char* format);
 
+/// Throws InputError naming `where` and the first episode whose actions are joint torques: the
+/// exports carry the cup's actions (their action space is the cup's).
+void require_cup_actions(const std::vector<Episode>& episodes, const std::string& where);
 /// True when the episodes are an arm's: each has its links and its final links (the T + 1th
 /// observation both exports carry); false when none has links. Throws InputError naming `where`
 /// and the episodes otherwise.

@@ -271,6 +271,7 @@ std::string default_minari_dataset_id(const fs::path& set_dir) {
 void export_minari(const DemoSet& set, const fs::path& dir, const std::string& dataset_id) {
   validate(set.world);
   require_transitions(set.episodes, dir.string());
+  require_cup_actions(set.episodes, dir.string());
   for (const auto& e : set.episodes) check_episode(e);
   const bool arm = arm_episodes(set.episodes, dir.string());
   check_minari_replaceable(dir);

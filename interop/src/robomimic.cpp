@@ -276,6 +276,7 @@ Episode read_robomimic_demo(const h5::ReadFile& f, const std::string& name, std:
 void export_robomimic(const DemoSet& set, const fs::path& file) {
   validate(set.world);
   require_transitions(set.episodes, file.string());
+  require_cup_actions(set.episodes, file.string());
   for (const auto& e : set.episodes) check_episode(e);
   const bool arm = arm_episodes(set.episodes, file.string());
   check_replaceable(file, robomimic_ownership());  // before any work

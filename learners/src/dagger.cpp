@@ -65,6 +65,7 @@ class Dagger final : public Learner {
   LearnResult learn(const LearnContext& c) const override {
     const TrainingPerturbation perturbation = learner_perturbation(params(), c.world, "dagger");  // before any work
     require_labellable(perturbation, feature_map(c.features), "dagger", true);
+    require_learnable_map("dagger", params(), feature_map(c.features));
     const DaggerSettings d = dagger_settings(params(), c.features);
     const int iterations = d.iterations, rollouts = d.rollouts;
     const std::string& expert_name = d.expert;

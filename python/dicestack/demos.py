@@ -14,7 +14,8 @@ SOURCES = ("human", "expert", "policy", "correction")
 
 @dataclass
 class Episode:
-    """One demonstration: T states (before each action) and the T actions taken in them.
+    """One demonstration: T states (before each action) and the T actions taken in them (T x 3,
+    the cup's; or T x 4, an arm's joint torques).
 
     `sources` says who chose each action (human, expert, policy or correction; default: policy);
     the outcome fields are what the judge saw over the whole episode. Format v2's transitions:

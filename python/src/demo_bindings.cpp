@@ -66,7 +66,7 @@ py::dict episode_dict(const Episode& e) {
   d["name"] = e.name;
   d["seed"] = e.seed;
   d["states"] = rows_to_array(e.states);
-  d["actions"] = actions_to_array(e.actions);
+  d["actions"] = actions_to_array(e.actions, e.actions.empty() ? ActionKind::cup : e.actions.front().kind());
   d["sources"] = sources;
   d["origin"] = e.origin;
   d["steps"] = e.outcome.steps;
@@ -89,7 +89,10 @@ Episode episode_from(const py::handle& obj) {
   e.name = d["name"].cast<std::string>();
   e.seed = seed_from(d["seed"], "episode seed").value_or(0);
   e.states = rows_from<kStateDim>(d["states"], "episode states");
-  e.actions = actions_from(d["actions"], "episode actions");
+  // Four columns are an arm's joint torques, three the cup's actions.
+  const py::array given_actions = py::array::ensure(d["actions"]);
+  const bool torques = given_actions && given_actions.ndim() == 2 && given_actions.shape(1) == static_cast<py::ssize_t>(kJointCount);
+  e.actions = actions_from(d["actions"], "episode actions", torques ? ActionKind::joint_torque : ActionKind::cup);
   for (const auto& s : d["sources"]) e.sources.push_back(step_source_from(s.cast<std::string>()));
   e.origin = d["origin"].cast<std::string>();
   e.outcome.steps = d["steps"].cast<int>();

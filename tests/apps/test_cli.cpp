@@ -823,21 +823,23 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+links+clock+start_state@dice+retry/torque");
   EXPECT_FALSE(nlohmann::json::parse(p.output).contains("train_error")) << "recordings hold cup actions: no score";
-  p = run("evaluate --model " + model + arm + " --episodes 2 --json", false);
+  p = run("evaluate --model " + model + arm + " --episodes 2 --json --save-rollouts " + (dir / "set").string(), false);
   ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(run("dataset validate " + (dir / "set").string()).status, 0) << "its rollouts: an arm's episodes in joint torques";
+  p = run("dataset info " + (dir / "set").string(), false);
+  EXPECT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("joint3_action"));
   const std::vector<std::pair<std::string, std::string>> refused{
       {"evaluate --model " + model + " --episodes 1", "--embodiment arm"},
-      {"evaluate --model " + model + arm + " --episodes 1 --save-rollouts " + (dir / "set").string(), "--save-rollouts writes a demonstration set"},
       {"evaluate --model " + model + arm + " --episodes 1 --demos " + kTinyDemos, "--demos scores a policy on recordings"},
       {"evaluate --model " + model + arm + " --episodes 1 --initial-push left", "an initial push is a cup velocity change"},
       {"robustness --model " + model + arm + " --factors action_noise", "without action_delay, action_noise and all"},
-      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "learned by dart alone"}};
+      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "learned by dart and dagger alone"}};
   for (const auto& [args, message] : refused) {
     p = run(args);
     EXPECT_EQ(p.status, 1) << args;
     EXPECT_THAT(p.output, HasSubstr(message)) << args;
   }
-  EXPECT_FALSE(std::filesystem::exists(dir / "set"));
   std::filesystem::remove_all(dir);
 }
 

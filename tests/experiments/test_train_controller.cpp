@@ -40,7 +40,7 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
   r = torque_request();
   r.learner = "bc";
   r.learner_options = {};
-  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("learned by dart alone"));
+  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("learned by dart and dagger alone"));
   r = torque_request();
   r.world.embodiment = Embodiment::cup;
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("--embodiment arm"));

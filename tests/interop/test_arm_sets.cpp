@@ -102,6 +102,26 @@ TEST(ArmSets, RobomimicAndMinariCarryTheLinksAndJointTorques) {
   EXPECT_DOUBLE_EQ(q[3], set.episodes[0].states[0][state_index::kCupAngle] - a[2]);
 }
 
+TEST(ArmSets, AnEpisodeInJointTorquesKeepsThemAsItsActions) {
+  DemoSet set;
+  set.world.embodiment = Embodiment::arm;
+  set.world.episode.max_steps = 20;
+  ExpertConfig torques;
+  torques.controller = ActionKind::joint_torque;
+  set.episodes = record_expert("scripted", torques, set.world, test::record_request(2, 9, 1));
+  ASSERT_EQ(set.episodes[0].actions.front().kind(), ActionKind::joint_torque);
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) set.episodes[i].name = "episode_000" + std::to_string(i);
+  const fs::path dir = scratch("arm_torques");
+  write_demo_set(set, dir);
+  const std::string csv = text_of(dir / "episode_0000.csv");
+  EXPECT_THAT(csv.substr(0, csv.find('\n')), HasSubstr(",cup_w,joint0_action,joint1_action,joint2_action,joint3_action,source,"));
+  expect_same(set, read_demo_set(dir));
+  // The exports' action space is the cup's.
+  EXPECT_THAT(test::error_of([&] { export_robomimic(read_demo_set(dir), scratch("arm_torques.hdf5")); }),
+              HasSubstr("episode episode_0000 acts in joint torques; the export carries the cup's actions"));
+  EXPECT_FALSE(fs::exists(scratch("arm_torques.hdf5")));
+}
+
 TEST(ArmSets, BadArmFilesAreRefusedNamingThePlace) {
   const DemoSet set = arm_set();
   // The arm's readings belong to an arm's world.
@@ -142,6 +162,15 @@ TEST(ArmSets, BadArmFilesAreRefusedNamingThePlace) {
   j["episodes"][0].erase("final_links");
   write_text(dir / "meta.json", j.dump(2));
   EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }), HasSubstr("episode_0000.csv holds an arm's links, but its entry has no"));
+  // Joint torques without the arm's links to run them on.
+  Episode bare = set.episodes[0];
+  bare.links.clear();
+  bare.joint_torques.clear();
+  bare.final_links.reset();
+  for (Action& a : bare.actions) a = Action::torques({1.0, 2.0, 3.0, 4.0});
+  DemoSet lone = set;
+  lone.episodes = {bare};
+  EXPECT_THAT(test::error_of([&] { write_demo_set(lone, scratch("arm_lone")); }), HasSubstr("needs the arm's link readings"));
 }
 
 }  // namespace

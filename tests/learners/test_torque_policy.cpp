@@ -3,11 +3,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
+#include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/learners/evaluate.hpp>
 #include <dicestack/learners/learner.hpp>
 #include <dicestack/learners/policy.hpp>
@@ -65,6 +67,29 @@ TEST(TorquePolicy, DartLearnsTheTrackersTorquesTheSameOnAnyThreadCount) {
   EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
 }
 
+// DAgger's rounds in torques: the student's own rollouts labelled by the tracker told in torques,
+// kept in its checkpoint (episodes whose actions are joint torques) and resumed from it.
+TEST(TorquePolicy, DaggerLearnsTheTrackersTorquesAndResumesFromItsCheckpoint) {
+  LearnContext c = arm_context();
+  const auto options = [](int iterations) {
+    return std::vector<std::string>{"expert=tracker", "include_demos=false", "iterations=" + std::to_string(iterations),
+                                    "rollouts=2", "tracker_probes=1", "tracker_robust=1", "tracker_variants=false"};
+  };
+  const LearnResult whole = LearnerRegistry::global().create("dagger", options(2))->learn(c);
+  EXPECT_EQ(whole.model->features().action_kind(), ActionKind::joint_torque);
+  c.checkpoint_dir = test::scratch_path("dicestack_dagger_torques");
+  std::filesystem::remove_all(c.checkpoint_dir);
+  LearnerRegistry::global().create("dagger", options(1))->learn(c);
+  const DemoSet round = read_demo_set(c.checkpoint_dir / "data-1");
+  ASSERT_FALSE(round.episodes.empty());
+  EXPECT_EQ(round.episodes[0].actions.front().kind(), ActionKind::joint_torque);
+  EXPECT_EQ(round.episodes[0].links.size(), round.episodes[0].size());
+  c.resume = true;
+  const LearnResult resumed = LearnerRegistry::global().create("dagger", options(2))->learn(c);
+  EXPECT_EQ(resumed.model->regressor().save_payload(), whole.model->regressor().save_payload());
+  std::filesystem::remove_all(c.checkpoint_dir);
+}
+
 TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   LearnContext c = arm_context();
   const auto refused = [&](const std::string& learner, const std::vector<std::string>& options) {
@@ -73,10 +98,11 @@ TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   EXPECT_THAT(refused("dart", quick_dart({"noise_dvy=0.5"})), HasSubstr("noise_dvy is a cup action's noise"));
   EXPECT_THAT(refused("dart", quick_dart({"include_demos=true"})), HasSubstr("include_demos adds recordings without"));
   EXPECT_THAT(refused("dart", quick_dart({"perturb=easy"})), HasSubstr("perturb= is not built for a policy of the arm's links"));
+  EXPECT_THAT(refused("dagger", {"expert=tracker", "iterations=1", "rollouts=1"}), HasSubstr("include_demos adds recordings without"));
   EXPECT_THAT(test::error_of([] {
                 require_learnable_map("bc", LearnerRegistry::global().create("bc", {})->params(), feature_map(kTorqueMap));
               }),
-              HasSubstr("learned by dart alone"));
+              HasSubstr("learned by dart and dagger alone"));
   // Where torques cannot run, an evaluation refuses before any rollout.
   EvalRequest request;
   request.actions = ActionKind::joint_torque;

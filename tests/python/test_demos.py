@@ -152,3 +152,9 @@ def test_an_arm_set_keeps_its_links_and_joint_torques(tmp_path, cli):
         dicestack.save_demos([dicestack.Episode(np.zeros((1, 24)), np.zeros((1, 3)), link_angles=np.zeros((1, 3)))],
                              tmp_path / "bad")
     assert all(e.link_angles is None for e in dicestack.load_demos("builtin")[:2])
+    # An episode in joint torques: four columns of actions, kept as such.
+    torques = dicestack.Episode(episodes[0].states[:3], np.full((3, 4), 5.0), link_angles=episodes[0].link_angles[:3],
+                                link_rates=episodes[0].link_rates[:3])
+    dicestack.save_demos([torques], tmp_path / "torques", world=world)
+    (back,) = dicestack.load_demos(tmp_path / "torques")
+    assert back.actions.shape == (3, 4) and np.all(back.actions == 5.0) and back.joint_torques is None

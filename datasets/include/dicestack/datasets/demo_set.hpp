@@ -37,8 +37,9 @@ struct DemoSet {
 
 /// The header row of an episode CSV of format `version` (1: t, 24 state names, dvx, dvy, dw,
 /// source; 2 and 3: those and reward; 4, an arm's episode: those, link0_angle to link2_angle,
-/// link0_rate to link2_rate and joint0_torque to joint3_torque).
-std::vector<std::string> episode_csv_columns(int version = kDemoFormatVersion);
+/// link0_rate to link2_rate and joint0_torque to joint3_torque). An arm's episode whose actions
+/// are joint torques has joint0_action to joint3_action (N m) where dvx, dvy, dw stand.
+std::vector<std::string> episode_csv_columns(int version = kDemoFormatVersion, ActionKind actions = ActionKind::cup);
 
 /// Reads a whole set, checking everything: meta.json's format and version, that its episode
 /// list matches the CSV files exactly, every header, row and value (finite numbers, known
