@@ -28,6 +28,7 @@ struct RecordOptions {
   int threads = 0;
   double noise = 0.0;
   std::string perturb = "none";
+  std::string controller = "cup";
   std::string expert_feedback = "world";
   std::string estimator = "none";
   TrackerOption tracker;
@@ -45,13 +46,16 @@ std::string record_provenance(const RecordOptions& opt, const Perturbation& pert
          std::to_string(opt.seed) + (opt.successes_only ? " --successes-only" : "") + (opt.no_replan ? " --no-replan" : "") +
          (opt.retry ? " --retry" : "") + (opt.noise > 0.0 ? " --noise " + std::to_string(opt.noise) : "") +
          (opt.perturb == "none" ? "" : " --perturb " + opt.perturb) + (sensed ? " --expert-feedback observations" : "") +
+         (opt.controller == "cup" ? "" : " --controller " + opt.controller) +
          (opt.estimator == "none" ? "" : " --estimator " + opt.estimator) +
          (opt.world.start == "random" ? "" : " --start " + opt.world.start) +
          (opt.demos.empty() ? "" : " --demos " + opt.demos.string()) + opt.tracker.as_arguments() +
          "; episode i starts from random_start_state(world, training_start_seed(seed, i))" + recordings +
          (opt.noise > 0.0 ? "; DART noise: executed actions perturbed by Gaussian noise of std " + std::to_string(opt.noise) +
-                                " x action.scale per dimension, clean expert actions recorded"
+                                (opt.controller == "cup" ? " x action.scale" : " x the torque limit") +
+                                " per dimension, clean expert actions recorded"
                           : "") +
+         (opt.controller == "cup" ? "" : "; the expert's cup actions told in the joint torques the cup controller held") +
          (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its seed (" +
                                             perturbation_summary(perturbation) + ")") +
          (sensed ? "; the expert's feedback acted on " +
@@ -65,19 +69,23 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   const WorldConfig world = opt.world.load();
   const Perturbation perturbation = load_perturbation(opt.perturb, world);  // before any work
   RecordRequest request;
+  request.perturbation = perturbation;
   request.feedback = opt.expert_feedback == "observations" ? ExpertFeedback::observations : ExpertFeedback::world;
   request.estimator = estimator_config(opt.estimator);
-  check_record_sensing(ActionKind::cup, request);
   const auto t0 = std::chrono::steady_clock::now();
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
   expert.retry = opt.retry;
+  if (opt.controller == "joint_torque") expert.controller = ActionKind::joint_torque;
+  check_record_request(expert.controller, world, request);
   std::string recordings;  // for the provenance
   if (opt.expert == "tracker") {
     if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
     const auto dir = resolve_demo_set(opt.demos, world);
     const DemoSet demos = read_demo_set(dir);
-    expert.recordings = make_recordings(demos.episodes, world, opt.tracker.config(), opt.seed, opt.threads, cluster);
+    TrackerConfig tracker = opt.tracker.config();
+    tracker.controller = expert.controller;  // its simulations choose what stacks as it will answer
+    expert.recordings = make_recordings(demos.episodes, world, tracker, opt.seed, opt.threads, cluster);
     recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
                  " (" + (demos.description.empty() ? "no description" : demos.description) + ")";
   } else if (!opt.demos.empty()) {
@@ -87,8 +95,8 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   }
   request.seed = opt.seed;
   request.threads = opt.threads;
-  request.noise = {opt.noise, opt.noise, opt.noise};
-  request.perturbation = perturbation;
+  request.noise = expert.controller == ActionKind::cup ? Action{opt.noise, opt.noise, opt.noise}
+                                                      : Action::torques({opt.noise, opt.noise, opt.noise, opt.noise});
   // What the set holds of each episode until the end (its meta.json entry): the only part of a
   // recording that grows with the count.
   require_memory("recording", static_cast<std::uint64_t>(opt.episodes), kEpisodeEntryBytes, "episodes");
@@ -169,6 +177,11 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
                   "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "
                   "medium, hard or a perturbation file (docs/robustness.md)")
       ->capture_default_str();
+  cmd->add_option("--controller", opt->controller,
+                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions "
+                  "told in the joint torques the cup controller held; the set keeps them as its actions)")
+      ->check(CLI::IsMember({"cup", "joint_torque"}))
+      ->capture_default_str();
   cmd->add_option("--expert-feedback", opt->expert_feedback,
                   "What the expert's feedback acts on: world (its own privilege) or observations (what a policy is "
                   "shown under the perturbation's sensing factors, or with --estimator the estimate; its choices "
@@ -180,7 +193,8 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
                     "observations), kalman or particle[:N] (docs/robustness.md)")
       ->capture_default_str();
   cmd->add_option("--noise", opt->noise,
-                  "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale; the "
+                  "DART: std of Gaussian noise added to each executed action, as a fraction of action.scale (with "
+                  "--controller joint_torque: of each torque limit); the "
                   "expert's clean actions are recorded")
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();

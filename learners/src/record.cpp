@@ -39,7 +39,13 @@ Action executed_noise(const Action& fractions, ActionKind kind, const WorldConfi
 
 }  // namespace
 
-void check_record_sensing(ActionKind controller, const RecordRequest& request) {
+void check_record_request(ActionKind controller, const WorldConfig& world, const RecordRequest& request) {
+  if (controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
+    throw ConfigError("record: an expert answering joint torques drives an arm's joints; this world's cup floats (give "
+                      "--embodiment arm)");
+  if (controller == ActionKind::joint_torque && !takes_joint_torques(request.perturbation))
+    throw ConfigError("record: an expert answering joint torques runs without an action delay, action noise or bias "
+                      "(they are drawn for the cup's actions)");
   if (request.estimator.kind == EstimatorKind::none) return;
   if (request.feedback != ExpertFeedback::observations)
     throw ConfigError("record: an estimator stands between the sensors and the expert's feedback, which reads the world; "
@@ -52,10 +58,8 @@ void check_record_sensing(ActionKind controller, const RecordRequest& request) {
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster) {
   make_expert(name, config);  // an unknown name fails here, before any thread starts
-  if (config.controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
-    throw ConfigError("record: an expert answering joint torques drives an arm's joints; this world's cup floats");
   validate(request.perturbation, world);
-  check_record_sensing(config.controller, request);
+  check_record_request(config.controller, world, request);
   require_memory("recording", static_cast<std::uint64_t>(std::max(0, request.episodes)),
                  episode_memory_bound(world.episode.max_steps), "episodes");
   require_memory("record: the estimators of the episodes running at once",

@@ -71,6 +71,12 @@ std::string read_text(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// A file's whole text.
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 TEST(Cli, VersionAndHelp) {
   const Process v = run("--version");
   EXPECT_EQ(v.status, 0);
@@ -749,6 +755,24 @@ TEST(CliLearning, RecordBehindTheEstimatorSaysSoAndAnEstimatorNothingReadsIsRefu
   EXPECT_FALSE(std::filesystem::exists(dir));
 }
 
+TEST(CliLearning, RecordInJointTorquesKeepsThemAsTheActionsAndNeedsTheArm) {
+  const auto dir = test::scratch_path("dicestack_cli_record_torques");
+  std::filesystem::remove_all(dir);
+  const Process p = run("record --expert scripted --episodes 1 --embodiment arm --controller joint_torque --noise 0.001 --out " +
+                            dir.string(), false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_THAT(file_text(dir / "episode_0000.csv"), HasSubstr(",joint0_action,"));
+  EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("--controller joint_torque"));
+  std::filesystem::remove_all(dir);
+  Process bad = run("record --expert scripted --episodes 1 --controller joint_torque --out " + dir.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("give --embodiment arm"));
+  bad = run("record --expert scripted --episodes 1 --embodiment arm --controller joint_torque --perturb medium --out " + dir.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("without an action delay, action noise or bias"));
+  EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
 TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
   const auto dir = test::scratch_path("dicestack_cli_tracker");
   const Process p = run("record --expert tracker --demos " + kTinyDemos + " --episodes 2 --out " + dir.string(), false);
@@ -1033,11 +1057,6 @@ int wait_for(pid_t pid, double seconds) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
-
-std::string file_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 TEST(CliInterrupt, CtrlCStopsALongRunAtOnceAndLeavesTheOldOutput) {

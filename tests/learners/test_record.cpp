@@ -65,8 +65,14 @@ TEST(Record, BehindAnEstimatorTheExpertsFeedbackReadsTheEstimateTheSameOnAnyThre
   // An estimator nothing reads, or that an expert in joint torques cannot run behind, is refused.
   EXPECT_THAT(test::error_of([&] { record_expert("mpc", {}, w, request(1, ExpertFeedback::world, "kalman")); }),
               ::testing::HasSubstr("give --expert-feedback observations"));
-  EXPECT_THAT(test::error_of([&] { check_record_sensing(ActionKind::joint_torque, request(1, ExpertFeedback::observations, "kalman")); }),
+  WorldConfig arm = w;
+  arm.embodiment = Embodiment::arm;
+  EXPECT_THAT(test::error_of([&] { check_record_request(ActionKind::joint_torque, arm, request(1, ExpertFeedback::observations, "kalman")); }),
               ::testing::HasSubstr("runs without an estimator"));
+  RecordRequest late = test::record_request(1, 0, 1);
+  late.perturbation.action_delay = 1;
+  EXPECT_THAT(test::error_of([&] { check_record_request(ActionKind::joint_torque, arm, late); }),
+              ::testing::HasSubstr("without an action delay, action noise or bias"));
 }
 
 TEST(Record, ReportsEachFinishedEpisodeOnOneThread) {

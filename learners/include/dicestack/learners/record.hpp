@@ -41,18 +41,18 @@ struct RecordRequest {
 /// Runs expert `name` from request.episodes random starts, in parallel with one world and one
 /// expert per thread. Returns every episode, successes and failures, each with its outcome (and,
 /// when perturbed, the values drawn). Throws ConfigError for an unknown expert, a negative noise,
-/// a perturbation the world cannot take, or an estimator that nothing reads (the feedback on the
-/// world) or cannot run (an expert in joint torques), before any episode. Collective over `cluster`:
+/// a perturbation the world cannot take, or what check_record_request refuses, before any episode. Collective over `cluster`:
 /// episodes dealt round-robin among its ranks, every rank gets all of them in index order, the
 /// same for any number of ranks.
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster = local_cluster());
 
-/// Throws ConfigError for an estimator nothing reads (the expert's feedback on the world) or
-/// that cannot run (an expert answering joint torques: its worlds are rebuilt from the 24
-/// observed numbers, without an arm's links): what record_expert checks first, for callers that
-/// check before other work.
-void check_record_sensing(ActionKind controller, const RecordRequest& request);
+/// Throws ConfigError for an expert in joint torques without an arm or under factors drawn for
+/// the cup's actions (an action delay, action noise or bias), and for an estimator nothing reads
+/// (the expert's feedback on the world) or that cannot run (an expert answering joint torques:
+/// its worlds are rebuilt from the 24 observed numbers, without an arm's links). What
+/// record_expert checks first, for callers that check before other work.
+void check_record_request(ActionKind controller, const WorldConfig& world, const RecordRequest& request);
 
 /// Seed and size of the built-in set.
 inline constexpr std::uint64_t kBuiltinSeed = 2026;
