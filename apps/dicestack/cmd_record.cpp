@@ -83,9 +83,9 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
     if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
     const auto dir = resolve_demo_set(opt.demos, world);
     const DemoSet demos = read_demo_set(dir);
-    TrackerConfig tracker = opt.tracker.config();
-    tracker.controller = expert.controller;  // its simulations choose what stacks as it will answer
-    expert.recordings = make_recordings(demos.episodes, world, tracker, opt.seed, opt.threads, cluster);
+    // Its simulations choose what stacks as it will answer.
+    expert.recordings = make_recordings(demos.episodes, world, opt.tracker.config_for(expert.controller), opt.seed,
+                                        opt.threads, cluster);
     recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
                  " (" + (demos.description.empty() ? "no description" : demos.description) + ")";
   } else if (!opt.demos.empty()) {

@@ -104,8 +104,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     if (opt.controller == "joint_torque") config.controller = ActionKind::joint_torque;
     if (opt.expert == "tracker") {
       if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
-      TrackerConfig tracker = opt.tracker.config();
-      tracker.controller = config.controller;  // its simulations choose what stacks as it will answer
+      const TrackerConfig tracker = opt.tracker.config_for(config.controller);  // simulating what it will answer
       config.recordings = make_recordings(read_demo_set(resolve_demo_set(opt.demos, world)).episodes, world, tracker,
                                           opt.seed, opt.threads, cluster);
     }

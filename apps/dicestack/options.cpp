@@ -57,6 +57,15 @@ void TrackerOption::add_to(CLI::App& app) {
   app.add_option("--tracker", settings, "tracker: a setting on top of the preset, NAME=VALUE, repeatable (" + names + ")");
 }
 
+TrackerConfig TrackerOption::config_for(ActionKind controller) const {
+  TrackerConfig tracker = config();
+  tracker.controller = controller;
+  const bool refine_given =
+      std::any_of(settings.begin(), settings.end(), [](const std::string& s) { return s.rfind("refine=", 0) == 0; });
+  if (controller == ActionKind::joint_torque && !refine_given) tracker.refine = 0;
+  return tracker;
+}
+
 std::string TrackerOption::as_arguments() const {
   std::string out = preset == "plain" ? "" : " --tracker-preset " + preset;
   for (const auto& s : settings) out += " --tracker " + s;
