@@ -56,6 +56,8 @@ std::string record_provenance(const RecordOptions& opt, const Perturbation& pert
                                 " per dimension, clean expert actions recorded"
                           : "") +
          (opt.controller == "cup" ? "" : "; the expert's cup actions told in the joint torques the cup controller held") +
+         (opt.controller == "cup" || opt.expert != "tracker" ? ""
+                                                             : " (in joint torques its paths are refined only with --tracker refine=N)") +
          (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its seed (" +
                                             perturbation_summary(perturbation) + ")") +
          (sensed ? "; the expert's feedback acted on " +
@@ -177,11 +179,9 @@ void add_record_command(CLI::App& app, Cluster& cluster) {
                   "Domain randomisation: each episode in its own perturbed world, drawn from its seed: none, easy, "
                   "medium, hard or a perturbation file (docs/robustness.md)")
       ->capture_default_str();
-  cmd->add_option("--controller", opt->controller,
-                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions "
-                  "told in the joint torques the cup controller held; the set keeps them as its actions)")
-      ->check(CLI::IsMember({"cup", "joint_torque"}))
-      ->capture_default_str();
+  add_expert_controller_option(*cmd, opt->controller)
+      ->description("What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions "
+                    "told in the joint torques the cup controller held; the set keeps them as its actions)");
   cmd->add_option("--expert-feedback", opt->expert_feedback,
                   "What the expert's feedback acts on: world (its own privilege) or observations (what a policy is "
                   "shown under the perturbation's sensing factors, or with --estimator the estimate; its choices "

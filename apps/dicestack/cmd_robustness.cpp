@@ -153,11 +153,7 @@ void add_robustness_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--expert", opt->expert, "An automatic expert instead: scripted, mpc or tracker (with --demos)");
   cmd->add_option("--demos", opt->demos, "tracker: the recordings it follows (a folder, builtin or human)");
   opt->tracker.add_to(*cmd);
-  cmd->add_option("--controller", opt->controller,
-                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions told "
-                  "in the joint torques the cup controller held)")
-      ->check(CLI::IsMember({"cup", "joint_torque"}))
-      ->capture_default_str();
+  add_expert_controller_option(*cmd, opt->controller);
   cmd->add_option("--expert-feedback", opt->expert_feedback,
                   "What the expert's feedback acts on: world (its own privilege; the sensing factors are left out) or "
                   "observations (what a policy is shown; its choices still read the world)")

@@ -151,6 +151,15 @@ CLI::Validator threads_check() {
       "THREADS");
 }
 
+CLI::Option* add_expert_controller_option(CLI::App& cmd, std::string& name) {
+  return cmd
+      .add_option("--controller", name,
+                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions "
+                  "told in the joint torques the cup controller held)")
+      ->check(CLI::IsMember({"cup", "joint_torque"}))
+      ->capture_default_str();
+}
+
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {
   return cmd
       .add_option("--estimator", name,

@@ -55,6 +55,10 @@ CLI::Validator threads_check();
 /// Left empty when not given: each model's own (estimator_for), none for an expert.
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name);
 
+/// `--controller cup|joint_torque` for a command that runs an expert: what it answers on the arm
+/// (default cup). Returns the option, so a command can say more in its description.
+CLI::Option* add_expert_controller_option(CLI::App& cmd, std::string& name);
+
 /// The median of `v` (the benchmarks' figure over repeated runs); 0 for none.
 double median(std::vector<double> v);
 

@@ -25,6 +25,10 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
   const PerturbationDraw d = channel_draw_from_json(e.perturbation, "episode \"" + e.name + "\"");
   const bool sensing = d.observation_delay > 0 ||
                        std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0; });
+  const nlohmann::json record = nlohmann::json::parse(e.perturbation, nullptr, false);
+  if (sensing && record.is_object() && record.contains("estimator"))
+    throw InputError("episode \"" + e.name + "\" was recorded with its expert behind an estimator: its actions answered "
+                     "the estimate, and a row shows what the sensors gave; record a training set without --estimator");
   const bool delayed = d.action_delay > 0 || d.observation_delay > 0;
   if (!sensing && !(features.ahead() && delayed)) return std::nullopt;
   if (features.ahead() && delayed && std::find(e.sources.begin(), e.sources.end(), StepSource::policy) != e.sources.end())

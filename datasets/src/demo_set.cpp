@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -196,6 +197,64 @@ void final_links_from(const json& f, const fs::path& meta, DemoMetaEntry& e) {
   e.final_links = l;
 }
 
+ActionKind actions_of(const Episode& e) { return e.actions.empty() ? ActionKind::cup : e.actions.front().kind(); }
+
+// A set holds one kind of action: every episode the cup's, or every episode an arm's joint
+// torques. `first` names the set's first episode and its kind.
+void check_same_actions(const std::pair<std::string, ActionKind>& first, const Episode& other, const std::string& where) {
+  if (first.second != actions_of(other))
+    throw InputError(where + ": " + first.first + " acts in " + std::string(action_kind_name(first.second)) + " actions and " +
+                     other.name + " in " + std::string(action_kind_name(actions_of(other))) + " ones; a set holds one kind");
+}
+
+// A cup action beyond the limits is no action the world takes; joint torques beyond theirs are
+// clipped when they run (a teacher's label may ask for more than the joints give).
+void check_action_limits(const Episode& e, const WorldConfig& world, const fs::path& path) {
+  for (std::size_t t = 0; t < e.size(); ++t)
+    for (std::size_t k = 0; k < kActionDim && e.actions[t].kind() == ActionKind::cup; ++k)
+      if (std::abs(e.actions[t][k]) > world.action.limit[k])
+        throw InputError(path.string() + ":" + std::to_string(t + 2) + ": column \"" + std::string(action_names()[k]) + "\" = " +
+                         episode_csv::number_text(e.actions[t][k]) + " is outside [-" +
+                         episode_csv::number_text(world.action.limit[k]) + ", " + episode_csv::number_text(world.action.limit[k]) +
+                         "] (the world's action.limit)");
+}
+
+// The episode file `path` that meta.json's `entry` lists, read and checked against the entry
+// (its version, the arm's readings, the transitions, the step count) and the world.
+Episode read_listed_episode(const fs::path& path, const fs::path& meta_path, int meta_version, DemoMetaEntry& entry,
+                            const WorldConfig& world) {
+  int csv_version = 0;
+  Episode e = episode_csv::parse(read_file(path), path.string(), path.stem().string(), csv_version);
+  // A version-2 set may hold version-1 files (appended to an old set): episodes without transitions.
+  if (csv_version > meta_version)
+    throw InputError(path.string() + ":1: the header is format version " + std::to_string(csv_version) + "'s (" +
+                     (csv_version >= 4 ? "with the arm's links and joint torques" : "with reward") + "), but meta.json says version " +
+                     std::to_string(meta_version));
+  check_links_world(e, world, path.string());
+  if (entry.arm != !e.links.empty())
+    meta_error(meta_path, entry.file + (entry.arm ? " has \"final_links\", but its file holds no arm links"
+                                                  : " holds an arm's links, but its entry has no \"final_links\" (null when unknown)"));
+  if (entry.final_links && !entry.final_state)
+    meta_error(meta_path, entry.file + " has final links but no final state; they are known together");
+  if (entry.final_state && e.rewards.empty())
+    throw InputError(path.string() + ": meta.json gives a final state, so every row needs a reward");
+  if (!entry.final_state && !e.rewards.empty())
+    throw InputError(path.string() + ": has rewards, but meta.json gives no final state (they are known together)");
+  if (entry.steps != e.size())
+    meta_error(meta_path, "says " + entry.file + " has " + std::to_string(entry.steps) + " steps; the file has " +
+                              std::to_string(e.size()));
+  e.final_state = entry.final_state;
+  e.terminated = entry.terminated;
+  e.truncated = entry.truncated;
+  e.seed = entry.seed;
+  e.origin = std::move(entry.origin);
+  e.perturbation = std::move(entry.perturbation);
+  e.final_links = entry.final_links;
+  e.outcome = entry.outcome;
+  check_action_limits(e, world, path);
+  return e;
+}
+
 Ownership meta_ownership() { return Ownership::json_object("dicestack demonstration meta.json", kDemoFormat); }
 
 // Our scratch files and folders: ".<name>.tmp-<digits>-..." or ".<name>.old-<digits>-...".
@@ -275,46 +334,10 @@ DemoSet read_demo_set(const fs::path& dir) {
   std::set<std::string> listed;
   for (auto& entry : meta.episodes) {
     listed.insert(entry.file);
-    const fs::path path = dir / entry.file;
-    if (absent(path)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
-    int csv_version = 0;
-    Episode e = episode_csv::parse(read_file(path), path.string(), path.stem().string(), csv_version);
-    // A version-2 set may hold version-1 files (appended to an old set): episodes without transitions.
-    if (csv_version > meta.version)
-      throw InputError(path.string() + ":1: the header is format version " + std::to_string(csv_version) + "'s (" +
-                       (csv_version >= 4 ? "with the arm's links and joint torques" : "with reward") + "), but meta.json says version " +
-                       std::to_string(meta.version));
-    check_links_world(e, set.world, path.string());
-    if (entry.arm != !e.links.empty())
-      meta_error(meta_path, entry.file + (entry.arm ? " has \"final_links\", but its file holds no arm links"
-                                                    : " holds an arm's links, but its entry has no \"final_links\" (null when unknown)"));
-    if (entry.final_links && !entry.final_state)
-      meta_error(meta_path, entry.file + " has final links but no final state; they are known together");
-    if (entry.final_state && e.rewards.empty())
-      throw InputError(path.string() + ": meta.json gives a final state, so every row needs a reward");
-    if (!entry.final_state && !e.rewards.empty())
-      throw InputError(path.string() + ": has rewards, but meta.json gives no final state (they are known together)");
-    e.final_state = entry.final_state;
-    e.terminated = entry.terminated;
-    e.truncated = entry.truncated;
-    e.seed = entry.seed;
-    e.origin = std::move(entry.origin);
-    e.perturbation = std::move(entry.perturbation);
-    e.final_links = entry.final_links;
-    if (entry.steps != e.size())
-      meta_error(meta_path, "says " + entry.file + " has " + std::to_string(entry.steps) + " steps; the file has " +
-                                std::to_string(e.size()));
-    e.outcome = entry.outcome;
-    // A cup action beyond the limits is no action the world takes; joint torques beyond theirs
-    // are clipped when they run (a teacher's label may ask for more than the joints give).
-    for (std::size_t t = 0; t < e.size(); ++t)
-      for (std::size_t k = 0; k < kActionDim && e.actions[t].kind() == ActionKind::cup; ++k)
-        if (std::abs(e.actions[t][k]) > set.world.action.limit[k])
-          throw InputError(path.string() + ":" + std::to_string(t + 2) + ": column \"" +
-                           std::string(action_names()[k]) + "\" = " + episode_csv::number_text(e.actions[t][k]) + " is outside [-" +
-                           episode_csv::number_text(set.world.action.limit[k]) + ", " + episode_csv::number_text(set.world.action.limit[k]) +
-                           "] (the world's action.limit)");
-    set.episodes.push_back(std::move(e));
+    if (absent(dir / entry.file)) meta_error(meta_path, "lists " + entry.file + ", which does not exist");
+    set.episodes.push_back(read_listed_episode(dir / entry.file, meta_path, meta.version, entry, set.world));
+    const Episode& first = set.episodes.front();
+    check_same_actions({first.name, actions_of(first)}, set.episodes.back(), dir.string());
   }
   for (fs::directory_iterator it(dir, ec), end; it != end; it.increment(ec)) {
     const auto name = it->path().filename().string();
@@ -397,6 +420,7 @@ void write_demo_set(const DemoSet& set, const fs::path& dir, const std::map<std:
   for (std::size_t i = 0; i < set.episodes.size(); ++i) {
     check_episode(set.episodes[i]);
     check_links_world(set.episodes[i], set.world, dir.string() + ": episode " + std::to_string(i));
+    check_same_actions({set.episodes[0].name, actions_of(set.episodes[0])}, set.episodes[i], dir.string());
     files.push_back(episode_file_name(i));
   }
   const auto ours = [](const fs::path& p) { return is_own_demo_set(p); };
@@ -420,9 +444,12 @@ std::size_t write_demo_set_streaming(const DemoSet& header, const fs::path& dir,
   const auto ours = [](const fs::path& p) { return is_own_demo_set(p); };
   replace_folder(dir, ours, check_demo_set_replaceable, [&](const fs::path& tmp) {
     json episodes = json::array();
+    std::pair<std::string, ActionKind> first;
     produce([&](const Episode& e) {
       check_episode(e);
       check_links_world(e, header.world, dir.string() + ": episode " + std::to_string(written));
+      if (written == 0) first = {e.name, actions_of(e)};
+      check_same_actions(first, e, dir.string());
       const std::string file = episode_file_name(written);
       episode_csv::write(e, tmp / file, AtomicFile::Leftovers::skip);
       episodes.push_back(episode_entry(e, file));
@@ -449,9 +476,14 @@ std::vector<std::string> append_to_demo_set(const fs::path& dir, std::vector<Epi
   std::vector<std::string> files, added;
   for (std::size_t i = 0; i < set.episodes.size(); ++i) files.push_back(set.episodes[i].name + ".csv");
   std::size_t next = set.episodes.size();
-  for (auto& e : episodes) {
+  // Every episode is checked before any file is written: a refused one leaves the set as it was.
+  for (const auto& e : episodes) {
     check_episode(e);
     check_links_world(e, set.world, dir.string());
+    const Episode& first = set.episodes.empty() ? episodes.front() : set.episodes.front();
+    check_same_actions({first.name, actions_of(first)}, e, dir.string());
+  }
+  for (auto& e : episodes) {
     std::string file;
     do file = episode_file_name(next++);
     while (fs::exists(dir / file));

@@ -34,6 +34,11 @@ namespace {
 // The arm's readings beyond the links of each state: the joints' torques (one per action, only
 // beside links) and the links after the last action (only beside links and a final state).
 void check_arm_readings(const Episode& e, const std::string& who) {
+  const ActionKind kind = e.actions.front().kind();
+  for (const Action& a : e.actions)
+    if (a.kind() != kind) throw InputError(who + ": its actions are all the cup's (dvx, dvy, dw) or all joint torques, not both");
+  if (kind == ActionKind::joint_torque && e.links.empty())
+    throw InputError(who + ": acts in joint torques, which command an arm, and has no arm link readings");
   if (!e.joint_torques.empty()) {
     if (e.links.empty()) throw InputError(who + ": has joint torques but no arm link readings; an arm episode has both");
     if (e.joint_torques.size() != e.actions.size())

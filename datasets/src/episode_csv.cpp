@@ -25,7 +25,7 @@ constexpr std::size_t kColumnsV4 = kColumnsV2 + kLinkColumns + kTorqueColumns;  
 constexpr std::size_t kColumnsV4Torques = kColumnsV4 + kJointCount - kActionDim;  // the same, its actions joint torques
 
 // A file's columns: its format version and what its actions command.
-struct Layout {
+struct CsvLayout {
   int version = 2;
   ActionKind actions = ActionKind::cup;
   std::size_t source() const { return 1 + kStateDim + action_dim(actions); }  // t, state, action, then source
@@ -53,7 +53,7 @@ std::string_view trim(std::string_view s) {
 
 // Checks a CSV header row (any layout's columns, in order); sets `columns` to its column names
 // and returns its layout (version 1, 2, or 4 for an arm's episode, whose actions may be torques).
-Layout check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
+CsvLayout check_csv_header(const std::vector<std::string_view>& fields, const std::string& prefix, std::vector<std::string>& columns) {
   const std::size_t width = fields.size();
   if (width != kColumnsV1 && width != kColumnsV2 && width != kColumnsV4 && width != kColumnsV4Torques)
     throw InputError(prefix + "header has " + std::to_string(width) + " columns, expected " + std::to_string(kColumnsV1) +
@@ -61,7 +61,7 @@ Layout check_csv_header(const std::vector<std::string_view>& fields, const std::
                      " (the same and reward: version 2), " + std::to_string(kColumnsV4) +
                      " (those, the arm's link angles and rates and its joint torques: version 4) or " +
                      std::to_string(kColumnsV4Torques) + " (the same with joint0_action to joint3_action: an arm's episode in joint torques)");
-  Layout layout;
+  CsvLayout layout;
   layout.version = width == kColumnsV1 ? 1 : width == kColumnsV2 ? 2 : 4;
   if (width == kColumnsV4Torques) layout.actions = ActionKind::joint_torque;
   columns = episode_csv_columns(layout.version, layout.actions);
@@ -130,7 +130,7 @@ void parse_csv_reward(std::string_view f, const std::string& prefix, bool& rewar
 // Appends one data row (its width already checked) to `e`: the next step's state, action,
 // source, from version 2 its reward and in version 4 the arm's links and joint torques.
 void append_csv_row(const std::vector<std::string_view>& fields, const std::string& prefix,
-                    const std::vector<std::string>& columns, const Layout& layout, bool& reward_empty, bool& torques_empty,
+                    const std::vector<std::string>& columns, const CsvLayout& layout, bool& reward_empty, bool& torques_empty,
                     Episode& e) {
   const double t = parse_csv_number(fields, 0, prefix, columns);
   const double expected_t = static_cast<double>(e.states.size());
@@ -169,14 +169,9 @@ std::string number_text(double v) {
 }
 
 void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftovers) {
-  // Before the file is made: nothing half-written. Joint torques command an arm, whose links
-  // the episode holds.
+  // The writers check the episode first (check_episode: one kind of action, links beside joint
+  // torques), before any file is made.
   const ActionKind kind = e.actions.empty() ? ActionKind::cup : e.actions.front().kind();
-  for (const Action& a : e.actions)
-    if (a.kind() != kind)
-      throw InputError(path.string() + ": an episode's actions are all the cup's (dvx, dvy, dw) or all joint torques");
-  if (kind == ActionKind::joint_torque && e.links.empty())
-    throw InputError(path.string() + ": an episode in joint torques needs the arm's link readings beside its states");
   AtomicFile file(path, ownership(), leftovers);
   auto& out = file.stream();
   // An arm's episode adds its links and joint torques; any other keeps version 2's columns, byte
@@ -209,7 +204,7 @@ Episode parse(std::string_view text, const std::string& where, std::string name,
   std::vector<std::string> columns;
   std::size_t width = 0;
   bool reward_empty = false, torques_empty = false;
-  Layout layout;
+  CsvLayout layout;
   Episode e;
   e.name = std::move(name);
   std::vector<std::string_view> fields;

@@ -217,15 +217,21 @@ void read_robomimic_arm(hid_t demo, const std::string& where, Episode& e) {
       rates.values.push_back(t < steps ? links.values[6 * t + 3 + i] : last.values[3 + i]);
     }
   links_from_rows(angles, rates, e);
-  for (const bool r : {false, true}) {
-    const std::string key = std::string("obs/") + (r ? "robot0_joint_vel" : "robot0_joint_pos");
-    if (!h5::exists(demo, key)) continue;
-    const h5::Array seen = read_shaped(demo, key, where + "/" + key, steps, 4);
-    const std::vector<double> expected = joint_rows(e.states, e.links, r);
-    for (std::size_t k = 0; k < expected.size(); ++k)
-      if (!(std::abs(seen.values[k] - expected[k]) <= 1e-9))
-        throw InputError(where + "/" + key + ": " + row_col(k / 4, k % 4) + " disagrees with dicestack/links and the states");
-  }
+  std::vector<State> next(e.states.begin() + 1, e.states.end());
+  next.push_back(*e.final_state);
+  std::vector<ArmLinks> next_links(e.links.begin() + 1, e.links.end());
+  next_links.push_back(*e.final_links);
+  for (const char* group : {"obs/", "next_obs/"})
+    for (const bool r : {false, true}) {
+      const std::string key = std::string(group) + (r ? "robot0_joint_vel" : "robot0_joint_pos");
+      if (!h5::exists(demo, key)) continue;
+      const h5::Array seen = read_shaped(demo, key, where + "/" + key, steps, 4);
+      const bool later = group[0] == 'n';
+      const std::vector<double> expected = later ? joint_rows(next, next_links, r) : joint_rows(e.states, e.links, r);
+      for (std::size_t k = 0; k < expected.size(); ++k)
+        if (!(std::abs(seen.values[k] - expected[k]) <= 1e-9))
+          throw InputError(where + "/" + key + ": " + row_col(k / 4, k % 4) + " disagrees with dicestack/links and the states");
+    }
   if (!h5::exists(demo, "action_dict/joint_torques")) return;
   const h5::Array torques = read_shaped(demo, "action_dict/joint_torques", where + "/action_dict/joint_torques", steps, 4);
   e.joint_torques.assign(steps, {});

@@ -23,7 +23,13 @@ constexpr std::uint64_t kRecordingsStream = 0x7265636f7264ULL;  // "record": the
 std::vector<CupPath> cup_paths(const std::vector<Episode>& episodes) {
   std::vector<CupPath> paths;
   paths.reserve(episodes.size());
-  for (const auto& e : episodes) paths.push_back({e.name, e.states, e.actions});
+  for (const auto& e : episodes) {
+    // The tracker follows a cup path: the states and the cup's velocity changes between them.
+    if (!e.actions.empty() && e.actions.front().kind() != ActionKind::cup)
+      throw InputError("expert tracker: recording \"" + e.name + "\" acts in joint torques; the tracker follows recordings of "
+                       "the cup's actions (record them with --controller cup)");
+    paths.push_back({e.name, e.states, e.actions});
+  }
   return paths;
 }
 

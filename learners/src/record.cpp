@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/initial_state.hpp>
 #include <dicestack/core/memory_budget.hpp>
@@ -35,6 +37,19 @@ Action executed_noise(const Action& fractions, ActionKind kind, const WorldConfi
     noise[k] = fraction * scale[k];
   }
   return noise;
+}
+
+// An episode whose expert acted behind an estimator says so in its perturbation record: its
+// actions answered the estimate, which a training row (rebuilt from what the sensors gave) does
+// not show, so make_dataset refuses it by name.
+void mark_estimator(const RecordRequest& request, const PerturbedEnv& episode, Episode& e) {
+  const PerturbationDraw& d = episode.draw();
+  const bool sensed = d.observation_delay > 0 || d.action_delay > 0 ||
+                      std::any_of(d.observation_noise.begin(), d.observation_noise.end(), [](double v) { return v > 0.0; });
+  if (request.estimator.kind == EstimatorKind::none || !sensed) return;
+  nlohmann::json record = nlohmann::json::parse(e.perturbation);
+  record["estimator"] = request.estimator.kind == EstimatorKind::kalman ? "kalman" : "particle";
+  e.perturbation = record.dump();
 }
 
 }  // namespace
@@ -83,6 +98,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
         ExpertPolicy policy(*expert, episode.env(), request.feedback);
         Episode e = rollout(episode, policy, episode.random_start(s), s, StepSource::expert);
         e.origin = "expert " + name;
+        mark_estimator(request, episode, e);
         const int done = std::min(total, ++finished * ranks);
         if (request.progress && w == 0) request.progress(done, total);
         return e;

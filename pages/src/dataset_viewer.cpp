@@ -6,6 +6,8 @@
 
 #include <dicestack/core/geometry.hpp>
 #include <dicestack/pages/dataset_viewer.hpp>
+
+#include <dicestack/core/error.hpp>
 #include <dicestack/pages/page.hpp>
 #include <dicestack/pages/resources.hpp>
 #include <dicestack/version.hpp>
@@ -99,6 +101,10 @@ std::string viewer_html(const DemoSet& set, const std::string& name, const std::
 }  // namespace
 
 void write_dataset_viewer(const DemoSet& set, const std::string& name, const fs::path& page_path) {
+  // The page plots the cup's actions (dvx, dvy, dw); an episode in joint torques has none.
+  for (const Episode& e : set.episodes)
+    if (!e.actions.empty() && e.actions.front().kind() != ActionKind::cup)
+      throw InputError(name + ": episode " + e.name + " acts in joint torques; the episode viewer plots the cup's actions");
   const page::MediaFolder media{page_media_folder(page_path), kViewerMarker, kViewerFormat, "episode viewer's folder"};
   page::write_page_with_media(
       page_path, results_page_ownership(), media,

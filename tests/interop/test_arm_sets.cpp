@@ -14,6 +14,7 @@
 
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/interop/interop.hpp>
+#include <dicestack/learners/demonstrator.hpp>
 
 #include <dicestack/test/helpers.hpp>
 #include <dicestack/test/interop.hpp>
@@ -120,6 +121,17 @@ TEST(ArmSets, AnEpisodeInJointTorquesKeepsThemAsItsActions) {
   EXPECT_THAT(test::error_of([&] { export_robomimic(read_demo_set(dir), scratch("arm_torques.hdf5")); }),
               HasSubstr("episode episode_0000 acts in joint torques; the export carries the cup's actions"));
   EXPECT_FALSE(fs::exists(scratch("arm_torques.hdf5")));
+  // The tracker follows recordings of the cup's actions, and a set holds one kind of action.
+  EXPECT_THAT(test::error_of([&] { make_recordings(set.episodes, set.world, tracker_preset("plain"), 0, 1, local_cluster()); }),
+              HasSubstr("recording \"episode_0000\" acts in joint torques"));
+  DemoSet mixed = set;
+  mixed.episodes.push_back(arm_set().episodes[0]);
+  EXPECT_THAT(test::error_of([&] { write_demo_set(mixed, scratch("arm_mixed")); }), HasSubstr("a set holds one kind"));
+  // An arm's files in a set whose world has no arm.
+  auto meta = nlohmann::json::parse(text_of(dir / "meta.json"));
+  meta["world"]["embodiment"] = "cup";
+  write_text(dir / "meta.json", meta.dump(2));
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }), HasSubstr("the set's world has no arm"));
 }
 
 TEST(ArmSets, BadArmFilesAreRefusedNamingThePlace) {
@@ -170,7 +182,7 @@ TEST(ArmSets, BadArmFilesAreRefusedNamingThePlace) {
   for (Action& a : bare.actions) a = Action::torques({1.0, 2.0, 3.0, 4.0});
   DemoSet lone = set;
   lone.episodes = {bare};
-  EXPECT_THAT(test::error_of([&] { write_demo_set(lone, scratch("arm_lone")); }), HasSubstr("needs the arm's link readings"));
+  EXPECT_THAT(test::error_of([&] { write_demo_set(lone, scratch("arm_lone")); }), HasSubstr("acts in joint torques, which command an arm, and has no arm link readings"));
 }
 
 }  // namespace

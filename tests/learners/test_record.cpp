@@ -12,6 +12,7 @@
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/expert.hpp>
 #include <dicestack/core/tracker.hpp>
+#include <dicestack/datasets/dataset.hpp>
 #include <dicestack/learners/demonstrator.hpp>
 #include <dicestack/learners/record.hpp>
 
@@ -62,6 +63,9 @@ TEST(Record, BehindAnEstimatorTheExpertsFeedbackReadsTheEstimateTheSameOnAnyThre
     EXPECT_NE(one[i].actions, world[i].actions);
     EXPECT_NE(one[i].actions, seen[i].actions);
   }
+  // Its actions answered the estimate, which a training row (what the sensors gave) does not show.
+  EXPECT_THAT(test::error_of([&] { make_dataset(one); }), ::testing::HasSubstr("recorded with its expert behind an estimator"));
+  EXPECT_NO_THROW(make_dataset(seen));
   // An estimator nothing reads, or that an expert in joint torques cannot run behind, is refused.
   EXPECT_THAT(test::error_of([&] { record_expert("mpc", {}, w, request(1, ExpertFeedback::world, "kalman")); }),
               ::testing::HasSubstr("give --expert-feedback observations"));

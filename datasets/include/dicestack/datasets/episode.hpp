@@ -70,7 +70,8 @@ inline double episode_memory_bound(int steps) {
 
 /// Throws InputError naming the episode unless states, actions and sources have one equal,
 /// non-zero length (links that length too, or none; joint torques that length, and only beside
-/// links, or none) and every value is finite; with a final state, rewards has that length too,
+/// links, or none), its actions are of one kind (joint torques only beside links) and every
+/// value is finite; with a final state, rewards has that length too,
 /// the final state and rewards are finite and at most one of terminated and truncated is set;
 /// without one, rewards is empty and there are no final links (which also need links).
 void check_episode(const Episode& episode);
