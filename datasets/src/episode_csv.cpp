@@ -19,9 +19,9 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t kColumnsV1 = 1 + kStateDim + kActionDim + 1;  // t, state, action, source
 constexpr std::size_t kColumnsV2 = kColumnsV1 + 1;                   // and reward
-constexpr std::size_t kLinkColumns = 6;                              // an arm's three link angles, then their rates
-constexpr std::size_t kTorqueColumns = 4;                            // the torques its four joints held
-constexpr std::size_t kColumnsV4 = kColumnsV2 + kLinkColumns + kTorqueColumns;  // and, on an arm, those
+constexpr std::size_t kCsvLinkColumns = 6;                              // an arm's three link angles, then their rates
+constexpr std::size_t kCsvTorqueColumns = 4;                            // the torques its four joints held
+constexpr std::size_t kColumnsV4 = kColumnsV2 + kCsvLinkColumns + kCsvTorqueColumns;  // and, on an arm, those
 constexpr std::size_t kColumnsV4Torques = kColumnsV4 + kJointCount - kActionDim;  // the same, its actions joint torques
 
 // A file's columns: its format version and what its actions command.
@@ -97,16 +97,16 @@ void parse_csv_arm(const std::vector<std::string_view>& fields, std::size_t firs
     l.angles[i] = parse_csv_number(fields, first + i, prefix, columns);
     l.rates[i] = parse_csv_number(fields, first + 3 + i, prefix, columns);
   }
-  const std::size_t torque = first + kLinkColumns;
+  const std::size_t torque = first + kCsvLinkColumns;
   bool empty = true;
-  for (std::size_t j = 0; j < kTorqueColumns; ++j) empty = empty && trim(fields[torque + j]).empty();
+  for (std::size_t j = 0; j < kCsvTorqueColumns; ++j) empty = empty && trim(fields[torque + j]).empty();
   if (e.states.size() == 1) torques_empty = empty;
   if (empty != torques_empty)
     throw InputError(prefix + "the joint torques are " + (empty ? "empty" : "numbers") + " but line 2's are " +
                      (torques_empty ? "empty" : "numbers") + "; an episode's joint torques are all known or all empty");
   if (empty) return;
-  std::array<double, kTorqueColumns>& tau = e.joint_torques.emplace_back();
-  for (std::size_t j = 0; j < kTorqueColumns; ++j) tau[j] = parse_csv_number(fields, torque + j, prefix, columns);
+  std::array<double, kCsvTorqueColumns>& tau = e.joint_torques.emplace_back();
+  for (std::size_t j = 0; j < kCsvTorqueColumns; ++j) tau[j] = parse_csv_number(fields, torque + j, prefix, columns);
 }
 
 // The reward cell `f` of the row just appended to `e`: empty in every row (unknown, as in the
@@ -187,7 +187,7 @@ void write(const Episode& e, const fs::path& path, AtomicFile::Leftovers leftove
     if (arm) {
       for (double v : e.links[t].angles) out << ',' << number_text(v);
       for (double v : e.links[t].rates) out << ',' << number_text(v);
-      for (std::size_t j = 0; j < kTorqueColumns; ++j)
+      for (std::size_t j = 0; j < kCsvTorqueColumns; ++j)
         out << ',' << (e.joint_torques.empty() ? std::string() : number_text(e.joint_torques[t][j]));  // empty: unknown
     }
     out << '\n';
