@@ -2,6 +2,7 @@
 #include <charconv>
 #include <cmath>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/atomic_file.hpp>
 #include <dicestack/core/error.hpp>
 #include <dicestack/datasets/dataset.hpp>
@@ -163,9 +164,9 @@ std::vector<double> joint_rows(const std::vector<State>& states, const std::vect
   std::vector<double> out;
   out.reserve(4 * states.size());
   for (std::size_t t = 0; t < states.size(); ++t) {
-    const auto& a = rates ? links[t].rates : links[t].angles;
-    const double cup = states[t][rates ? state_index::kCupW : state_index::kCupAngle];
-    out.insert(out.end(), {a[0], a[1] - a[0], a[2] - a[1], cup - a[2]});
+    const auto joints = arm_joint_angles_of(rates ? links[t].rates : links[t].angles,
+                                            states[t][rates ? state_index::kCupW : state_index::kCupAngle]);
+    out.insert(out.end(), joints.begin(), joints.end());
   }
   return out;
 }

@@ -67,8 +67,7 @@ std::string JointOscillation::to_text() const {
 }
 
 std::array<double, 4> arm_joint_angles(const World& world) {
-  const auto links = world.arm_link_angles();
-  return {links[0], links[1] - links[0], links[2] - links[1], world.state()[state_index::kCupAngle] - links[2]};
+  return arm_joint_angles_of(world.arm_link_angles(), world.state()[state_index::kCupAngle]);
 }
 
 Action oscillation_torques(const World& world, const JointOscillation& pattern, const std::array<double, 4>& start, int t) {

@@ -24,6 +24,13 @@ struct ArmPosture {
 /// holds the same arm.
 ArmPosture arm_posture(const ArmConfig& arm, Vec2 wrist);
 
+/// The four joints' angles from the links' absolute ones and the cup's (the shoulder's absolute,
+/// each other one its body's less the body's before it). The same of the rates gives the joints'
+/// rates.
+inline std::array<double, 4> arm_joint_angles_of(const std::array<double, 3>& links, double cup) {
+  return {links[0], links[1] - links[0], links[2] - links[1], cup - links[2]};
+}
+
 /// The posture of `link_angles` (joints by forward kinematics from the shoulder).
 ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& link_angles);
 
