@@ -195,6 +195,30 @@ TEST(Arm, ATorqueChangeChangesTheCupsVelocityByWhatWasAsked) {
   EXPECT_NEAR(changed.state()[si::kCupW] - base.state()[si::kCupW], 0.5, 0.05);
 }
 
+// Asked for more than its torques can give, the cup controller scales the task's share of them
+// down: the cup moves the way it was asked and the arm keeps its posture. Clipping each joint
+// alone sent the cup elsewhere (asked left and up, it went right and up) and turned the arm.
+TEST(Arm, AVelocityChangeBeyondTheTorqueLimitsKeepsItsDirectionAndTheArmsPosture) {
+  const WorldConfig c = arm_world();
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;  // clear of the dice
+  const std::array<Action, 3> asked{Action{-50.0, 0.0, 0.0}, Action{-30.0, 30.0, 0.0}, Action{0.0, 0.0, -60.0}};
+  for (const Action& a : asked) {
+    World w(c, lifted);
+    const double last_link = w.arm_link_angles()[2];
+    w.step(a);
+    const State& s = w.state();
+    const std::array<double, 3> got{s[si::kCupVx], s[si::kCupVy], s[si::kCupW]};
+    const double norm = std::hypot(a[0], a[1], a[2]), along = (got[0] * a[0] + got[1] * a[1] + got[2] * a[2]) / norm;
+    EXPECT_GT(along, 1.0) << "the cup moves the way it was asked, " << a[0] << ", " << a[1] << ", " << a[2];
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(got[k], along * a[k] / norm, 0.1 * along) << "component " << k;
+    EXPECT_NEAR(w.arm_link_angles()[2], last_link, 0.02) << "the last link keeps its direction";
+    bool saturated = false;
+    for (std::size_t j = 0; j < 4; ++j) saturated = saturated || std::abs(w.arm_joint_torques()[j]) >= c.arm.torque_limit[j] - 1e-6;
+    EXPECT_TRUE(saturated) << "a joint is at its limit";
+  }
+}
+
 TEST(Arm, ALinkOnAWallIsWallContact) {
   WorldConfig c = arm_world();
   State s = paper_start_state(c);

@@ -139,17 +139,38 @@ ChainDynamics chain_dynamics(const ArmConfig& arm, const ArmMotion& now, Vec2 gr
   return {m, bias};
 }
 
-// Generalised forces on the absolute angles as joint torques, each clipped to its limit: the
-// force on body j is its joint's torque less the next joint's (which acts back on it).
-std::array<double, 4> joint_torques_of(const ArmConfig& arm, const Vec4& force) {
-  std::array<double, 4> torque{};
+// Generalised forces on the absolute angles as joint torques: the force on body j is its
+// joint's torque less the next joint's (which acts back on it).
+Vec4 joint_torques_of(const Vec4& force) {
+  Vec4 torque;
   double after = 0.0;
-  for (int j = 3; j >= 0; --j) {
+  for (Eigen::Index j = 3; j >= 0; --j) {
     after += force(j);
-    torque[static_cast<std::size_t>(j)] = after;
+    torque(j) = after;
   }
-  for (std::size_t j = 0; j < 4; ++j) torque[j] = std::clamp(torque[j], -arm.torque_limit[j], arm.torque_limit[j]);
   return torque;
+}
+
+// Each torque clipped to its limit.
+std::array<double, 4> clipped(const ArmConfig& arm, const Vec4& torque) {
+  std::array<double, 4> out{};
+  for (std::size_t j = 0; j < 4; ++j)
+    out[j] = std::clamp(torque(static_cast<Eigen::Index>(j)), -arm.torque_limit[j], arm.torque_limit[j]);
+  return out;
+}
+
+// The most of `extra` that `base` can take with every joint within its limit, in [0, 1]; 0 when
+// `base` alone is beyond a limit.
+double within_limits(const ArmConfig& arm, const Vec4& base, const Vec4& extra) {
+  double share = 1.0;
+  for (std::size_t j = 0; j < 4; ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    const double limit = arm.torque_limit[j];
+    if (std::abs(base(i)) > limit) return 0.0;
+    if (base(i) + extra(i) > limit) share = std::min(share, (limit - base(i)) / extra(i));
+    if (base(i) + extra(i) < -limit) share = std::min(share, (-limit - base(i)) / extra(i));
+  }
+  return std::max(share, 0.0);
 }
 
 // The task's Jacobian: the cup's centre (the wrist) and its angle by the chain's absolute angles.
@@ -174,7 +195,7 @@ Eigen::Matrix<double, 4, 3> task_inverse(const Eigen::Matrix<double, 3, 4>& task
 std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
                                               Vec2 gravity) {
   const ChainDynamics d = chain_dynamics(arm, now, gravity);
-  return joint_torques_of(arm, d.m * Vec4(accel[0], accel[1], accel[2], accel[3]) + d.bias);
+  return clipped(arm, joint_torques_of(d.m * Vec4(accel[0], accel[1], accel[2], accel[3]) + d.bias));
 }
 
 std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity_change, double turn_change,
@@ -213,7 +234,8 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   Vec4 accel = pinv * wanted;
   Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
   posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];
-  accel += (Eigen::Matrix4d::Identity() - pinv * task) * posture;
+  const Vec4 spare = (Eigen::Matrix4d::Identity() - pinv * task) * posture;
+  accel += spare;
   // No joint faster than its speed limit by the end of the substep: the relative rates it would
   // reach, clipped, give back the accelerations.
   std::array<double, 4> next{}, relative{};
@@ -225,7 +247,12 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
     absolute += relative[i];
     accel(static_cast<Eigen::Index>(i)) = (absolute - w[i]) / dt;
   }
-  return joint_torques_of(arm, d.m * accel + d.bias);
+  // Saturation: what the task asks beyond the limits is scaled down as a whole, so the torques
+  // keep its direction and the posture's motion, where clipping each joint alone would turn the
+  // excess into motion of the spare degree of freedom (a cup pressed on the table folds the arm).
+  const Vec4 holding = joint_torques_of(d.m * spare + d.bias);
+  const Vec4 task_part = joint_torques_of(d.m * (accel - spare));
+  return clipped(arm, holding + within_limits(arm, holding, task_part) * task_part);
 }
 
 }  // namespace dicestack

@@ -53,9 +53,11 @@ struct ArmMotion {
 /// on its body and back on the one before) that bring the cup's velocity to `velocity` and its
 /// turn to `angular_velocity` within `dt`, from the chain's own dynamics (mass matrix,
 /// centripetal terms, gravity), with the spare degree of freedom pulled to the rest posture in
-/// the task's null space; no joint driven past its arm.speed_limit, and each torque clipped to
-/// its arm.torque_limit. Loads the model does
-/// not know (dice in the cup) are left to the next call's velocity error.
+/// the task's null space; no joint driven past its arm.speed_limit. Where the torques would pass
+/// their arm.torque_limit, the task's share of them is scaled down as a whole, keeping what holds
+/// the arm up and its posture (clipping each joint alone would fold the arm when the cup is
+/// pressed on something); each torque is then clipped to its limit. Loads the model does not
+/// know (dice in the cup) are left to the next call's velocity error.
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
                                   double dt, Vec2 gravity);
 
