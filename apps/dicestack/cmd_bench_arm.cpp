@@ -65,7 +65,7 @@ struct Demand {
 // cup would take it (gravity's pull over the step made up).
 Demand torque_demand(WorldConfig arm, const std::vector<Episode>& recordings) {
   constexpr double kPositionGain = 0.5;  // of the position error made up per step
-  arm.arm.torque_limit = {1e7, 1e7, 1e7, 1e7};  // the range's top: nothing a path asks is cut
+  arm.arm.torque_limit = {1e7, 1e7, 1e7, 1e7};  // the range's top: only the recordings' stops reach it
   const double dt = arm.physics.control_dt;
   Demand d;
   for (const Episode& e : recordings) {

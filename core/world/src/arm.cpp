@@ -247,9 +247,10 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
     absolute += relative[i];
     accel(static_cast<Eigen::Index>(i)) = (absolute - w[i]) / dt;
   }
-  // Saturation: what the task asks beyond the limits is scaled down as a whole, so the torques
-  // keep its direction and the posture's motion, where clipping each joint alone would turn the
-  // excess into motion of the spare degree of freedom (a cup pressed on the table folds the arm).
+  // Saturation: the task's share (its acceleration with the drift's correction, as the speed
+  // limit left it) is scaled down as a whole, keeping what holds the arm up and moves its
+  // posture; clipping each joint alone turned the excess into motion of the spare degree of
+  // freedom and sent the cup elsewhere than asked.
   const Vec4 holding = joint_torques_of(d.m * spare + d.bias);
   const Vec4 task_part = joint_torques_of(d.m * (accel - spare));
   return clipped(arm, holding + within_limits(arm, holding, task_part) * task_part);

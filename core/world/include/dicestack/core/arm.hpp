@@ -53,11 +53,13 @@ struct ArmMotion {
 /// on its body and back on the one before) that bring the cup's velocity to `velocity` and its
 /// turn to `angular_velocity` within `dt`, from the chain's own dynamics (mass matrix,
 /// centripetal terms, gravity), with the spare degree of freedom pulled to the rest posture in
-/// the task's null space; no joint driven past its arm.speed_limit. Where the torques would pass
-/// their arm.torque_limit, the task's share of them is scaled down as a whole, keeping what holds
-/// the arm up and its posture (clipping each joint alone would fold the arm when the cup is
-/// pressed on something); each torque is then clipped to its limit. Loads the model does not
-/// know (dice in the cup) are left to the next call's velocity error.
+/// the task's null space; no joint asked past its arm.speed_limit. Where the torques would pass
+/// their arm.torque_limit, the task's share of them (the cup's wanted acceleration, with the
+/// correction of the chain's centripetal drift) is scaled down as a whole, keeping what holds the
+/// arm up and moves its posture: clipping each joint alone sent the cup elsewhere than asked and
+/// turned the arm. When holding and posture alone pass a limit, no task share is given and they
+/// are clipped. Each torque is then clipped to its limit. Loads the model does not know (dice in
+/// the cup) are left to the next call's velocity error.
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
                                   double dt, Vec2 gravity);
 
