@@ -195,6 +195,24 @@ TEST(Arm, ATorqueChangeChangesTheCupsVelocityByWhatWasAsked) {
   EXPECT_NEAR(changed.state()[si::kCupW] - base.state()[si::kCupW], 0.5, 0.05);
 }
 
+// Within the limits the law's inverse gives back the velocity asked, so a teacher's torques
+// label the cup motion that the law turns back into them.
+TEST(Arm, TheLawsInverseGivesBackTheVelocityItWasAsked) {
+  const WorldConfig c = arm_world();
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;
+  lifted[si::kCupVx] = 0.4;
+  World w(c, lifted);
+  const ArmMotion now = w.arm_motion();
+  const double dt = c.physics.control_dt;
+  const std::array<double, 4> torques = arm_torques(c.arm, now, {0.6, 0.3}, -0.4, dt, c.physics.gravity);
+  for (std::size_t j = 0; j < 4; ++j) ASSERT_LT(std::abs(torques[j]), c.arm.torque_limit[j]) << "within the limits, joint " << j;
+  const CupVelocity back = arm_torques_inverse(c.arm, now, torques, dt, c.physics.gravity);
+  EXPECT_NEAR(back.velocity.x, 0.6, 1e-9);
+  EXPECT_NEAR(back.velocity.y, 0.3, 1e-9);
+  EXPECT_NEAR(back.angular_velocity, -0.4, 1e-9);
+}
+
 // Asked for more than its torques can give, the cup controller scales the task's share of them
 // down: the cup moves the way it was asked and the arm keeps its posture. Clipping each joint
 // alone sent the cup elsewhere (asked left and up, it went right and up) and turned the arm.

@@ -212,30 +212,49 @@ std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& n
   return {change(0), change(1), change(2), change(3)};
 }
 
-std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
-                                  double dt, Vec2 gravity) {
+namespace {
+
+// Operational-space control's parts at `now`: the chain's dynamics, the task's damped inverse,
+// the posture's acceleration in the task's null space, and what the task's acceleration is
+// measured against (the cup's own rates, and the chain's centripetal drift).
+struct OperationalSpace {
+  ChainDynamics d;
+  Eigen::Matrix<double, 4, 3> pinv;
+  Vec4 spare;
+  Eigen::Vector3d cup_rate;
+  Eigen::Vector3d drift;  // the task's acceleration at zero angular acceleration
+};
+
+OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
   const auto& a = now.angles;
   const auto& w = now.rates;
-  const ChainDynamics d = chain_dynamics(arm, now, gravity);
+  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero()};
   // The task: the cup's centre (the wrist) and its angle.
   const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
-  Eigen::Vector3d drift = Eigen::Vector3d::Zero();  // the task's acceleration at zero angular acceleration
   for (std::size_t j = 0; j < 3; ++j) {
     const double l = arm.link_lengths[j];
-    drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
-    drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
+    os.drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
+    os.drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
   }
   // The cup's own velocity, not the links' rates through the chain: what the joints let drift
   // is corrected too.
-  const Eigen::Vector3d cup_rate(now.cup_velocity.x, now.cup_velocity.y, w[3]);
-  const Eigen::Vector3d wanted = (Eigen::Vector3d(velocity.x, velocity.y, angular_velocity) - cup_rate) / dt - drift;
-  // Damped least-norm angular accelerations for the task, plus the posture's in its null space.
-  const Eigen::Matrix<double, 4, 3> pinv = task_inverse(task);
-  Vec4 accel = pinv * wanted;
+  os.cup_rate = Eigen::Vector3d(now.cup_velocity.x, now.cup_velocity.y, w[3]);
+  os.pinv = task_inverse(task);
   Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
   posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];
-  const Vec4 spare = (Eigen::Matrix4d::Identity() - pinv * task) * posture;
-  accel += spare;
+  os.spare = (Eigen::Matrix4d::Identity() - os.pinv * task) * posture;
+  return os;
+}
+
+}  // namespace
+
+std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
+                                  double dt, Vec2 gravity) {
+  const auto& w = now.rates;
+  const OperationalSpace os = operational_space(arm, now, gravity);
+  const Eigen::Vector3d wanted = (Eigen::Vector3d(velocity.x, velocity.y, angular_velocity) - os.cup_rate) / dt - os.drift;
+  // Damped least-norm angular accelerations for the task, plus the posture's in its null space.
+  Vec4 accel = os.pinv * wanted + os.spare;
   // No joint faster than its speed limit by the end of the substep: the relative rates it would
   // reach, clipped, give back the accelerations.
   std::array<double, 4> next{}, relative{};
@@ -251,9 +270,23 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   // limit left it) is scaled down as a whole, keeping what holds the arm up and moves its
   // posture; clipping each joint alone turned the excess into motion of the spare degree of
   // freedom and sent the cup elsewhere than asked.
-  const Vec4 holding = joint_torques_of(d.m * spare + d.bias);
-  const Vec4 task_part = joint_torques_of(d.m * (accel - spare));
+  const Vec4 holding = joint_torques_of(os.d.m * os.spare + os.d.bias);
+  const Vec4 task_part = joint_torques_of(os.d.m * (accel - os.spare));
   return clipped(arm, holding + within_limits(arm, holding, task_part) * task_part);
+}
+
+CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
+                                Vec2 gravity) {
+  const OperationalSpace os = operational_space(arm, now, gravity);
+  // Where no limit binds, torques = holding + (the task's wanted acceleration through the damped
+  // inverse and the mass matrix, as joint torques): linear in the wanted acceleration.
+  Eigen::Matrix<double, 4, 3> per_wanted;
+  for (Eigen::Index k = 0; k < 3; ++k) per_wanted.col(k) = joint_torques_of(os.d.m * os.pinv.col(k));
+  const Vec4 holding = joint_torques_of(os.d.m * os.spare + os.d.bias);
+  const Vec4 task_part = Vec4(torques[0], torques[1], torques[2], torques[3]) - holding;
+  const Eigen::Vector3d wanted = (per_wanted.transpose() * per_wanted).ldlt().solve(per_wanted.transpose() * task_part);
+  const Eigen::Vector3d v = os.cup_rate + dt * (wanted + os.drift);
+  return {{v(0), v(1)}, v(2)};
 }
 
 }  // namespace dicestack

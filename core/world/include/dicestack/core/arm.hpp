@@ -63,6 +63,19 @@ struct ArmMotion {
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
                                   double dt, Vec2 gravity);
 
+/// A cup velocity (m/s) and turn (rad/s).
+struct CupVelocity {
+  Vec2 velocity;
+  double angular_velocity = 0.0;
+};
+
+/// arm_torques' inverse: the cup velocity and turn whose arm_torques (same `now`, `dt` and
+/// `gravity`) give `torques`, exactly where no limit binds, else the nearest (least squares over
+/// the four joints). A policy that answers the cup's motion and acts in held joint torques is
+/// labelled so from a teacher's torques.
+CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
+                                Vec2 gravity);
+
 /// Joint-space control: the four joint torques that give the chain's absolute angles (the three
 /// links, then the cup) the accelerations `accel` (rad/s^2), from the chain's own dynamics as
 /// arm_torques uses them; each torque clipped to its limit.
