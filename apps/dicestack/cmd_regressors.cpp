@@ -69,7 +69,8 @@ int run_learners(bool markdown) {
     print_line(line);
   }
   print_line("each also as NAME/velocity (the regressor answers the cup velocity to set), NAME/position (the cup pose "
-             "to servo to), on the arm NAME/torque (its four joint torques) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
+             "to servo to), on the arm NAME/torque (its four joint torques) or NAME/osc (a cup pose that operational-space "
+             "control turns into held joint torques; NAME with links) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
              "clock of that step), as in NAME/position/landing");
   print_line("a name is parts joined by +, each once and in this order: state or cup, links (the arm's link angles "
              "and rates), clock, start or start_state "

@@ -13,7 +13,7 @@ namespace {
 constexpr std::string_view kDiceFrame = "@dice";
 constexpr std::string_view kGrammarHint =
     "a map is parts joined by \"+\", each once and in this order: state or cup, links, clock, start or start_state "
-    "(either may end in @dice), history, retry; then /velocity, /position or /torque; then /ahead or /landing";
+    "(either may end in @dice), history, retry; then /velocity, /position, /torque or /osc; then /ahead or /landing";
 
 // An input part's place in a name: parts of one rank exclude each other.
 enum Rank { kCurrentRank, kLinksRank, kClockRank, kStartRank, kHistoryRank, kRetryRank };
@@ -82,11 +82,12 @@ void parse_suffix(std::string_view name, std::string_view suffix, int& last_rank
   using T = FeatureSpec::Timing;
   const std::string slash = "/" + std::string(suffix);
   int rank = -1;
-  if (suffix == "velocity" || suffix == "position" || suffix == "torque") {
+  if (suffix == "velocity" || suffix == "position" || suffix == "torque" || suffix == "osc") {
     rank = 0;
     spec.target = suffix == "velocity"   ? ActionTarget::velocity
                   : suffix == "position" ? ActionTarget::position
-                                         : ActionTarget::torque;
+                  : suffix == "torque"   ? ActionTarget::torque
+                                         : ActionTarget::osc;
   } else if (suffix == "ahead" || suffix == "landing") {
     rank = 1;
     spec.timing = suffix == "ahead" ? T::ahead : T::landing;
@@ -96,8 +97,8 @@ void parse_suffix(std::string_view name, std::string_view suffix, int& last_rank
   if (rank == last_rank) bad_feature_name(name, in_quotes(slash) + " given with another " + (rank == 0 ? "target" : "timing"));
   if (rank < last_rank) bad_feature_name(name, in_quotes(slash) + " must come before the timing");
   // A delay's pending and unseen actions move the cup ahead as cup actions; torques do not.
-  if (rank == 1 && spec.target == ActionTarget::torque)
-    bad_feature_name(name, in_quotes(slash) + " moves the cup ahead by cup actions; a \"/torque\" map takes no timing");
+  if (rank == 1 && (spec.target == ActionTarget::torque || spec.target == ActionTarget::osc))
+    bad_feature_name(name, in_quotes(slash) + " moves the cup ahead by cup actions; a map in joint torques takes no timing");
   last_rank = rank;
 }
 
@@ -113,13 +114,15 @@ FeatureSpec parse_feature_spec(std::string_view name) {
     parse_suffix(name, name.substr(at + 1, next == std::string_view::npos ? next : next - at - 1), last_rank, spec);
     at = next;
   }
+  if (spec.target == ActionTarget::osc && !spec.links)
+    bad_feature_name(name, "\"/osc\" servos the cup through the arm's links: give links among its parts");
   return spec;
 }
 
 std::string torque_map_name(std::string_view name) {
   FeatureSpec spec = parse_feature_spec(name);
   spec.links = true;
-  spec.target = ActionTarget::torque;
+  spec.target = ActionTarget::osc;
   spec.timing = FeatureSpec::Timing::now;
   return to_string(spec);
 }
@@ -139,6 +142,7 @@ std::string to_string(const FeatureSpec& spec) {
   if (spec.target == ActionTarget::velocity) out += kVelocityTargetSuffix;
   if (spec.target == ActionTarget::position) out += kPositionTargetSuffix;
   if (spec.target == ActionTarget::torque) out += kTorqueTargetSuffix;
+  if (spec.target == ActionTarget::osc) out += kOscTargetSuffix;
   if (spec.timing == T::ahead) out += kAheadSuffix;
   if (spec.timing == T::landing) out += kLandingSuffix;
   return out;

@@ -7,7 +7,9 @@
 #include <mutex>
 #include <string>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/geometry.hpp>
 #include <dicestack/core/judge.hpp>
 #include <dicestack/core/world_config.hpp>
 
@@ -35,6 +37,29 @@ const State& acting_state(const FeatureMap& m, const History& h, State& scratch)
   return m.ahead() ? (scratch = cup_ahead(h)) : h.current();
 }
 
+// The law an "/osc" map carries: operational-space control in the default world, over one
+// control step.
+const WorldConfig& osc_world() {
+  static const WorldConfig nominal{};
+  return nominal;
+}
+
+// The arm and cup as `h` shows them now, for the law. Throws InputError without the links.
+ArmMotion shown_motion(const FeatureMap& m, const History& h) {
+  if (h.links.size() != h.states.size())
+    throw InputError("feature map \"" + m.name() + "\" servos the cup through the arm's links, and this episode has no readings of them");
+  const ArmLinks& l = h.links.back();
+  const State& s = h.current();
+  static const CupGeometry cup = cup_geometry(osc_world().cup);
+  ArmMotion now;
+  now.angles = {l.angles[0], l.angles[1], l.angles[2], s[si::kCupAngle]};
+  now.rates = {l.rates[0], l.rates[1], l.rates[2], s[si::kCupW]};
+  now.cup_velocity = {s[si::kCupVx], s[si::kCupVy]};
+  now.cup_mass = cup.mass;
+  now.cup_inertia = cup.inertia;
+  return now;
+}
+
 // One line for listings, from the spec's parts.
 std::string describe(const FeatureSpec& f) {
   std::string out = f.current == Current::state ? "the 24 state numbers"
@@ -50,6 +75,9 @@ std::string describe(const FeatureSpec& f) {
   if (f.target == ActionTarget::velocity) out += "; answers the cup velocity to set";
   if (f.target == ActionTarget::position) out += "; answers the cup pose to servo to (10/s times the pose error)";
   if (f.target == ActionTarget::torque) out += "; answers the arm's four joint torques";
+  if (f.target == ActionTarget::osc)
+    out += "; answers the cup pose to servo to, which operational-space control turns into the arm's joint torques, held "
+           "through the step";
   if (f.timing != Timing::now) out += "; under delays, the cup moved ahead to where it is when the action lands";
   if (f.timing == Timing::landing) out += ", and the clock of that step";
   return out;
@@ -189,6 +217,9 @@ void check_map_world(const FeatureMap& map, const WorldConfig& world) {
     throw ConfigError("feature map \"" + map.name() + "\" " +
                       (map.reads_links() ? "reads the arm's links" : "answers the arm's joint torques") +
                       "; this world's cup floats: run it with the arm (--embodiment arm)");
+  if (map.target() == ActionTarget::osc && (!(world.arm == osc_world().arm) || world.physics.control_dt != osc_world().physics.control_dt))
+    throw ConfigError("feature map \"" + map.name() + "\" carries the operational-space law of the default world's arm and "
+                      "control step; this world's differ: train the policy in this world with a \"/torque\" map");
   if (!map.ahead()) return;
   const PhysicsConfig nominal{}, &p = world.physics;
   if (p.gravity.x != nominal.gravity.x || p.gravity.y != nominal.gravity.y || p.control_dt != nominal.control_dt ||
@@ -207,12 +238,23 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
     std::copy(action.begin(), action.end(), out.begin());
     return;
   }
+  if (target() == ActionTarget::osc) {
+    // The pose whose servo velocity the law turns into these torques: the law's inverse.
+    const WorldConfig& w = osc_world();
+    const CupVelocity v = arm_torques_inverse(w.arm, shown_motion(*this, h), {action[0], action[1], action[2], action[3]},
+                                              w.physics.control_dt, w.physics.gravity);
+    const std::array<double, kActionDim> velocity{v.velocity.x, v.velocity.y, v.angular_velocity};
+    for (std::size_t k = 0; k < kActionDim; ++k)
+      out[k] = h.current()[kCupPose[k]] + velocity[k] / kPositionGain - (k == 0 ? origin_x(h) : 0.0);
+    return;
+  }
   State scratch;
   const State& s = acting_state(*this, h, scratch);
   for (std::size_t k = 0; k < kActionDim; ++k) {
     switch (target()) {
       case ActionTarget::impulse:
-      case ActionTarget::torque: out[k] = action[k]; break;
+      case ActionTarget::torque:
+      case ActionTarget::osc: out[k] = action[k]; break;
       case ActionTarget::velocity: out[k] = action[k] + s[kCupVelocity[k]]; break;
       case ActionTarget::position:
         out[k] = s[kCupPose[k]] + (action[k] + s[kCupVelocity[k]]) / kPositionGain - (k == 0 ? origin_x(h) : 0.0);
@@ -223,13 +265,22 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
 
 Action FeatureMap::action(const History& h, std::span<const double> output) const {
   if (target() == ActionTarget::torque) return Action::torques({output[0], output[1], output[2], output[3]});
+  if (target() == ActionTarget::osc) {
+    std::array<double, kActionDim> velocity{};
+    for (std::size_t k = 0; k < kActionDim; ++k)
+      velocity[k] = kPositionGain * (output[k] + (k == 0 ? origin_x(h) : 0.0) - h.current()[kCupPose[k]]);
+    const WorldConfig& w = osc_world();
+    return Action::torques(arm_torques(w.arm, shown_motion(*this, h), {velocity[0], velocity[1]}, velocity[2],
+                                       w.physics.control_dt, w.physics.gravity));
+  }
   State scratch;
   const State& s = acting_state(*this, h, scratch);
   Action a;
   for (std::size_t k = 0; k < kActionDim; ++k) {
     switch (target()) {
       case ActionTarget::impulse:
-      case ActionTarget::torque: a[k] = output[k]; break;
+      case ActionTarget::torque:
+      case ActionTarget::osc: a[k] = output[k]; break;
       case ActionTarget::velocity: a[k] = output[k] - s[kCupVelocity[k]]; break;
       case ActionTarget::position:
         a[k] = kPositionGain * (output[k] + (k == 0 ? origin_x(h) : 0.0) - s[kCupPose[k]]) - s[kCupVelocity[k]];

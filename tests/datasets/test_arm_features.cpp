@@ -5,7 +5,10 @@
 
 #include <vector>
 
+#include <dicestack/core/arm.hpp>
 #include <dicestack/core/error.hpp>
+#include <dicestack/core/initial_state.hpp>
+#include <dicestack/core/world.hpp>
 #include <dicestack/datasets/dataset.hpp>
 #include <dicestack/datasets/features.hpp>
 
@@ -70,6 +73,48 @@ TEST(ArmFeatures, TorqueMapsTakeNoTimingAndRunOnlyOnTheArm) {
   EXPECT_THAT(test::error_of([&] { check_map_world(feature_map("state+links"), world); }), HasSubstr("reads the arm's links"));
   world.embodiment = Embodiment::arm;
   EXPECT_NO_THROW(check_map_world(feature_map(kTorqueMap), world));
+}
+
+// An "/osc" map answers the cup pose whose servo velocity the operational-space law turns into
+// the torques: a teacher's torques within the limits are labelled and given back as they were.
+TEST(ArmFeatures, AnOscMapAnswersThePoseTheLawTurnsBackIntoTheTorques) {
+  WorldConfig c;
+  c.embodiment = Embodiment::arm;
+  State lifted = paper_start_state(c);
+  lifted[state_index::kCupY] += 1.5;
+  lifted[state_index::kCupVx] = 0.3;
+  const World w(c, lifted);
+  const std::vector<State> states{w.state()};
+  const std::vector<ArmLinks> links{{w.arm_link_angles(), w.arm_link_rates()}};
+  const History h{states, {}, {}, {}, links};
+  const FeatureMap& m = feature_map("state+links+clock/osc");
+  EXPECT_EQ(m.action_kind(), ActionKind::joint_torque);
+  EXPECT_EQ(m.outputs(), kActionDim) << "a pose, not four torques";
+  EXPECT_EQ(m.width(), feature_map("state+links+clock").width());
+  const std::array<double, 4> taught = arm_torques(c.arm, w.arm_motion(), {0.5, 0.2}, 0.3, c.physics.control_dt, c.physics.gravity);
+  std::vector<double> label(m.outputs());
+  m.label(h, Action::torques(taught), label);
+  EXPECT_NEAR(label[0], states[0][state_index::kCupX] + 0.5 / kPositionGain, 1e-9);
+  EXPECT_NEAR(label[1], states[0][state_index::kCupY] + 0.2 / kPositionGain, 1e-9);
+  EXPECT_NEAR(label[2], states[0][state_index::kCupAngle] + 0.3 / kPositionGain, 1e-9);
+  const Action back = m.action(h, label);
+  ASSERT_EQ(back.kind(), ActionKind::joint_torque);
+  for (std::size_t j = 0; j < kJointCount; ++j) EXPECT_NEAR(back[j], taught[j], 1e-6 * c.arm.torque_limit[j]) << j;
+}
+
+TEST(ArmFeatures, AnOscMapNeedsTheLinksAndTheDefaultArm) {
+  EXPECT_THAT(test::error_of([] { feature_map("state+clock/osc"); }), HasSubstr("give links among its parts"));
+  EXPECT_THAT(test::error_of([] { feature_map("state+links/osc/ahead"); }), HasSubstr("takes no timing"));
+  const std::vector<State> states{counted(0)};
+  std::vector<double> label(3);
+  EXPECT_THAT(test::error_of([&] { feature_map("state+links/osc").label(History{states, {}}, Action::torques({1, 2, 3, 4}), label); }),
+              HasSubstr("no readings of them"));
+  WorldConfig world;
+  world.embodiment = Embodiment::arm;
+  EXPECT_NO_THROW(check_map_world(feature_map("state+links/osc"), world));
+  world.arm.link_lengths[0] += 0.1;
+  EXPECT_THAT(test::error_of([&] { check_map_world(feature_map("state+links/osc"), world); }),
+              HasSubstr("default world's arm and control step"));
 }
 
 TEST(ArmFeatures, DatasetRowsOfATorqueMapComeFromTheEpisodesLinksAndTorques) {

@@ -52,8 +52,11 @@ inline constexpr std::size_t kMaxOutputWidth = kJointCount;
 /// cancelling the cup's velocity error gives labels that hold the noise of the last step; as
 /// velocities they are smooth; as poses, for a tracker of the same gain, the same wherever the
 /// cup is (so a learner's errors do not add up into a drift). On an arm, a policy may answer the
-/// joint torques its four joints hold through the step instead (the joint_torque controller).
-enum class ActionTarget { impulse, velocity, position, torque };
+/// joint torques its four joints hold through the step instead (the joint_torque controller), or
+/// a cup pose as "/position" does that a fixed operational-space law (arm_torques over the
+/// control step, the default world's arm) turns into those torques once per step ("/osc"): a
+/// pose is one per step wherever the arm is, a torque is not.
+enum class ActionTarget { impulse, velocity, position, torque, osc };
 
 /// What a feature map is made of: its name, read part by part. The grammar of a name
 /// (docs/learners.md, "Feature-map names"):
@@ -69,6 +72,7 @@ enum class ActionTarget { impulse, velocity, position, torque };
 ///             | "start_state"         the whole start state
 ///     TARGET := "/velocity" | "/position"   the regressor answers a cup velocity or a pose
 ///             | "/torque"                 the arm's four joint torques (no TIMING)
+///             | "/osc"                    a pose servoed to by held joint torques (needs links, no TIMING)
 ///     TIMING := "/ahead" | "/landing"       under delays, the cup where the action lands
 ///
 /// A map with no current-state part is open loop. "retry" needs a clock or a start to restart.
@@ -94,8 +98,8 @@ FeatureSpec parse_feature_spec(std::string_view name);
 /// The name of `spec`: parse_feature_spec's inverse, so a model file's name reads back the same.
 std::string to_string(const FeatureSpec& spec);
 /// The map for a policy in joint torques made from map `name`: its inputs, the arm's links
-/// added, answering the four torques ("/torque", no timing). "state+clock/position" gives
-/// "state+links+clock/torque". Throws ConfigError as parse_feature_spec.
+/// added, answering a pose the operational-space law turns into torques ("/osc", no timing).
+/// "state+clock/position" gives "state+links+clock/osc". Throws ConfigError as parse_feature_spec.
 std::string torque_map_name(std::string_view name);
 
 /// A named, versioned map from a History to one input row, and from the regressor's answer to
@@ -118,10 +122,15 @@ class FeatureMap {
   virtual void compute(const History& history, std::span<double> out) const = 0;
   /// What the regressor's outputs are (default: the action).
   virtual ActionTarget target() const { return ActionTarget::impulse; }
-  /// The controller its actions are for: joint_torque for a "/torque" map, else cup.
-  ActionKind action_kind() const { return target() == ActionTarget::torque ? ActionKind::joint_torque : ActionKind::cup; }
-  /// The regressor's answers per row: the action's size (3, or 4 torques).
-  std::size_t outputs() const { return action_dim(action_kind()); }
+  /// The controller its actions are for: joint_torque for a "/torque" or "/osc" map, else cup.
+  ActionKind action_kind() const {
+    return target() == ActionTarget::torque || target() == ActionTarget::osc ? ActionKind::joint_torque : ActionKind::cup;
+  }
+  /// The actions whose names and size the regressor's answers have: the four torques of a
+  /// "/torque" map, else the cup's three numbers.
+  ActionKind answer_kind() const { return target() == ActionTarget::torque ? ActionKind::joint_torque : ActionKind::cup; }
+  /// The regressor's answers per row (3, or 4 torques).
+  std::size_t outputs() const { return action_dim(answer_kind()); }
   /// True for a map that reads the arm's links (History::links): it runs only on an arm.
   virtual bool reads_links() const { return false; }
 
@@ -149,7 +158,8 @@ State cup_ahead(const History& history);
 
 /// Throws ConfigError if `map` cannot run in `world`: an "/ahead" map whose physics (gravity,
 /// control step, substeps) is not the default world's, which cup_ahead() moves the cup in; a
-/// map that reads the arm's links or answers joint torques, in a world without the arm.
+/// map that reads the arm's links or answers joint torques, in a world without the arm; an
+/// "/osc" map on an arm or a control step other than the default world's, whose law it carries.
 void check_map_world(const FeatureMap& map, const WorldConfig& world);
 
 /// The map a name describes (FeatureSpec's grammar), e.g. "state+clock+start_state@dice+retry/position",
@@ -169,6 +179,9 @@ inline constexpr double kPositionGain = 10.0;
 
 /// The suffix of a map whose regressor answers the arm's joint torques (ActionTarget::torque).
 inline constexpr std::string_view kTorqueTargetSuffix = "/torque";
+
+/// The suffix of a map whose regressor answers the cup pose held joint torques servo to (ActionTarget::osc).
+inline constexpr std::string_view kOscTargetSuffix = "/osc";
 
 /// The suffix of a map that acts for the moment its action lands (FeatureMap::ahead()).
 inline constexpr std::string_view kAheadSuffix = "/ahead";
