@@ -136,7 +136,10 @@ std::string followed_recordings(const Recordings& recordings) {
   return out;
 }
 
-bool servo_targets(const std::string& features) { return feature_map(features).target() == ActionTarget::position; }
+bool servo_targets(const std::string& features) {
+  const ActionTarget target = feature_map(features).target();
+  return target == ActionTarget::position || target == ActionTarget::osc;
+}
 
 bool expert_retries(const std::string& retry, const std::string& features) {
   return retry == "auto" ? feature_map(features).attempts() : retry == "true";

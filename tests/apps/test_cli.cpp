@@ -853,7 +853,7 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
                   "--option expert=tracker --option episodes=2 --option successes_only=false --option tracker_probes=1 "
                   "--option tracker_robust=1 --option tracker_variants=false --out " + model + " --json", false);
   ASSERT_EQ(p.status, 0) << p.output;
-  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+links+clock+start_state@dice+retry/torque");
+  EXPECT_EQ(nlohmann::json::parse(p.output)["features"], "state+links+clock+start_state@dice+retry/osc");
   EXPECT_FALSE(nlohmann::json::parse(p.output).contains("train_error")) << "recordings hold cup actions: no score";
   p = run("evaluate --model " + model + arm + " --episodes 2 --json --save-rollouts " + (dir / "set").string(), false);
   ASSERT_EQ(p.status, 0) << p.output;

@@ -26,8 +26,8 @@ TrainRequest torque_request() {
 }
 
 TEST(TrainController, JointTorquesTakeTheLearnersMapInTorques) {
-  EXPECT_EQ(check_train_settings(torque_request()), "state+links+clock+start_state@dice+retry/torque");
-  EXPECT_EQ(torque_map_name("state+clock/position/ahead"), "state+links+clock/torque");
+  EXPECT_EQ(check_train_settings(torque_request()), "state+links+clock+start_state@dice+retry/osc");
+  EXPECT_EQ(torque_map_name("state+clock/position/ahead"), "state+links+clock/osc");
   TrainRequest cup = torque_request();
   cup.controller = "cup";
   EXPECT_EQ(check_train_settings(cup), "state+clock+start_state@dice+retry/position");

@@ -67,6 +67,21 @@ TEST(TorquePolicy, DartLearnsTheTrackersTorquesTheSameOnAnyThreadCount) {
   EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
 }
 
+// An "/osc" student answers the cup pose the law servos to (three numbers, labelled through the
+// law's inverse from the teacher's torques), and acts in joint torques.
+TEST(TorquePolicy, DartLearnsAnOscMapWhoseRegressorAnswersAPoseAndActsInTorques) {
+  LearnContext c = arm_context();
+  c.features = "state+links+clock+start_state@dice+retry/osc";
+  const LearnResult r = LearnerRegistry::global().create("dart", quick_dart())->learn(c);
+  EXPECT_EQ(r.model->regressor().output_dim(), kActionDim);
+  EXPECT_THAT(r.model->record.at("dart_settings"), HasSubstr("noise=0.03/0.03/0.03/0.03"));
+  DiceEnv env(c.world);
+  ModelPolicy policy(r.model);
+  const Episode e = rollout(env, policy, random_start_state(c.world, 17), 17, StepSource::policy);
+  EXPECT_EQ(e.actions.front().kind(), ActionKind::joint_torque);
+  EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
+}
+
 // DAgger's rounds in torques: the student's own rollouts labelled by the tracker told in torques,
 // kept in its checkpoint (episodes whose actions are joint torques) and resumed from it.
 TEST(TorquePolicy, DaggerLearnsTheTrackersTorquesAndResumesFromItsCheckpoint) {

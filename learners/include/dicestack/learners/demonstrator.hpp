@@ -34,7 +34,7 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
 /// records it as "tracker_followed": which recording a policy plays, and how robust it was.
 std::string followed_recordings(const Recordings& recordings);
 
-/// True when the feature map `features` answers a cup pose to servo to ("/position"): the
+/// True when the feature map `features` answers a cup pose to servo to ("/position", "/osc"): the
 /// tracker's labels are then one pose per step, and the learners follow one recording
 /// (docs/learners.md, "Position targets").
 bool servo_targets(const std::string& features);
