@@ -197,6 +197,8 @@ std::string learners_reference_markdown() {
          "        | \"start_state\"               the whole start state\n"
          "TARGET := \"/velocity\" | \"/position\"   the regressor answers a cup velocity, or a pose\n"
          "        | \"/torque\"                   the arm's four joint torques (no TIMING)\n"
+         "        | \"/osc\"                      a cup pose that operational-space control turns into\n"
+         "                                      held joint torques (needs \"links\"; no TIMING)\n"
          "TIMING := \"/ahead\" | \"/landing\"       under delays: the cup where the action lands (and its clock)\n"
          "```\n\n"
          "The input sets `dicestack learners` lists (each also with every target and timing):\n\n"

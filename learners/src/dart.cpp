@@ -172,7 +172,7 @@ class Dart final : public Learner {
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise; with expert=tracker, 0.5)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise; with expert=tracker, 0.2)", {}},
             {"episodes", ParamType::integer, "0", 0, 1000000,
-             "noisy demonstrations from random training starts (0: 300; 900 under perturb=; 1200 with expert=tracker and a /position map)", {}},
+             "noisy demonstrations from random training starts (0: 300; 900 under perturb=; 1200 with expert=tracker and a /position or /osc map)", {}},
             {"mpc_robust", ParamType::integer, "0", 0, 1000,
              "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},
             {"replan", ParamType::boolean, "false", 0, 1,

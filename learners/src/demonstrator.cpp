@@ -86,7 +86,7 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: search timing, offset and amplitude when no recording succeeds as recorded", {}},
           {"tracker_paths", ParamType::integer, "-1", -1, 1000000,
            "tracker: follow only this many recordings, those that succeed from the most probe starts (0: all; "
-           "-1: 1 with a /position map, else 3)", {}},
+           "-1: 1 with a /position or /osc map, else 3)", {}},
           {"tracker_demos", ParamType::text, "same", 0, 0,
            "tracker: follow the training episodes of this set (builtin, human or a folder; same: the run's --demos)", {}},
           {"tracker_recordings", ParamType::integer, "0", 0, 1000000,

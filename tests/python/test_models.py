@@ -162,14 +162,15 @@ def test_the_trackers_preset_and_settings_go_by_the_learners_names(builtin_episo
         dicestack.expert("mpc", settings={"smooth": 2})
 
 
-def test_a_torque_policy_reads_the_arms_links_beside_each_observation():
+@pytest.mark.parametrize("target", ["osc", "torque"])
+def test_a_torque_policy_reads_the_arms_links_beside_each_observation(target):
     world = short_world(30)
     world["embodiment"] = "arm"
     recordings = dicestack.load_demos("human")[:2]
     options = {"expert": "tracker", "episodes": 2, "successes_only": False, "tracker_probes": 1, "tracker_robust": 1,
                "tracker_variants": False, "tracker_refine": 0}
     model = dicestack.train("knn", "dart", demos=recordings, options=options, world=world,
-                            features="state+links+clock+start_state@dice+retry/torque", params={"k": 1})
+                            features="state+links+clock+start_state@dice+retry/" + target, params={"k": 1})
     assert "train_error" not in model.training  # the recordings hold cup actions: nothing to score
     env = dicestack.DiceStackEnv(world=world, controller="joint_torque")
     obs, info = env.reset(seed=3)
