@@ -44,8 +44,9 @@ constexpr double kDartTrackerNoiseDvy = 0.5, kDartTrackerNoiseDw = 0.2;
 // torques": 10 / 74 / 81 % at 0.001 / 0.01 / 0.03 on the tuning seed).
 constexpr double kDartTorqueNoise = 0.001, kDartOscNoise = 0.03;
 // Noisy demonstrations by default, in randomised worlds, and with the tracker for a "/position"
-// map.
-constexpr int kDartEpisodes = 300, kDartRandomisedEpisodes = 900, kDartServoEpisodes = 1200;
+// map and an "/osc" map. The "/osc" student stacked in 72 / 81 / 79 % with 300 / 600 / 1200
+// (300 tuning starts each), 600 taking half of 1200's time (docs/notebook/2026-11-29-osc-policies.md).
+constexpr int kDartEpisodes = 300, kDartRandomisedEpisodes = 900, kDartServoEpisodes = 1200, kDartOscEpisodes = 600;
 
 DartSettings dart_settings(const Learner& learner, const std::string& features, bool randomised) {
   const Params& params = learner.params();
@@ -59,8 +60,10 @@ DartSettings dart_settings(const Learner& learner, const std::string& features, 
   // In randomised worlds the same state asks for different actions in different draws, and three
   // times the episodes bought 74 -> 89 % nominally with mpc (docs/robustness.md, "Domain
   // randomisation").
+  const bool osc = feature_map(features).target() == ActionTarget::osc;
   if (d.episodes == 0)
-    d.episodes = d.expert == "tracker" && servo_targets(features) ? kDartServoEpisodes
+    d.episodes = d.expert == "tracker" && osc                     ? kDartOscEpisodes
+                 : d.expert == "tracker" && servo_targets(features) ? kDartServoEpisodes
                  : randomised                                     ? kDartRandomisedEpisodes
                                                                   : kDartEpisodes;
   const double noise = params.real("noise");
@@ -73,7 +76,6 @@ DartSettings dart_settings(const Learner& learner, const std::string& features, 
         throw ConfigError(std::string("dart: ") + key + " is a cup action's noise; a map in joint torques takes noise=");
     // Any noise leaves the tracker on the arm in its less robust regime, more noise fewer
     // successes to learn from (docs/arm.md, "Policies in joint torques").
-    const bool osc = feature_map(features).target() == ActionTarget::osc;
     const double torque_noise = learner.given("noise") ? noise : osc ? kDartOscNoise : kDartTorqueNoise;
     d.noise = Action::torques({torque_noise, torque_noise, torque_noise, torque_noise});
   }
@@ -172,7 +174,7 @@ class Dart final : public Learner {
             {"noise_dvy", ParamType::real, "-1", -1, 10, "the same for dvy alone (-1: noise; with expert=tracker, 0.5)", {}},
             {"noise_dw", ParamType::real, "-1", -1, 10, "the same for dw alone (-1: noise; with expert=tracker, 0.2)", {}},
             {"episodes", ParamType::integer, "0", 0, 1000000,
-             "noisy demonstrations from random training starts (0: 300; 900 under perturb=; 1200 with expert=tracker and a /position or /osc map)", {}},
+             "noisy demonstrations from random training starts (0: 300; 900 under perturb=; 1200 with expert=tracker and a /position map, 600 with an /osc map)", {}},
             {"mpc_robust", ParamType::integer, "0", 0, 1000,
              "mpc: noisy trials (DART's noise) a chosen plan must also pass (0: the first plan that succeeds)", {}},
             {"replan", ParamType::boolean, "false", 0, 1,
