@@ -136,9 +136,10 @@ void export_split(const Split& split, const FeatureMap& features, const std::fil
   std::filesystem::create_directories(dir);
   const std::vector<std::string> columns = features.column_names();
   write_matrix_csv(dir / "train_x.csv", split.train.x, columns);
-  write_matrix_csv(dir / "train_y.csv", split.train.y, action_names());
+  const auto answers = action_names(features.answer_kind());
+  write_matrix_csv(dir / "train_y.csv", split.train.y, answers);
   write_matrix_csv(dir / "test_x.csv", split.test.x, columns);
-  write_matrix_csv(dir / "test_y.csv", split.test.y, action_names());
+  write_matrix_csv(dir / "test_y.csv", split.test.y, answers);
 }
 
 int run_bench(const RegressorBenchOptions& opt) {

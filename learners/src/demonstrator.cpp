@@ -112,7 +112,7 @@ std::vector<ParamSpec> tracker_param_specs() {
           {"tracker_refine", ParamType::integer, std::to_string(d.refine), 0, 10000,
            "tracker: CMA-ES generations that move the leading path by smooth offsets to succeed from the most "
            "starts, clean and under DART's noise; the refined path leads if it beats the leading path from fresh starts (0: off; "
-           "with a /torque map 0 unless given)", {}},
+           "with a map in joint torques 0 unless given)", {}},
           {"tracker_refine_probes", ParamType::integer, std::to_string(d.refine_probes), 1, 100000,
            "tracker: starts per generation of tracker_refine", {}},
           {"tracker_refine_restarts", ParamType::integer, std::to_string(d.refine_restarts), 1, 100,

@@ -309,7 +309,8 @@ void bind_models(py::module_& m) {
            }, py::arg("X"),
            "The regressor's answers (N x 3; N x 4 for a /torque map) for rows of the model's feature map (N x input_dim): actions, or the cup "
            "velocities to set for a '/velocity' map (its policy acts with their difference from the cup's velocity), or "
-           "the cup poses to servo to for a '/position' map (x measured from the start's mean die x for an '@dice' map)")
+           "the cup poses to servo to for a '/position' or '/osc' map (x measured from the start's mean die x for an '@dice' map; an "
+           "'/osc' policy turns them into the arm's joint torques)")
       .def("policy", [](const PyModel& pm) { return PyPolicy(pm.model); }, "A fresh policy acting with this model")
       .def("save", [](PyModel& pm, const std::filesystem::path& path) {
              save_model(*pm.model, path);

@@ -87,14 +87,15 @@ TEST(ArmFeatures, AnOscMapAnswersThePoseTheLawTurnsBackIntoTheTorques) {
   const std::vector<State> states{w.state()};
   const std::vector<ArmLinks> links{{w.arm_link_angles(), w.arm_link_rates()}};
   const History h{states, {}, {}, {}, links};
-  const FeatureMap& m = feature_map("state+links+clock/osc");
+  const FeatureMap& m = feature_map("state+links+clock+start_state@dice/osc");  // x from the dice's mean
   EXPECT_EQ(m.action_kind(), ActionKind::joint_torque);
   EXPECT_EQ(m.outputs(), kActionDim) << "a pose, not four torques";
-  EXPECT_EQ(m.width(), feature_map("state+links+clock").width());
+  EXPECT_EQ(m.width(), feature_map("state+links+clock+start_state@dice").width());
+  ASSERT_GT(m.origin_x(h), 1.0);
   const std::array<double, 4> taught = arm_torques(c.arm, w.arm_motion(), {0.5, 0.2}, 0.3, c.physics.control_dt, c.physics.gravity);
   std::vector<double> label(m.outputs());
   m.label(h, Action::torques(taught), label);
-  EXPECT_NEAR(label[0], states[0][state_index::kCupX] + 0.5 / kPositionGain, 1e-9);
+  EXPECT_NEAR(label[0], states[0][state_index::kCupX] + 0.5 / kPositionGain - m.origin_x(h), 1e-9);
   EXPECT_NEAR(label[1], states[0][state_index::kCupY] + 0.2 / kPositionGain, 1e-9);
   EXPECT_NEAR(label[2], states[0][state_index::kCupAngle] + 0.3 / kPositionGain, 1e-9);
   const Action back = m.action(h, label);

@@ -49,7 +49,7 @@ bool expert_retries(const std::string& retry, const std::string& features);
 ParamSpec retry_param_spec();
 
 /// How many recordings a learner's tracker follows for the option value `paths`: -1 is the
-/// default for the feature map `features` (1 for a "/position" map, else 3); others as given.
+/// default for the feature map `features` (1 for a "/position" or "/osc" map, else 3); others as given.
 int tracker_paths_for(int paths, const std::string& features);
 
 /// The options of a learner whose expert may be the tracker (DART, DAgger, DaD): tracker_preset,

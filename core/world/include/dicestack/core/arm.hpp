@@ -70,9 +70,10 @@ struct CupVelocity {
 };
 
 /// arm_torques' inverse: the cup velocity and turn whose arm_torques (same `now`, `dt` and
-/// `gravity`) give `torques`, exactly where no limit binds, else the nearest (least squares over
-/// the four joints). A policy that answers the cup's motion and acts in held joint torques is
-/// labelled so from a teacher's torques.
+/// `gravity`) come nearest `torques` (least squares over the four joints, in N m). Exact for
+/// torques arm_torques gives where no limit binds; other torques (a teacher's, which also move
+/// the spare degree of freedom its own way) are projected on what the law can give. A policy that
+/// answers the cup's motion and acts in held joint torques is labelled so from a teacher's torques.
 CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
                                 Vec2 gravity);
 
