@@ -75,6 +75,7 @@ TEST(TorquePolicy, DartLearnsAnOscMapWhoseRegressorAnswersAPoseAndActsInTorques)
   const LearnResult r = LearnerRegistry::global().create("dart", quick_dart())->learn(c);
   EXPECT_EQ(r.model->regressor().output_dim(), kActionDim);
   EXPECT_THAT(r.model->record.at("dart_settings"), HasSubstr("noise=0.03/0.03/0.03/0.03"));
+  EXPECT_THAT(r.model->record.at("tracker_settings"), HasSubstr("paths=1,")) << "one pose per step: one path, as /position";
   DiceEnv env(c.world);
   ModelPolicy policy(r.model);
   const Episode e = rollout(env, policy, random_start_state(c.world, 17), 17, StepSource::policy);

@@ -190,6 +190,40 @@ Eigen::Matrix<double, 4, 3> task_inverse(const Eigen::Matrix<double, 3, 4>& task
   return task.transpose() * tt.inverse();
 }
 
+// Operational-space control's parts at `now`: the chain's dynamics, the task's damped inverse,
+// the posture's acceleration in the task's null space, and what the task's acceleration is
+// measured against (the cup's own rates, and the chain's centripetal drift).
+struct OperationalSpace {
+  ChainDynamics d;
+  Eigen::Matrix<double, 4, 3> pinv;
+  Vec4 spare;
+  Eigen::Vector3d cup_rate;
+  Eigen::Vector3d drift;  // the task's acceleration at zero angular acceleration
+  Vec4 holding;           // the joint torques that hold the arm up and move its posture
+};
+
+OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
+  const auto& a = now.angles;
+  const auto& w = now.rates;
+  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero(), Vec4::Zero()};
+  // The task: the cup's centre (the wrist) and its angle.
+  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
+  for (std::size_t j = 0; j < 3; ++j) {
+    const double l = arm.link_lengths[j];
+    os.drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
+    os.drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
+  }
+  // The cup's own velocity, not the links' rates through the chain: what the joints let drift
+  // is corrected too.
+  os.cup_rate = Eigen::Vector3d(now.cup_velocity.x, now.cup_velocity.y, w[3]);
+  os.pinv = task_inverse(task);
+  Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
+  posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];
+  os.spare = (Eigen::Matrix4d::Identity() - os.pinv * task) * posture;
+  os.holding = joint_torques_of(os.d.m * os.spare + os.d.bias);
+  return os;
+}
+
 }  // namespace
 
 std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
@@ -211,42 +245,6 @@ std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& n
   const Vec4 change = a.transpose() * aat.ldlt().solve(Eigen::Vector3d(velocity_change.x, velocity_change.y, turn_change));
   return {change(0), change(1), change(2), change(3)};
 }
-
-namespace {
-
-// Operational-space control's parts at `now`: the chain's dynamics, the task's damped inverse,
-// the posture's acceleration in the task's null space, and what the task's acceleration is
-// measured against (the cup's own rates, and the chain's centripetal drift).
-struct OperationalSpace {
-  ChainDynamics d;
-  Eigen::Matrix<double, 4, 3> pinv;
-  Vec4 spare;
-  Eigen::Vector3d cup_rate;
-  Eigen::Vector3d drift;  // the task's acceleration at zero angular acceleration
-};
-
-OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
-  const auto& a = now.angles;
-  const auto& w = now.rates;
-  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero()};
-  // The task: the cup's centre (the wrist) and its angle.
-  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
-  for (std::size_t j = 0; j < 3; ++j) {
-    const double l = arm.link_lengths[j];
-    os.drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
-    os.drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
-  }
-  // The cup's own velocity, not the links' rates through the chain: what the joints let drift
-  // is corrected too.
-  os.cup_rate = Eigen::Vector3d(now.cup_velocity.x, now.cup_velocity.y, w[3]);
-  os.pinv = task_inverse(task);
-  Vec4 posture = Vec4::Zero();  // critically damped towards the rest direction
-  posture(2) = arm.posture_gain * arm.posture_gain * posture_error(arm, {a[0], a[1], a[2]}) - 2.0 * arm.posture_gain * w[2];
-  os.spare = (Eigen::Matrix4d::Identity() - os.pinv * task) * posture;
-  return os;
-}
-
-}  // namespace
 
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
                                   double dt, Vec2 gravity) {
@@ -270,9 +268,8 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   // limit left it) is scaled down as a whole, keeping what holds the arm up and moves its
   // posture; clipping each joint alone turned the excess into motion of the spare degree of
   // freedom and sent the cup elsewhere than asked.
-  const Vec4 holding = joint_torques_of(os.d.m * os.spare + os.d.bias);
   const Vec4 task_part = joint_torques_of(os.d.m * (accel - os.spare));
-  return clipped(arm, holding + within_limits(arm, holding, task_part) * task_part);
+  return clipped(arm, os.holding + within_limits(arm, os.holding, task_part) * task_part);
 }
 
 CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
@@ -282,8 +279,7 @@ CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, cons
   // inverse and the mass matrix, as joint torques): linear in the wanted acceleration.
   Eigen::Matrix<double, 4, 3> per_wanted;
   for (Eigen::Index k = 0; k < 3; ++k) per_wanted.col(k) = joint_torques_of(os.d.m * os.pinv.col(k));
-  const Vec4 holding = joint_torques_of(os.d.m * os.spare + os.d.bias);
-  const Vec4 task_part = Vec4(torques[0], torques[1], torques[2], torques[3]) - holding;
+  const Vec4 task_part = Vec4(torques[0], torques[1], torques[2], torques[3]) - os.holding;
   const Eigen::Vector3d wanted = (per_wanted.transpose() * per_wanted).ldlt().solve(per_wanted.transpose() * task_part);
   const Eigen::Vector3d v = os.cup_rate + dt * (wanted + os.drift);
   return {{v(0), v(1)}, v(2)};
