@@ -69,8 +69,8 @@ int run_learners(bool markdown) {
     print_line(line);
   }
   print_line("each also as NAME/velocity (the regressor answers the cup velocity to set), NAME/position (the cup pose "
-             "to servo to), on the arm NAME/torque (its four joint torques) or NAME/osc (a cup pose that operational-space "
-             "control turns into held joint torques; NAME with links) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
+             "to servo to), on the arm NAME/torque (its four joint torques) or NAME/osc (a cup pose and the posture's "
+             "acceleration that operational-space control turns into held joint torques; NAME with links) and, under delays, NAME/ahead (the cup where the action lands) or NAME/landing (and the "
              "clock of that step), as in NAME/position/landing");
   print_line("a name is parts joined by +, each once and in this order: state or cup, links (the arm's link angles "
              "and rates), clock, start or start_state "
@@ -136,7 +136,7 @@ void export_split(const Split& split, const FeatureMap& features, const std::fil
   std::filesystem::create_directories(dir);
   const std::vector<std::string> columns = features.column_names();
   write_matrix_csv(dir / "train_x.csv", split.train.x, columns);
-  const auto answers = action_names(features.answer_kind());
+  const auto answers = features.answer_names();
   write_matrix_csv(dir / "train_y.csv", split.train.y, answers);
   write_matrix_csv(dir / "test_x.csv", split.test.x, columns);
   write_matrix_csv(dir / "test_y.csv", split.test.y, answers);

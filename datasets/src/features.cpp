@@ -88,7 +88,9 @@ class SpecFeatureMap final : public FeatureMap {
   explicit SpecFeatureMap(const FeatureSpec& spec) : spec_(spec), name_(to_string(spec)), description_(describe(spec)) {}
 
   std::string name() const override { return name_; }
-  int version() const override { return 1; }
+  // "/osc" maps answer the posture too since version 2; a version-1 model's three answers
+  // would be read short.
+  int version() const override { return spec_.target == ActionTarget::osc ? 2 : 1; }
   std::string description() const override { return description_; }
   ActionTarget target() const override { return spec_.target; }
   bool ahead() const override { return spec_.timing != Timing::now; }
@@ -239,13 +241,16 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
     return;
   }
   if (target() == ActionTarget::osc) {
-    // The pose whose servo velocity the law turns into these torques: the law's inverse.
+    // The pose whose servo velocity the law turns into these torques, and the posture's
+    // acceleration they ask beyond the law's own: the law's inverse. Without the posture the
+    // teacher's torques lost what their held steps do to the links (docs/arm.md).
     const WorldConfig& w = osc_world();
-    const CupVelocity v = arm_torques_inverse(w.arm, shown_motion(*this, h), {action[0], action[1], action[2], action[3]},
-                                              w.physics.control_dt, w.physics.gravity);
-    const std::array<double, kActionDim> velocity{v.velocity.x, v.velocity.y, v.angular_velocity};
+    const LawRequest asked = arm_torques_inverse(w.arm, shown_motion(*this, h), {action[0], action[1], action[2], action[3]},
+                                                 w.physics.control_dt, w.physics.gravity);
+    const std::array<double, kActionDim> velocity{asked.cup.velocity.x, asked.cup.velocity.y, asked.cup.angular_velocity};
     for (std::size_t k = 0; k < kActionDim; ++k)
       out[k] = h.current()[kCupPose[k]] + velocity[k] / kPositionGain - (k == 0 ? origin_x(h) : 0.0);
+    out[kActionDim] = asked.posture;
     return;
   }
   State scratch;
@@ -271,7 +276,7 @@ Action FeatureMap::action(const History& h, std::span<const double> output) cons
       velocity[k] = kPositionGain * (output[k] + (k == 0 ? origin_x(h) : 0.0) - h.current()[kCupPose[k]]);
     const WorldConfig& w = osc_world();
     return Action::torques(arm_torques(w.arm, shown_motion(*this, h), {velocity[0], velocity[1]}, velocity[2],
-                                       w.physics.control_dt, w.physics.gravity));
+                                       w.physics.control_dt, w.physics.gravity, output[kActionDim]));
   }
   State scratch;
   const State& s = acting_state(*this, h, scratch);
@@ -288,6 +293,12 @@ Action FeatureMap::action(const History& h, std::span<const double> output) cons
     }
   }
   return a;
+}
+
+std::span<const std::string_view> FeatureMap::answer_names() const {
+  static constexpr std::array<std::string_view, kActionDim + 1> osc{"dvx", "dvy", "dw", "posture"};
+  if (target() == ActionTarget::osc) return osc;
+  return action_names(target() == ActionTarget::torque ? ActionKind::joint_torque : ActionKind::cup);
 }
 
 const FeatureMap& feature_map(std::string_view name) {

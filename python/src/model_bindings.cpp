@@ -307,10 +307,10 @@ void bind_models(py::module_& m) {
              const Matrix rows = matrix_from(x, pm.model->features().width(), "X");
              return to_array(pm.model->predict(rows));
            }, py::arg("X"),
-           "The regressor's answers (N x 3; N x 4 for a /torque map) for rows of the model's feature map (N x input_dim): actions, or the cup "
+           "The regressor's answers (N x 3; N x 4 for a /torque or /osc map) for rows of the model's feature map (N x input_dim): actions, or the cup "
            "velocities to set for a '/velocity' map (its policy acts with their difference from the cup's velocity), or "
            "the cup poses to servo to for a '/position' or '/osc' map (x measured from the start's mean die x for an '@dice' map; an "
-           "'/osc' policy turns them into the arm's joint torques)")
+           "'/osc' map's fourth answer is the posture's acceleration, and its policy turns the four into the arm's joint torques)")
       .def("policy", [](const PyModel& pm) { return PyPolicy(pm.model); }, "A fresh policy acting with this model")
       .def("save", [](PyModel& pm, const std::filesystem::path& path) {
              save_model(*pm.model, path);

@@ -127,7 +127,7 @@ Model Model::train(std::unique_ptr<Regressor> regressor, const Matrix& x, const 
   std::vector<std::string> names = features.column_names();
   Standardizer xs = Standardizer::fit(x, warnings, &names);
   names.clear();
-  for (auto n : action_names(features.answer_kind())) names.emplace_back(n);
+  for (auto n : features.answer_names()) names.emplace_back(n);
   Standardizer ys = Standardizer::fit(y, warnings, &names);
   regressor->fit(xs.apply(x), ys.apply(y), seed);
   return Model(std::move(regressor), std::move(xs), std::move(ys), features);
@@ -182,7 +182,7 @@ std::string model_header(const Model& model, const std::string& payload) {
                     {"state_dim", kStateDim},
                     {"action_dim", r.output_dim()},
                     {"state_names", state_names()},
-                    {"action_names", action_names(model.features().answer_kind())},
+                    {"action_names", model.features().answer_names()},
                     {"x_standardizer", scaler_json(model.x_scaler())},
                     {"y_standardizer", scaler_json(model.y_scaler())},
                     {"record", model.record},

@@ -195,9 +195,9 @@ TEST(Arm, ATorqueChangeChangesTheCupsVelocityByWhatWasAsked) {
   EXPECT_NEAR(changed.state()[si::kCupW] - base.state()[si::kCupW], 0.5, 0.05);
 }
 
-// Within the limits the law's inverse gives back the velocity asked, so a teacher's torques
-// label the cup motion that the law turns back into them.
-TEST(Arm, TheLawsInverseGivesBackTheVelocityItWasAsked) {
+// Within the limits the law's inverse gives back what it was asked, so a teacher's torques
+// label the cup motion and posture that the law turns back into them.
+TEST(Arm, TheLawsInverseGivesBackTheVelocityAndPostureItWasAsked) {
   const WorldConfig c = arm_world();
   State lifted = paper_start_state(c);
   lifted[si::kCupY] += 1.5;
@@ -205,12 +205,50 @@ TEST(Arm, TheLawsInverseGivesBackTheVelocityItWasAsked) {
   World w(c, lifted);
   const ArmMotion now = w.arm_motion();
   const double dt = c.physics.control_dt;
-  const std::array<double, 4> torques = arm_torques(c.arm, now, {0.6, 0.3}, -0.4, dt, c.physics.gravity);
+  const std::array<double, 4> torques = arm_torques(c.arm, now, {0.6, 0.3}, -0.4, dt, c.physics.gravity, 2.5);
   for (std::size_t j = 0; j < 4; ++j) ASSERT_LT(std::abs(torques[j]), c.arm.torque_limit[j]) << "within the limits, joint " << j;
-  const CupVelocity back = arm_torques_inverse(c.arm, now, torques, dt, c.physics.gravity);
-  EXPECT_NEAR(back.velocity.x, 0.6, 1e-9);
-  EXPECT_NEAR(back.velocity.y, 0.3, 1e-9);
-  EXPECT_NEAR(back.angular_velocity, -0.4, 1e-9);
+  const LawRequest back = arm_torques_inverse(c.arm, now, torques, dt, c.physics.gravity);
+  EXPECT_NEAR(back.cup.velocity.x, 0.6, 1e-9);
+  EXPECT_NEAR(back.cup.velocity.y, 0.3, 1e-9);
+  EXPECT_NEAR(back.cup.angular_velocity, -0.4, 1e-9);
+  EXPECT_NEAR(back.posture, 2.5, 1e-9);
+}
+
+// Any torques within the limits are something the law can be asked: the four numbers give them
+// back, whichever way they move the spare degree of freedom.
+TEST(Arm, AnyTorquesWithinTheLimitsAreWhatTheLawWasAsked) {
+  const WorldConfig c = arm_world();
+  State lifted = paper_start_state(c);
+  lifted[si::kCupY] += 1.5;
+  World w(c, lifted);
+  const ArmMotion now = w.arm_motion();
+  const double dt = c.physics.control_dt;
+  std::array<double, 4> torques = arm_torques(c.arm, now, {0.0, 0.0}, 0.0, dt, c.physics.gravity);
+  torques[0] += 300.0;  // a shoulder push the law's posture would not give
+  torques[2] -= 40.0;
+  const LawRequest asked = arm_torques_inverse(c.arm, now, torques, dt, c.physics.gravity);
+  const std::array<double, 4> again = arm_torques(c.arm, now, asked.cup.velocity, asked.cup.angular_velocity, dt, c.physics.gravity, asked.posture);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(again[j], torques[j], 1e-6 * c.arm.torque_limit[j]) << "joint " << j;
+  EXPECT_GT(std::abs(asked.posture), 1.0) << "the push moves the posture";
+}
+
+// The posture's axis moves the links and not the cup: the Jacobian of the cup's centre and angle
+// sends it to zero.
+TEST(Arm, ThePostureAxisLeavesTheCupWhereItIs) {
+  const WorldConfig c = arm_world();
+  const World w(c, paper_start_state(c));
+  const std::array<double, 4> angles = w.arm_motion().angles;
+  const std::array<double, 4> axis = arm_posture_axis(c.arm, angles);
+  double x = 0.0, y = 0.0, norm = 0.0;
+  for (std::size_t j = 0; j < 3; ++j) {
+    x -= c.arm.link_lengths[j] * std::sin(angles[j]) * axis[j];
+    y += c.arm.link_lengths[j] * std::cos(angles[j]) * axis[j];
+  }
+  for (double a : axis) norm += a * a;
+  EXPECT_NEAR(x, 0.0, 1e-12);
+  EXPECT_NEAR(y, 0.0, 1e-12);
+  EXPECT_EQ(axis[3], 0.0);
+  EXPECT_NEAR(norm, 1.0, 1e-12);
 }
 
 // Asked for more than its torques can give, the cup controller scales the task's share of them

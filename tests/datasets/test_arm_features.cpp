@@ -89,15 +89,17 @@ TEST(ArmFeatures, AnOscMapAnswersThePoseTheLawTurnsBackIntoTheTorques) {
   const History h{states, {}, {}, {}, links};
   const FeatureMap& m = feature_map("state+links+clock+start_state@dice/osc");  // x from the dice's mean
   EXPECT_EQ(m.action_kind(), ActionKind::joint_torque);
-  EXPECT_EQ(m.outputs(), kActionDim) << "a pose, not four torques";
+  EXPECT_EQ(m.outputs(), kActionDim + 1) << "a pose and the posture, not four torques";
+  EXPECT_EQ(m.answer_names().back(), "posture");
   EXPECT_EQ(m.width(), feature_map("state+links+clock+start_state@dice").width());
   ASSERT_GT(m.origin_x(h), 1.0);
-  const std::array<double, 4> taught = arm_torques(c.arm, w.arm_motion(), {0.5, 0.2}, 0.3, c.physics.control_dt, c.physics.gravity);
+  const std::array<double, 4> taught = arm_torques(c.arm, w.arm_motion(), {0.5, 0.2}, 0.3, c.physics.control_dt, c.physics.gravity, -1.5);
   std::vector<double> label(m.outputs());
   m.label(h, Action::torques(taught), label);
   EXPECT_NEAR(label[0], states[0][state_index::kCupX] + 0.5 / kPositionGain - m.origin_x(h), 1e-9);
   EXPECT_NEAR(label[1], states[0][state_index::kCupY] + 0.2 / kPositionGain, 1e-9);
   EXPECT_NEAR(label[2], states[0][state_index::kCupAngle] + 0.3 / kPositionGain, 1e-9);
+  EXPECT_NEAR(label[3], -1.5, 1e-9);
   const Action back = m.action(h, label);
   ASSERT_EQ(back.kind(), ActionKind::joint_torque);
   for (std::size_t j = 0; j < kJointCount; ++j) EXPECT_NEAR(back[j], taught[j], 1e-6 * c.arm.torque_limit[j]) << j;
@@ -107,7 +109,7 @@ TEST(ArmFeatures, AnOscMapNeedsTheLinksAndTheDefaultArm) {
   EXPECT_THAT(test::error_of([] { feature_map("state+clock/osc"); }), HasSubstr("give links among its parts"));
   EXPECT_THAT(test::error_of([] { feature_map("state+links/osc/ahead"); }), HasSubstr("takes no timing"));
   const std::vector<State> states{counted(0)};
-  std::vector<double> label(3);
+  std::vector<double> label(4);
   EXPECT_THAT(test::error_of([&] { feature_map("state+links/osc").label(History{states, {}}, Action::torques({1, 2, 3, 4}), label); }),
               HasSubstr("no readings of them"));
   WorldConfig world;

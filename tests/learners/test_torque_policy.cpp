@@ -67,13 +67,14 @@ TEST(TorquePolicy, DartLearnsTheTrackersTorquesTheSameOnAnyThreadCount) {
   EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
 }
 
-// An "/osc" student answers the cup pose the law servos to (three numbers, labelled through the
-// law's inverse from the teacher's torques), and acts in joint torques.
+// An "/osc" student answers the cup pose the law servos to and the posture's acceleration (four
+// numbers, labelled through the law's inverse from the teacher's torques), and acts in joint
+// torques.
 TEST(TorquePolicy, DartLearnsAnOscMapWhoseRegressorAnswersAPoseAndActsInTorques) {
   LearnContext c = arm_context();
   c.features = "state+links+clock+start_state@dice+retry/osc";
   const LearnResult r = LearnerRegistry::global().create("dart", quick_dart())->learn(c);
-  EXPECT_EQ(r.model->regressor().output_dim(), kActionDim);
+  EXPECT_EQ(r.model->regressor().output_dim(), kActionDim + 1);
   EXPECT_THAT(r.model->record.at("dart_settings"), HasSubstr("noise=0.03/0.03/0.03/0.03"));
   EXPECT_THAT(r.model->record.at("tracker_settings"), HasSubstr("paths=1,")) << "one pose per step: one path, as /position";
   DiceEnv env(c.world);

@@ -200,12 +200,22 @@ struct OperationalSpace {
   Eigen::Vector3d cup_rate;
   Eigen::Vector3d drift;  // the task's acceleration at zero angular acceleration
   Vec4 holding;           // the joint torques that hold the arm up and move its posture
+  Vec4 posture_axis;      // the task's null space as a unit vector (zero when stretched straight)
 };
+
+// The null space of the task's Jacobian: the third body's angle stays free of the cup's angle,
+// the three links' accelerations are the cross product of the Jacobian's x and y rows.
+Vec4 posture_axis(const ArmConfig& arm, const std::array<double, 4>& a) {
+  const auto& l = arm.link_lengths;
+  const Vec4 axis(l[1] * l[2] * std::sin(a[2] - a[1]), l[0] * l[2] * std::sin(a[0] - a[2]), l[0] * l[1] * std::sin(a[1] - a[0]), 0.0);
+  const double norm = axis.norm();
+  return norm > 1e-9 ? Vec4(axis / norm) : Vec4::Zero();
+}
 
 OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
   const auto& a = now.angles;
   const auto& w = now.rates;
-  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero(), Vec4::Zero()};
+  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero(), Vec4::Zero(), posture_axis(arm, a)};
   // The task: the cup's centre (the wrist) and its angle.
   const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
   for (std::size_t j = 0; j < 3; ++j) {
@@ -246,13 +256,18 @@ std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& n
   return {change(0), change(1), change(2), change(3)};
 }
 
+std::array<double, 4> arm_posture_axis(const ArmConfig& arm, const std::array<double, 4>& angles) {
+  const Vec4 axis = posture_axis(arm, angles);
+  return {axis(0), axis(1), axis(2), axis(3)};
+}
+
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
-                                  double dt, Vec2 gravity) {
+                                  double dt, Vec2 gravity, double posture) {
   const auto& w = now.rates;
   const OperationalSpace os = operational_space(arm, now, gravity);
   const Eigen::Vector3d wanted = (Eigen::Vector3d(velocity.x, velocity.y, angular_velocity) - os.cup_rate) / dt - os.drift;
   // Damped least-norm angular accelerations for the task, plus the posture's in its null space.
-  Vec4 accel = os.pinv * wanted + os.spare;
+  Vec4 accel = os.pinv * wanted + os.spare + posture * os.posture_axis;
   // No joint faster than its speed limit by the end of the substep: the relative rates it would
   // reach, clipped, give back the accelerations.
   std::array<double, 4> next{}, relative{};
@@ -272,17 +287,20 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
   return clipped(arm, os.holding + within_limits(arm, os.holding, task_part) * task_part);
 }
 
-CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
-                                Vec2 gravity) {
+LawRequest arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
+                               Vec2 gravity) {
   const OperationalSpace os = operational_space(arm, now, gravity);
   // Where no limit binds, torques = holding + (the task's wanted acceleration through the damped
-  // inverse and the mass matrix, as joint torques): linear in the wanted acceleration.
-  Eigen::Matrix<double, 4, 3> per_wanted;
-  for (Eigen::Index k = 0; k < 3; ++k) per_wanted.col(k) = joint_torques_of(os.d.m * os.pinv.col(k));
-  const Vec4 task_part = Vec4(torques[0], torques[1], torques[2], torques[3]) - os.holding;
-  const Eigen::Vector3d wanted = (per_wanted.transpose() * per_wanted).ldlt().solve(per_wanted.transpose() * task_part);
-  const Eigen::Vector3d v = os.cup_rate + dt * (wanted + os.drift);
-  return {{v(0), v(1)}, v(2)};
+  // inverse, and the posture's along its axis, through the mass matrix as joint torques): linear
+  // in the four. The posture's column is zero where the arm is stretched straight, and the
+  // posture asked is then zero.
+  Eigen::Matrix4d per_asked;
+  for (Eigen::Index k = 0; k < 3; ++k) per_asked.col(k) = joint_torques_of(os.d.m * os.pinv.col(k));
+  per_asked.col(3) = joint_torques_of(os.d.m * os.posture_axis);
+  const Vec4 beyond = Vec4(torques[0], torques[1], torques[2], torques[3]) - os.holding;
+  const Vec4 asked = per_asked.colPivHouseholderQr().solve(beyond);
+  const Eigen::Vector3d v = os.cup_rate + dt * (asked.head<3>() + os.drift);
+  return {{{v(0), v(1)}, v(2)}, asked(3)};
 }
 
 }  // namespace dicestack

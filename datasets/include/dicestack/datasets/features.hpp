@@ -53,9 +53,10 @@ inline constexpr std::size_t kMaxOutputWidth = kJointCount;
 /// velocities they are smooth; as poses, for a tracker of the same gain, the same wherever the
 /// cup is (so a learner's errors do not add up into a drift). On an arm, a policy may answer the
 /// joint torques its four joints hold through the step instead (the joint_torque controller), or
-/// a cup pose as "/position" does that a fixed operational-space law (arm_torques over the
-/// control step, the default world's arm) turns into those torques once per step ("/osc"): a
-/// pose is one per step wherever the arm is, a torque is not.
+/// a cup pose as "/position" does, with the posture's acceleration, that a fixed
+/// operational-space law (arm_torques over the control step, the default world's arm) turns into
+/// those torques once per step ("/osc"): a pose is one per step wherever the arm is, a torque is
+/// not.
 enum class ActionTarget { impulse, velocity, position, torque, osc };
 
 /// What a feature map is made of: its name, read part by part. The grammar of a name
@@ -72,7 +73,7 @@ enum class ActionTarget { impulse, velocity, position, torque, osc };
 ///             | "start_state"         the whole start state
 ///     TARGET := "/velocity" | "/position"   the regressor answers a cup velocity or a pose
 ///             | "/torque"                 the arm's four joint torques (no TIMING)
-///             | "/osc"                    a pose servoed to by held joint torques (needs links, no TIMING)
+///             | "/osc"                    a pose and posture servoed to by held joint torques (needs links, no TIMING)
 ///     TIMING := "/ahead" | "/landing"       under delays, the cup where the action lands
 ///
 /// A map with no current-state part is open loop. "retry" needs a clock or a start to restart.
@@ -126,11 +127,11 @@ class FeatureMap {
   ActionKind action_kind() const {
     return target() == ActionTarget::torque || target() == ActionTarget::osc ? ActionKind::joint_torque : ActionKind::cup;
   }
-  /// The actions whose names and size the regressor's answers have: the four torques of a
-  /// "/torque" map, else the cup's three numbers.
-  ActionKind answer_kind() const { return target() == ActionTarget::torque ? ActionKind::joint_torque : ActionKind::cup; }
-  /// The regressor's answers per row (3, or 4 torques).
-  std::size_t outputs() const { return action_dim(answer_kind()); }
+  /// The names of the regressor's answers: the four torques of a "/torque" map, else the cup's
+  /// three numbers, and for an "/osc" map the posture's acceleration after them.
+  std::span<const std::string_view> answer_names() const;
+  /// The regressor's answers per row (3, or 4: torques, or an "/osc" map's pose and posture).
+  std::size_t outputs() const { return answer_names().size(); }
   /// True for a map that reads the arm's links (History::links): it runs only on an arm.
   virtual bool reads_links() const { return false; }
 

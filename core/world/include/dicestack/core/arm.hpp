@@ -53,15 +53,21 @@ struct ArmMotion {
 /// on its body and back on the one before) that bring the cup's velocity to `velocity` and its
 /// turn to `angular_velocity` within `dt`, from the chain's own dynamics (mass matrix,
 /// centripetal terms, gravity), with the spare degree of freedom pulled to the rest posture in
-/// the task's null space; no joint asked past its arm.speed_limit. Where the torques would pass
+/// the task's null space, `posture` (rad/s^2) added to that pull along the null space's unit
+/// axis (arm_posture_axis); no joint asked past its arm.speed_limit. Where the torques would pass
 /// their arm.torque_limit, the task's share of them (the cup's wanted acceleration, with the
-/// correction of the chain's centripetal drift) is scaled down as a whole, keeping what holds the
-/// arm up and moves its posture: clipping each joint alone sent the cup elsewhere than asked and
-/// turned the arm. When holding and posture alone pass a limit, no task share is given and they
-/// are clipped. Each torque is then clipped to its limit. Loads the model does not know (dice in
-/// the cup) are left to the next call's velocity error.
+/// correction of the chain's centripetal drift, and `posture`) is scaled down as a whole, keeping
+/// what holds the arm up and pulls it to its rest posture: clipping each joint alone sent the cup
+/// elsewhere than asked and turned the arm. When holding and that pull alone pass a limit, no
+/// task share is given and they are clipped. Each torque is then clipped to its limit. Loads the
+/// model does not know (dice in the cup) are left to the next call's velocity error.
 std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity, double angular_velocity,
-                                  double dt, Vec2 gravity);
+                                  double dt, Vec2 gravity, double posture = 0.0);
+
+/// The angular accelerations of the chain's bodies that leave the cup's centre and angle where
+/// they are (the task's null space: the elbows fold, the cup stays), as a unit vector whose
+/// shoulder part follows the elbow's bend; zero where the arm is stretched straight.
+std::array<double, 4> arm_posture_axis(const ArmConfig& arm, const std::array<double, 4>& angles);
 
 /// A cup velocity (m/s) and turn (rad/s).
 struct CupVelocity {
@@ -69,13 +75,19 @@ struct CupVelocity {
   double angular_velocity = 0.0;
 };
 
-/// arm_torques' inverse: the cup velocity and turn whose arm_torques (same `now`, `dt` and
-/// `gravity`) come nearest `torques` (least squares over the four joints, in N m). Exact for
-/// torques arm_torques gives where no limit binds; other torques (a teacher's, which also move
-/// the spare degree of freedom its own way) are projected on what the law can give. A policy that
-/// answers the cup's motion and acts in held joint torques is labelled so from a teacher's torques.
-CupVelocity arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
-                                Vec2 gravity);
+/// What arm_torques is asked: the cup's velocity and turn, and the posture's acceleration.
+struct LawRequest {
+  CupVelocity cup;
+  double posture = 0.0;
+};
+
+/// arm_torques' inverse: what it must be asked (same `now`, `dt` and `gravity`) to give
+/// `torques`. Four torques, four numbers: exact wherever no limit binds (the speed's, the
+/// torques'), for any torques, also a teacher's that move the spare degree of freedom their own
+/// way. A policy that answers the cup's motion and acts in held joint torques is labelled so from
+/// a teacher's torques.
+LawRequest arm_torques_inverse(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& torques, double dt,
+                               Vec2 gravity);
 
 /// Joint-space control: the four joint torques that give the chain's absolute angles (the three
 /// links, then the cup) the accelerations `accel` (rad/s^2), from the chain's own dynamics as
