@@ -105,5 +105,22 @@ TEST(LearnerSpec, TheLearnersTrackerIsThePresetWithTheOptionsGivenOnTop) {
   EXPECT_EQ(options(*distill_default), as_text) << "the learners' preset: its options' text as before";
 }
 
+// In joint torques the tracker follows the path it ranks first without refining it, so it ranks
+// from more probe starts; what is given stays as given.
+TEST(LearnerSpec, ATrackerInJointTorquesDoesNotRefineAndRanksFromMoreStarts) {
+  const std::string map = "state+links+clock+start_state@dice+retry/osc";
+  const TrackerConfig by_default = learner_tracker_config(*LearnerRegistry::global().create("dart", {"expert=tracker"}), map);
+  EXPECT_EQ(by_default.refine, 0);
+  EXPECT_EQ(by_default.probes, 32);
+  EXPECT_EQ(by_default.controller, ActionKind::joint_torque);
+  const TrackerConfig given = learner_tracker_config(
+      *LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_probes=8", "tracker_refine=3"}), map);
+  EXPECT_EQ(given.probes, 8);
+  EXPECT_EQ(given.refine, 3);
+  EXPECT_EQ(learner_tracker_config(*LearnerRegistry::global().create("dart", {"expert=tracker"}), "state+clock+start_state@dice+retry/position").probes,
+            tracker_preset("distill").probes)
+      << "in the cup's actions, the preset's";
+}
+
 }  // namespace
 }  // namespace dicestack
