@@ -85,14 +85,12 @@ class ThroughMap final : public Policy {
   Rng rng_{0};
 };
 
-// The tracker a DART run with `features` distils, ranked with seed 0 as training seed 0 ranks it.
+// The tracker a DART run with `features` distils (the learner's defaults), ranked with seed 0 as
+// training seed 0 ranks it.
 ExpertConfig teacher(const WorldConfig& world, const std::string& features, int threads) {
   const std::vector<Episode> demos =
       DemoSplit(read_demo_set(resolve_demo_set("human", world)).episodes, "episodes").train();
-  TrackerConfig tracker = tracker_preset("distill");
-  tracker.paths = tracker_paths_for(-1, features);
-  tracker.controller = feature_map(features).action_kind();
-  if (tracker.controller == ActionKind::joint_torque) tracker.refine = 0;
+  const TrackerConfig tracker = learner_tracker_config(*LearnerRegistry::global().create("dart", {"expert=tracker"}), features);
   ExpertConfig config;
   config.controller = tracker.controller;
   config.retry = true;

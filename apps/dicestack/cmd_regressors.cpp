@@ -179,13 +179,13 @@ int run_bench(const RegressorBenchOptions& opt) {
     // fastest regressors).
     const Matrix probe = model.x_scaler().apply(queries);
     std::vector<double> per_call;
-    double out[kActionDim];
+    double out[kMaxOutputWidth];
     const auto n = static_cast<std::size_t>(probe.rows());
     for (int b = 0; b < std::max(1, opt.calls / 50); ++b) {
       t0 = std::chrono::steady_clock::now();
       for (int k = 0; k < 50; ++k) {
         const auto row = static_cast<Eigen::Index>((static_cast<std::size_t>(b) * 50 + static_cast<std::size_t>(k)) % n);
-        model.regressor().predict_row({probe.row(row).data(), static_cast<std::size_t>(probe.cols())}, out);
+        model.regressor().predict_row({probe.row(row).data(), static_cast<std::size_t>(probe.cols())}, {out, model.regressor().output_dim()});
       }
       per_call.push_back(seconds_since(t0) / 50.0);
     }

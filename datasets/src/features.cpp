@@ -76,8 +76,8 @@ std::string describe(const FeatureSpec& f) {
   if (f.target == ActionTarget::position) out += "; answers the cup pose to servo to (10/s times the pose error)";
   if (f.target == ActionTarget::torque) out += "; answers the arm's four joint torques";
   if (f.target == ActionTarget::osc)
-    out += "; answers the cup pose to servo to, which operational-space control turns into the arm's joint torques, held "
-           "through the step";
+    out += "; answers the cup pose to servo to and the posture's acceleration, which operational-space control turns into "
+           "the arm's joint torques, held through the step";
   if (f.timing != Timing::now) out += "; under delays, the cup moved ahead to where it is when the action lands";
   if (f.timing == Timing::landing) out += ", and the clock of that step";
   return out;
@@ -88,8 +88,8 @@ class SpecFeatureMap final : public FeatureMap {
   explicit SpecFeatureMap(const FeatureSpec& spec) : spec_(spec), name_(to_string(spec)), description_(describe(spec)) {}
 
   std::string name() const override { return name_; }
-  // "/osc" maps answer the posture too since version 2; a version-1 model's three answers
-  // would be read short.
+  // An "/osc" map's answers are the pose and the posture (version 2); a model of the pose alone
+  // (version 1) would be read short, and is refused.
   int version() const override { return spec_.target == ActionTarget::osc ? 2 : 1; }
   std::string description() const override { return description_; }
   ActionTarget target() const override { return spec_.target; }
@@ -242,8 +242,9 @@ void FeatureMap::label(const History& h, const Action& action, std::span<double>
   }
   if (target() == ActionTarget::osc) {
     // The pose whose servo velocity the law turns into these torques, and the posture's
-    // acceleration they ask beyond the law's own: the law's inverse. Without the posture the
-    // teacher's torques lost what their held steps do to the links (docs/arm.md).
+    // acceleration they ask beyond the law's own: the law's inverse. The teacher's torques in the
+    // task's null space move the links through the held step, and with them the cup and the
+    // walls the links reach (docs/arm.md, "The map's own limit").
     const WorldConfig& w = osc_world();
     const LawRequest asked = arm_torques_inverse(w.arm, shown_motion(*this, h), {action[0], action[1], action[2], action[3]},
                                                  w.physics.control_dt, w.physics.gravity);

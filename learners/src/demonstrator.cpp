@@ -176,7 +176,8 @@ TrackerConfig learner_tracker_config(const Learner& learner, const std::string& 
   // Refining a path in held torques costs two more simulated steps per step: about 10 s a
   // generation on 2 cores, 40 min for the preset's refinements. Without a refinement the ranked
   // path is the one followed, and 16 probe starts ranked a weaker one first for one training
-  // seed in three (199 of 480 probe trials against 606 of 960 with 32): twice the probes, 30 s.
+  // seed in three (199 of 480 probe trials against 606 of 960 with 32), whose run then took 406 s
+  // instead of 285 s: twice the probes cost 30 s.
   if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_refine")) tracker.refine = 0;
   if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_probes"))
     tracker.probes = std::max(tracker.probes, kTorqueTrackerProbes);

@@ -20,7 +20,7 @@ def register_regressor(name, factory, *, description=None, params=None):
 
     factory(**params) must return a fresh, unfitted object with fit(X, Y) and predict(X) (a
     scikit-learn estimator, a Pipeline, a class of your own): X is N x d standardised feature
-    rows, Y is N x 3 standardised actions, predict returns N x 3 (multi-output: wrap a
+    rows, Y is N x 3 standardised actions (N x 4 for a /torque or /osc map), predict returns the same shape (multi-output: wrap a
     single-output estimator in sklearn.multioutput.MultiOutputRegressor). If the object has a
     `random_state` parameter left at None, it is set from the training seed, so that the same
     data and seed give the same model.

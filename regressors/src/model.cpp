@@ -270,7 +270,7 @@ const FeatureMap& model_feature_map(const json& h, int version, const std::strin
     const auto fv = static_cast<int>(header_count(h, "features_version", 1000, where));
     if (fv != features.version())
       throw InputError(where + "feature map \"" + features.name() + "\" version " + std::to_string(fv) +
-                       " differs from this dicestack's (" + std::to_string(features.version()) + ")");
+                       " differs from this dicestack's (" + std::to_string(features.version()) + "): train the model again");
   }
   return features;
 }

@@ -226,6 +226,7 @@ TEST(Arm, AnyTorquesWithinTheLimitsAreWhatTheLawWasAsked) {
   std::array<double, 4> torques = arm_torques(c.arm, now, {0.0, 0.0}, 0.0, dt, c.physics.gravity);
   torques[0] += 300.0;  // a shoulder push the law's posture would not give
   torques[2] -= 40.0;
+  for (std::size_t j = 0; j < 4; ++j) ASSERT_LT(std::abs(torques[j]), c.arm.torque_limit[j]) << "within the limits, joint " << j;
   const LawRequest asked = arm_torques_inverse(c.arm, now, torques, dt, c.physics.gravity);
   const std::array<double, 4> again = arm_torques(c.arm, now, asked.cup.velocity, asked.cup.angular_velocity, dt, c.physics.gravity, asked.posture);
   for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(again[j], torques[j], 1e-6 * c.arm.torque_limit[j]) << "joint " << j;

@@ -203,8 +203,8 @@ struct OperationalSpace {
   Vec4 posture_axis;      // the task's null space as a unit vector (zero when stretched straight)
 };
 
-// The null space of the task's Jacobian: the third body's angle stays free of the cup's angle,
-// the three links' accelerations are the cross product of the Jacobian's x and y rows.
+// The null space of the task's Jacobian: the cup's angle has its own row, so the axis has no
+// cup part; the three links' accelerations are the cross product of the x and y rows.
 Vec4 posture_axis(const ArmConfig& arm, const std::array<double, 4>& a) {
   const auto& l = arm.link_lengths;
   const Vec4 axis(l[1] * l[2] * std::sin(a[2] - a[1]), l[0] * l[2] * std::sin(a[0] - a[2]), l[0] * l[1] * std::sin(a[1] - a[0]), 0.0);

@@ -17,7 +17,7 @@ namespace dicestack {
 /// Stacked (state, action) pairs of some episodes.
 struct Dataset {
   Matrix x;                              ///< N x features.width() (24 for "state")
-  Matrix y;                              ///< N x 3
+  Matrix y;                              ///< N x features.outputs() (3; 4 for a "/torque" or "/osc" map)
   std::vector<std::size_t> episode_begin;  ///< first row of each episode, ascending
   std::vector<std::string> episode_names;
 

@@ -65,8 +65,9 @@ std::array<double, 4> arm_torques(const ArmConfig& arm, const ArmMotion& now, Ve
                                   double dt, Vec2 gravity, double posture = 0.0);
 
 /// The angular accelerations of the chain's bodies that leave the cup's centre and angle where
-/// they are (the task's null space: the elbows fold, the cup stays), as a unit vector whose
-/// shoulder part follows the elbow's bend; zero where the arm is stretched straight.
+/// they are (the task's null space: the elbows fold, the cup stays), as a unit vector:
+/// (l1 l2 sin(a2 - a1), l0 l2 sin(a0 - a2), l0 l1 sin(a1 - a0), 0) over its norm, for the links'
+/// lengths l and absolute angles a; zero where the arm is stretched straight.
 std::array<double, 4> arm_posture_axis(const ArmConfig& arm, const std::array<double, 4>& angles);
 
 /// A cup velocity (m/s) and turn (rad/s).
