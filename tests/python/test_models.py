@@ -172,6 +172,7 @@ def test_a_torque_policy_reads_the_arms_links_beside_each_observation(target):
     model = dicestack.train("knn", "dart", demos=recordings, options=options, world=world,
                             features="state+links+clock+start_state@dice+retry/" + target, params={"k": 1})
     assert "train_error" not in model.training  # the recordings hold cup actions: nothing to score
+    assert model.predict(np.zeros((2, model.input_dim))).shape == (2, 4)  # torques, or the pose and the posture
     env = dicestack.DiceStackEnv(world=world, controller="joint_torque")
     obs, info = env.reset(seed=3)
     policy = model.policy()
