@@ -38,6 +38,8 @@ struct RecordOptions {
 
 // Episodes recorded (and held) at a time.
 constexpr int kRecordBatch = 256;
+// The paths the printed line names, best-ranked first (the set's provenance names them all).
+constexpr std::size_t kShownPaths = 3;
 
 // How the set was made, for its meta.json: the command's options and what they mean.
 std::string record_provenance(const RecordOptions& opt, const Perturbation& perturbation, const std::string& recordings) {
@@ -81,6 +83,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   if (opt.controller == "joint_torque") expert.controller = ActionKind::joint_torque;
   check_record_request(expert.controller, world, request);
   std::string recordings;  // for the provenance
+  std::string followed;    // the tracker's paths, best-ranked first
   if (opt.expert == "tracker") {
     if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
     const auto dir = resolve_demo_set(opt.demos, world);
@@ -89,7 +92,11 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
     expert.recordings = make_recordings(demos.episodes, world, opt.tracker.config_for(expert.controller), opt.seed,
                                         opt.threads, cluster);
     recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
-                 " (" + (demos.description.empty() ? "no description" : demos.description) + ")";
+                 " (" + (demos.description.empty() ? "no description" : demos.description) + "), ranked " +
+                 followed_recordings(*expert.recordings);
+    followed = followed_recordings(*expert.recordings, kShownPaths);
+    // Which path the expert plays decides what a student of the set learns: said before the wait.
+    if (cluster.is_root() && !opt.json) print_line("the tracker follows " + followed);
   } else if (!opt.demos.empty()) {
     throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
   } else if (opt.tracker.given()) {
@@ -144,7 +151,8 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
                               {"wall_contact_rate", walls / n},
                               {"seconds_per_episode", seconds / n},
                               {"seconds", seconds},
-                              {"out", opt.out.string()}}
+                              {"out", opt.out.string()},
+                              {"tracker_followed", followed}}
                    .dump());
     return 0;
   }

@@ -42,12 +42,16 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
 void check_rows_of(const Episode& e, const FeatureMap& features) {
   if (features.reads_links() && e.links.size() != e.states.size())
     throw InputError("episode \"" + e.name + "\": feature map \"" + features.name() +
-                     "\" reads the arm's links, and the episode has no readings of them");
+                     "\" reads the arm's links, and the episode has no readings of them (an episode recorded "
+                     "with record --embodiment arm has)");
   for (std::size_t t = 0; t < e.actions.size(); ++t)
     if (e.actions[t].kind() != features.action_kind())
       throw InputError("episode \"" + e.name + "\" step " + std::to_string(t) + ": feature map \"" + features.name() +
                        "\" answers " + std::string(action_kind_name(features.action_kind())) + " actions, the step's is for the " +
-                       std::string(action_kind_name(e.actions[t].kind())) + " controller");
+                       std::string(action_kind_name(e.actions[t].kind())) + " controller" +
+                       (features.action_kind() == ActionKind::joint_torque
+                            ? " (record --embodiment arm --controller joint_torque records torques)"
+                            : ""));
 }
 
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features, const RowFilter& rows = {}) {

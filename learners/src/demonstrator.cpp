@@ -126,9 +126,10 @@ std::vector<ParamSpec> tracker_param_specs() {
            "tracker: tracker_refine also moves the path's timing, each bump by at most this many seconds (0: not)", {}}};
 }
 
-std::string followed_recordings(const Recordings& recordings) {
+std::string followed_recordings(const Recordings& recordings, std::size_t most) {
   std::string out;
   for (const std::size_t p : recordings.order()) {
+    if (most-- == 0) return out + ", ...";
     // A path with trials was ranked by them (or, refined, validated); without, it was not ranked.
     const int trials = recordings.probe_trials()[p];
     out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;

@@ -207,9 +207,12 @@ void require_labellable(const TrainingPerturbation& p, const FeatureMap& feature
 void require_learnable_map(const std::string& learner, const Params& params, const FeatureMap& map) {
   if (!map.reads_links() && map.action_kind() == ActionKind::cup) return;
   const std::string what = "learner \"" + learner + "\" on feature map \"" + map.name() + "\"";
+  // bc fits the given episodes alone: a set recorded on the arm holds the links and the torques,
+  // and the dataset names any episode that does not.
+  if (learner == "bc") return;
   if (learner != "dart" && learner != "dagger")
-    throw ConfigError(what + ": a map of the arm's links or joint torques is learned by dart and dagger alone, whose "
-                             "experts run on the arm (the recordings hold no links, and the cup's actions)");
+    throw ConfigError(what + ": a map of the arm's links or joint torques is learned by bc (from episodes recorded on the "
+                             "arm), dart and dagger alone, whose experts run on the arm");
   if (params.boolean("include_demos")) throw ConfigError(what + ": include_demos adds recordings without the arm's links");
   if (params.choice("perturb") != "none")
     throw ConfigError(what + ": perturb= is not built for a policy of the arm's links yet; leave it at none");

@@ -866,7 +866,7 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
       {"evaluate --model " + model + arm + " --episodes 1 --demos " + kTinyDemos, "--demos scores a policy on recordings"},
       {"evaluate --model " + model + arm + " --episodes 1 --initial-push left", "an initial push is a cup velocity change"},
       {"robustness --model " + model + arm + " --factors action_noise", "without action_delay, action_noise and all"},
-      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "learned by dart and dagger alone"}};
+      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "record --embodiment arm"}};
   for (const auto& [args, message] : refused) {
     p = run(args);
     EXPECT_EQ(p.status, 1) << args;

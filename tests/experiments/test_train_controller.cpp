@@ -38,9 +38,9 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
   r.features = "state+clock/position";
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("answers cup actions, not the joint_torque controller's"));
   r = torque_request();
-  r.learner = "bc";
+  r.learner = "dad";
   r.learner_options = {};
-  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("learned by dart and dagger alone"));
+  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("dart and dagger alone"));
   r = torque_request();
   r.world.embodiment = Embodiment::cup;
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("--embodiment arm"));

@@ -20,6 +20,7 @@
 namespace dicestack {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 constexpr const char* kTorqueMap = "state+links+clock+start_state@dice+retry/torque";
@@ -84,6 +85,23 @@ TEST(TorquePolicy, DartLearnsAnOscMapWhoseRegressorAnswersAPoseAndActsInTorques)
   EXPECT_NE(e.links.front(), e.links.back()) << "the arm moved";
 }
 
+// Behaviour cloning in torques fits episodes recorded on the arm (their links and torques), and
+// names an episode of the floating cup, which has neither.
+TEST(TorquePolicy, BcFitsEpisodesRecordedOnTheArmAndNamesOneThatWasNot) {
+  LearnContext c = arm_context();
+  const LearnResult teacher = LearnerRegistry::global().create("dart", quick_dart())->learn(c);
+  DiceEnv env(c.world);
+  ModelPolicy policy(teacher.model);
+  const Episode on_arm = rollout(env, policy, random_start_state(c.world, 17), 17, StepSource::policy);
+  const auto bc = LearnerRegistry::global().create("bc", {});
+  EXPECT_THAT(test::error_of([&] { bc->learn(c); }),
+              AllOf(HasSubstr("\"" + c.demos.front().name + "\""), HasSubstr("record --embodiment arm")));
+  c.demos = {on_arm};
+  const LearnResult student = bc->learn(c);
+  EXPECT_EQ(student.model->features().action_kind(), ActionKind::joint_torque);
+  EXPECT_EQ(student.model->regressor().output_dim(), 4u);
+}
+
 // DAgger's rounds in torques: the student's own rollouts labelled by the tracker told in torques,
 // kept in its checkpoint (episodes whose actions are joint torques) and resumed from it.
 TEST(TorquePolicy, DaggerLearnsTheTrackersTorquesAndResumesFromItsCheckpoint) {
@@ -117,9 +135,9 @@ TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   EXPECT_THAT(refused("dart", quick_dart({"perturb=easy"})), HasSubstr("perturb= is not built for a policy of the arm's links"));
   EXPECT_THAT(refused("dagger", {"expert=tracker", "iterations=1", "rollouts=1"}), HasSubstr("include_demos adds recordings without"));
   EXPECT_THAT(test::error_of([] {
-                require_learnable_map("bc", LearnerRegistry::global().create("bc", {})->params(), feature_map(kTorqueMap));
+                require_learnable_map("dad", LearnerRegistry::global().create("dad", {})->params(), feature_map(kTorqueMap));
               }),
-              HasSubstr("learned by dart and dagger alone"));
+              HasSubstr("learned by bc (from episodes recorded on the arm), dart and dagger alone"));
   // Where torques cannot run, an evaluation refuses before any rollout.
   EvalRequest request;
   request.actions = ActionKind::joint_torque;

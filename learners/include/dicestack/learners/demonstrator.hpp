@@ -32,7 +32,8 @@ std::shared_ptr<const Recordings> make_recordings(const std::vector<Episode>& de
 /// The recordings the tracker follows, best-ranked first, each with its probe score:
 /// "episode_0039 (88 of 96 probe trials), ..." ("not ranked" with no probes). A learner's model
 /// records it as "tracker_followed": which recording a policy plays, and how robust it was.
-std::string followed_recordings(const Recordings& recordings);
+/// With `most`, only the first `most`, then ", ..." if there are more.
+std::string followed_recordings(const Recordings& recordings, std::size_t most = SIZE_MAX);
 
 /// True when the feature map `features` answers a cup pose to servo to ("/position", "/osc"): the
 /// tracker's labels are then one pose per step, and the learners follow one recording

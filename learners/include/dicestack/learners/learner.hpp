@@ -184,8 +184,9 @@ TrainingPerturbation learner_perturbation(const Params& params, const WorldConfi
 void require_labellable(const TrainingPerturbation& p, const FeatureMap& features, const std::string& learner,
                         bool own_choices = false);
 /// Throws ConfigError unless `learner` (with `params`) can learn a policy on `map` when the map
-/// reads the arm's links or answers joint torques: dart alone, whose expert runs on the arm
-/// (recordings hold neither links nor torques), without include_demos, in the nominal world.
+/// reads the arm's links or answers joint torques: bc, on episodes recorded on the arm (the
+/// dataset refuses any other by name), or dart and dagger, whose experts run on the arm (human
+/// recordings hold neither links nor torques), without include_demos, in the nominal world.
 void require_learnable_map(const std::string& learner, const Params& params, const FeatureMap& map);
 /// The same for a learner's options: nothing when `schema` has no "perturb" (a leaderboard's row,
 /// which also refuses a map of the arm's links or torques: its rows are scored on recordings).
