@@ -181,7 +181,7 @@ TrackerConfig learner_tracker_config(const Learner& learner, const std::string& 
   // instead of 285 s: twice the probes cost 30 s.
   if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_refine")) tracker.refine = 0;
   if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_probes"))
-    tracker.probes = std::max(tracker.probes, kTorqueTrackerProbes);
+    set_tracker_setting(tracker, "probes", std::to_string(std::max(tracker.probes, kTorqueTrackerProbes)));  // as the option would
   validate(tracker);
   return tracker;
 }

@@ -112,6 +112,8 @@ TEST(LearnerSpec, ATrackerInJointTorquesDoesNotRefineAndRanksFromMoreStarts) {
   const TrackerConfig by_default = learner_tracker_config(*LearnerRegistry::global().create("dart", {"expert=tracker"}), map);
   EXPECT_EQ(by_default.refine, 0);
   EXPECT_EQ(by_default.probes, 32);
+  const TrackerConfig as_option = learner_tracker_config(*LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_probes=32"}), map);
+  EXPECT_EQ(by_default.finalist_probes, as_option.finalist_probes) << "the default is the option's value, finalists and all";
   EXPECT_EQ(by_default.controller, ActionKind::joint_torque);
   const TrackerConfig given = learner_tracker_config(
       *LearnerRegistry::global().create("dart", {"expert=tracker", "tracker_probes=8", "tracker_refine=3"}), map);

@@ -25,6 +25,7 @@
 namespace dicestack {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 using test::inputs;
@@ -120,6 +121,27 @@ TEST(ModelFile, ATorquePolicyIsVersionThreeWithFourAnswersAndReadsBack) {
   // Without the fitted data's widths: 3 labels for a torque map.
   EXPECT_THAT(test::error_of([&] { Model::train(RegressorRegistry::global().create("linear_svr"), x, model_labels(x), 3, nullptr, f); }),
               HasSubstr("to 4 action values"));
+  fs::remove(path);
+}
+
+// An "/osc" map answered the pose alone at version 1 and answers the posture too at version 2:
+// a model of the older map is refused by name, not run with its answers misread.
+TEST(ModelFile, AnOscModelOfAnOlderMapVersionIsRefusedAndSaysToTrainAgain) {
+  const FeatureMap& f = feature_map("state+links+clock/osc");
+  ASSERT_EQ(f.version(), 2);
+  const Matrix x = random_rows(100, static_cast<Eigen::Index>(f.width()), 6);
+  Matrix y(x.rows(), 4);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) y.row(i) << x(i, 0), x(i, 1), x(i, 2), 0.5 * x(i, 25);
+  const fs::path path = temp_model("osc_v1");
+  save_model(Model::train(RegressorRegistry::global().create("linear_svr"), x, y, 3, nullptr, f), path);
+  EXPECT_NO_THROW(load_model(path));
+  auto [header, payload] = read_parts(path);
+  header["features_version"] = 1;
+  reseal(header, payload);
+  write_parts(path, header, payload);
+  EXPECT_THAT(test::error_of([&] { load_model(path); }),
+              AllOf(HasSubstr(path.string()), HasSubstr("\"state+links+clock/osc\" version 1 differs from this dicestack's (2)"),
+                    HasSubstr("train the model again")));
   fs::remove(path);
 }
 
