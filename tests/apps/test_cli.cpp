@@ -771,6 +771,9 @@ TEST(CliLearning, RecordInJointTorquesKeepsThemAsTheActionsAndNeedsTheArm) {
                               "--episodes 1 --out " + dir.string(), false);
   ASSERT_EQ(tracked.status, 0) << tracked.output;
   EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("refined only with --tracker refine=N"));
+  // Which path it plays is said before the episodes, and kept with the set.
+  EXPECT_THAT(tracked.output, HasSubstr("the tracker follows episode_"));
+  EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("), ranked episode_"));
   std::filesystem::remove_all(dir);
   Process bad = run("record --expert scripted --episodes 1 --controller joint_torque --out " + dir.string());
   EXPECT_EQ(bad.status, 1);
