@@ -68,6 +68,24 @@ std::string record_provenance(const RecordOptions& opt, const Perturbation& pert
                  : "");
 }
 
+// The tracker's recordings, ranked by simulations of what it will answer. Adds to `provenance`
+// the set they came from and their ranking, and says which paths lead before the episodes
+// (which path the expert plays decides what a student of the set learns).
+std::shared_ptr<const Recordings> tracker_recordings(const RecordOptions& opt, const WorldConfig& world,
+                                                     ActionKind controller, Cluster& cluster, std::string& provenance,
+                                                     std::string& followed) {
+  if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
+  const auto dir = resolve_demo_set(opt.demos, world);
+  const DemoSet demos = read_demo_set(dir);
+  auto recordings = make_recordings(demos.episodes, world, opt.tracker.config_for(controller), opt.seed, opt.threads, cluster);
+  provenance = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
+               " (" + (demos.description.empty() ? "no description" : demos.description) + "), ranked " +
+               followed_recordings(*recordings);
+  followed = followed_recordings(*recordings, kShownPaths);
+  if (cluster.is_root() && !opt.json) print_line("the tracker follows " + followed);
+  return recordings;
+}
+
 int run_record(const RecordOptions& opt, Cluster& cluster) {
   check_demo_set_replaceable(opt.out);  // refuse a user's folder before any work
   const WorldConfig world = opt.world.load();
@@ -85,18 +103,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   std::string recordings;  // for the provenance
   std::string followed;    // the tracker's paths, best-ranked first
   if (opt.expert == "tracker") {
-    if (opt.demos.empty()) throw ConfigError("record: --expert tracker follows recordings: give them with --demos DIR|builtin|human");
-    const auto dir = resolve_demo_set(opt.demos, world);
-    const DemoSet demos = read_demo_set(dir);
-    // Its simulations choose what stacks as it will answer.
-    expert.recordings = make_recordings(demos.episodes, world, opt.tracker.config_for(expert.controller), opt.seed,
-                                        opt.threads, cluster);
-    recordings = "; recordings followed: the " + std::to_string(demos.episodes.size()) + " episodes of " + dir.string() +
-                 " (" + (demos.description.empty() ? "no description" : demos.description) + "), ranked " +
-                 followed_recordings(*expert.recordings);
-    followed = followed_recordings(*expert.recordings, kShownPaths);
-    // Which path the expert plays decides what a student of the set learns: said before the wait.
-    if (cluster.is_root() && !opt.json) print_line("the tracker follows " + followed);
+    expert.recordings = tracker_recordings(opt, world, expert.controller, cluster, recordings, followed);
   } else if (!opt.demos.empty()) {
     throw ConfigError("record: --demos gives the recordings of --expert tracker; expert " + opt.expert + " reads none");
   } else if (opt.tracker.given()) {
@@ -152,7 +159,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
                               {"seconds_per_episode", seconds / n},
                               {"seconds", seconds},
                               {"out", opt.out.string()},
-                              {"tracker_followed", followed}}
+                              {"tracker_followed", followed.empty() ? nlohmann::json(nullptr) : nlohmann::json(followed)}}
                    .dump());
     return 0;
   }

@@ -42,8 +42,8 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
 void check_rows_of(const Episode& e, const FeatureMap& features) {
   if (features.reads_links() && e.links.size() != e.states.size())
     throw InputError("episode \"" + e.name + "\": feature map \"" + features.name() +
-                     "\" reads the arm's links, and the episode has no readings of them (an episode recorded "
-                     "with record --embodiment arm has)");
+                     "\" reads the arm's links, and the episode has no readings of them (record --embodiment arm "
+                     "--controller joint_torque records them and the torques)");
   for (std::size_t t = 0; t < e.actions.size(); ++t)
     if (e.actions[t].kind() != features.action_kind())
       throw InputError("episode \"" + e.name + "\" step " + std::to_string(t) + ": feature map \"" + features.name() +

@@ -211,8 +211,9 @@ void require_learnable_map(const std::string& learner, const Params& params, con
   // and the dataset names any episode that does not.
   if (learner == "bc") return;
   if (learner != "dart" && learner != "dagger")
-    throw ConfigError(what + ": a map of the arm's links or joint torques is learned by bc (from episodes recorded on the "
-                             "arm), dart and dagger alone, whose experts run on the arm");
+    throw ConfigError(what + ": a map of the arm's links or joint torques is learned by bc from episodes recorded on the "
+                             "arm, or by dart and dagger, whose experts run on the arm (human recordings hold no links, and "
+                             "the cup's actions)");
   if (params.boolean("include_demos")) throw ConfigError(what + ": include_demos adds recordings without the arm's links");
   if (params.choice("perturb") != "none")
     throw ConfigError(what + ": perturb= is not built for a policy of the arm's links yet; leave it at none");
