@@ -129,7 +129,7 @@ std::vector<ParamSpec> tracker_param_specs() {
 std::string followed_recordings(const Recordings& recordings, std::size_t most) {
   std::string out;
   for (const std::size_t p : recordings.order()) {
-    if (most-- == 0) return out + ", ...";
+    if (most-- == 0) return out.empty() ? "..." : out + ", ...";
     // A path with trials was ranked by them (or, refined, validated); without, it was not ranked.
     const int trials = recordings.probe_trials()[p];
     out += (out.empty() ? "" : ", ") + recordings.paths()[p].name;

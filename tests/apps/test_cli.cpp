@@ -763,6 +763,12 @@ TEST(CliLearning, RecordInJointTorquesKeepsThemAsTheActionsAndNeedsTheArm) {
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(file_text(dir / "episode_0000.csv"), HasSubstr(",joint0_action,"));
   EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("--controller joint_torque"));
+  // Behaviour cloning learns a policy in joint torques from such a set, which holds the links.
+  const auto model = (dir / "bc.dsm").string();
+  const Process bc = run("train --learner bc --regressor knn --demos " + dir.string() + " --embodiment arm --controller "
+                         "joint_torque --features state+links+clock/osc --split none --out " + model, false);
+  ASSERT_EQ(bc.status, 0) << bc.output;
+  EXPECT_TRUE(std::filesystem::exists(model));
   std::filesystem::remove_all(dir);
   // The tracker in torques skips the distill preset's refinements (about 40 min in held torques)
   // unless refine= is given: this recording would not finish within the test's time otherwise.
