@@ -22,13 +22,14 @@ struct LeaderboardOptions {
   WorldOption world;
   DemosOption demos;
   LeaderboardRequest request;
+  std::string controller = "cup";
   std::vector<int> recordings;  // --recordings: a learning curve instead of the table
   int draws = 3;
 };
 
 // `--recordings 1,3,10`: realistic success against the number of recordings (learning_curve.hpp).
 int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
-  for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb", "--estimator"})
+  for (const char* unused : {"--baselines", "--features", "--seeds", "--profile", "--split", "--perturb", "--estimator", "--controller"})
     if (cmd.count(unused) > 0) throw ConfigError(std::string("leaderboard --recordings draws a learning curve; ") + unused + " is for the table");
   const LeaderboardRequest& t = opt.request;
   const auto formats = learning_curve_formats();
@@ -57,6 +58,7 @@ int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
 
 int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
   LeaderboardRequest request = opt.request;
+  request.controller = opt.controller == "joint_torque" ? ActionKind::joint_torque : ActionKind::cup;
   request.world = opt.world.load();
   request.demos = opt.demos.resolve(request.world, cluster);
   request.cluster = &cluster;
@@ -140,6 +142,12 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
                   "training stays nominal")
       ->capture_default_str();
   add_estimator_option(*cmd, r.estimator);
+  cmd->add_option("--controller", opt->controller,
+                  "What the rows' policies answer: cup (the cup's velocity changes) or joint_torque (the arm's four torques, "
+                  "with --embodiment arm: each learner's map in torques; dart and dagger learn them from their experts, bc "
+                  "from a set recorded on the arm; docs/arm.md)")
+      ->check(CLI::IsMember({"cup", "joint_torque"}))
+      ->capture_default_str();
   cmd->add_option("--recordings", opt->recordings,
                   "Instead of the table, a learning curve: realistic success against the number of recordings each "
                   "policy learns from (comma-separated numbers, e.g. 1,3,10,68; default learners dart:expert=tracker "

@@ -1,7 +1,6 @@
 // `dicestack robustness`: a model's or an expert's realistic success in perturbed worlds, factor
 // by factor and level by level (docs/robustness.md). The work is the library's
 // (learners/robustness.hpp): this parses, calls it and prints.
-#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -32,14 +31,10 @@ struct RobustnessOptions {
   TrackerOption tracker;
 };
 
-// Joint torques run on the arm, without the factors drawn in the cup's units or an estimator
-// (its worlds hold no arm links). `what` names who answers in them.
+// Joint torques run on the arm, without an estimator (its worlds hold no arm links). `what`
+// names who answers in them.
 void check_torque_run(const std::string& what, const RobustnessOptions& opt, const WorldConfig& world) {
   if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
-  const auto names = [&](const char* factor) { return std::find(opt.factors.begin(), opt.factors.end(), factor) != opt.factors.end(); };
-  if (opt.factors.empty() || names("all") || names("action_noise") || names("action_delay"))
-    throw ConfigError(what + ": an action delay, action noise and bias are drawn for the cup's actions; name the factors "
-                           "without action_delay, action_noise and all (--factors none, friction, ...)");
   if (!opt.estimator.empty() && opt.estimator != "none")
     throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; leave --estimator out");
 }
@@ -96,6 +91,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     if (model->features().action_kind() == ActionKind::joint_torque)
       check_torque_run("robustness: " + opt.model.string() + " (a policy in joint torques)", opt, world);
     run.estimator = estimator_for(opt.estimator, *model);
+    request.actions = model->features().action_kind();
     factory = [model] { return std::make_unique<ModelPolicy>(model); };
     run.policy = "model " + opt.model.string() + " (" + model->regressor().name() + ", " + model->features().name() + ")";
     run.record = model->record;
@@ -115,6 +111,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
                  opt.tracker.as_arguments() + (opt.controller == "cup" ? "" : ", in joint torques") +
                  (sensed ? ", feedback on the observations" : "");
     request.reads_world = !sensed;
+    request.actions = config.controller;
   }
   request.estimator = estimator_config(run.estimator);
   run.reads_world = request.reads_world;

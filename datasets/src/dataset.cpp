@@ -34,7 +34,7 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
   if (features.ahead() && delayed && std::find(e.sources.begin(), e.sources.end(), StepSource::policy) != e.sources.end())
     throw InputError("episode \"" + e.name + "\" ran under a delay with steps a learner chose, whose choices are not "
                      "recorded (only the expert's labels): an \"/ahead\" map cannot rebuild what was pending or unseen");
-  return PerturbedChannel(d);
+  return PerturbedChannel(d, features.action_kind());
 }
 
 // Throws InputError naming the episode if `features` cannot make its rows: a map of the arm's

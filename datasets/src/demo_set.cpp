@@ -31,6 +31,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+// An arm's perturbation drawn in joint torques (draw_to_json): the keys version 5 adds.
+constexpr const char* kTorqueBiasKey = "joint_torque_bias";
+constexpr const char* kTorqueNoiseKey = "joint_torque_noise_std";
+
 std::string episode_file_name(std::size_t index) {
   std::string digits = std::to_string(index);
   if (digits.size() < 4) digits.insert(0, 4 - digits.size(), '0');
@@ -74,8 +78,12 @@ void check_links_world(const Episode& e, const WorldConfig& world, const std::st
 json meta_with_entries(const DemoSet& set, json episodes) {
   const bool perturbed = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("perturbation"); });
   const bool arm = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("final_links"); });
-  // Version 3 only adds the perturbation, version 4 an arm's readings: a set without either is
-  // written as the version before them.
+  const bool torque_draws = std::any_of(episodes.begin(), episodes.end(), [](const json& e) {
+    return e.contains("perturbation") && e["perturbation"].contains(kTorqueBiasKey);
+  });
+  // Version 3 only adds the perturbation, version 4 an arm's readings, version 5 an arm's
+  // perturbation drawn in joint torques too: a set without them is written as the version
+  // before them.
   json units{{"length", "m"},
              {"angle", "rad"},
              {"time", "s"},
@@ -90,7 +98,7 @@ json meta_with_entries(const DemoSet& set, json episodes) {
     units["final_links"] = "the links after the last action (null: unknown)";
   }
   return {{"format", kDemoFormat},
-          {"version", arm ? kDemoFormatVersion : perturbed ? 3 : 2},
+          {"version", torque_draws ? 5 : arm ? 4 : perturbed ? 3 : 2},
           {"dicestack_version", DICESTACK_VERSION},
           {"description", set.description},
           {"provenance", set.provenance},
@@ -310,6 +318,9 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
     if (version >= 3 && entry.contains("perturbation")) {
       if (!entry["perturbation"].is_object())
         meta_error(meta_path, "\"perturbation\" of " + e.file + " must be an object (the values its world drew)");
+      if (version < 5 && (entry["perturbation"].contains(kTorqueBiasKey) || entry["perturbation"].contains(kTorqueNoiseKey)))
+        meta_error(meta_path, "\"perturbation\" of " + e.file + " has the joint torques' bias or noise, which format version " +
+                                  std::to_string(version) + " does not have (version 5 added them)");
       e.perturbation = entry["perturbation"].dump();
     }
     if (version >= 4 && entry.contains("final_links")) final_links_from(entry["final_links"], meta_path, e);

@@ -124,36 +124,6 @@ LeaderboardRow row_from(const json& j) {
 
 }  // namespace
 
-double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
-                          const Profile& profile, int rollouts) {
-  // Seconds on one core, from the measured quick and paper leaderboards (docs/learners.md,
-  // docs/notebook/2026-11-27-learners-page-history.md "The paper profile", docs/scaling.md).
-  // Only the ratios matter: they decide which rank gets which row. A profile
-  // other than "paper" is costed as quick.
-  const bool paper = profile.name == "paper";
-  if (learner == "baseline") {
-    const BaselineInfo& b = baseline(regressor);
-    const double budget = static_cast<double>(b.budget(profile)) / b.budget(leaderboard_profile("quick"));
-    return budget * b.quick_seconds + rollouts * 0.01;
-  }
-  auto pick = [](const std::map<std::string, double>& table, const std::string& key, double otherwise) {
-    const auto it = table.find(key);
-    return it == table.end() ? otherwise : it->second;
-  };
-  // One fit on the demonstrations (80 episodes, ~20,000 rows), and the time per policy step.
-  const double fit = pick({{"gbt", 10.0}, {"rbf_svr", 10.0}, {"mlp", 1.0}, {"random_forest", 0.2}, {"knn", 0.01}, {"linear_svr", 0.02}}, regressor, 2.0);
-  double step_us = pick({{"knn", 60.0}, {"rbf_svr", 80.0}, {"gbt", 10.0}}, regressor, 2.0);
-  if (features != "state" && features != "-") step_us *= regressor == "knn" ? 10.0 : 1.5;
-  // What a learner adds: its data relative to the demonstrations (fits grow with it, a kernel
-  // SVR's with its square), its fits, and its own simulation (expert rollouts, corrections).
-  const double rows = pick({{"bc", 1.0}, {"dagger", paper ? 3.0 : 1.5}, {"dart", 3.0}, {"dad", 1.5}}, learner, 2.0);
-  const double fits = pick({{"bc", 1.0}, {"dagger", paper ? 6.0 : 3.0}, {"dart", 1.0}, {"dad", paper ? 31.0 : 3.0}}, learner, 3.0);
-  const double own = pick({{"bc", 0.0}, {"dagger", paper ? 80.0 : 4.0}, {"dart", 2.0}, {"dad", paper ? 400.0 : 20.0}}, learner, 10.0);
-  const double fit_cost = fits * fit * (regressor == "rbf_svr" ? rows * rows : rows);
-  const double rollout_steps = (rollouts + (learner == "dagger" || learner == "dad" ? fits * 16 : 0)) * 300.0;
-  return fit_cost + own + rollout_steps * (step_us + 25.0) * 1e-6;
-}
-
 
 namespace {
 
@@ -260,13 +230,18 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
   std::vector<std::pair<std::string, std::string>> combos;
   for (const auto& l : plan.learners) {
     const LearnerInfo& info = LearnerRegistry::global().info(plan.base(l));
-    // The paper profile's full picture: every learner with the bare state and with dart's map too.
-    const std::string own = default_features(plan.base(l), plan.options_for(l));
+    // The paper profile's full picture: every learner with the bare state and with dart's map too
+    // (cup maps: in torques, each learner's own).
+    const bool torques = opt.controller == ActionKind::joint_torque;
+    const std::string cup_map = default_features(plan.base(l), plan.options_for(l));
+    const std::string own = torques ? torque_map_name(cup_map) : cup_map;
     std::vector<std::string> maps{own};
-    if (plan.profile->every_feature_map && own != "state") maps.insert(maps.begin(), "state");
-    if (plan.profile->every_feature_map && own == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
+    if (plan.profile->every_feature_map && !torques && own != "state") maps.insert(maps.begin(), "state");
+    if (plan.profile->every_feature_map && !torques && own == "state") maps.push_back(LearnerRegistry::global().info("dart").default_features);
     for (const auto& f : opt.features.empty() ? maps : opt.features) {
-      feature_map(f);  // unknown names fail before any work
+      if ((feature_map(f).action_kind() == ActionKind::joint_torque) != torques)  // unknown names fail here too
+        throw ConfigError("feature map \"" + f + "\" answers " + std::string(action_kind_name(feature_map(f).action_kind())) +
+                          " actions, not the --controller " + std::string(action_kind_name(opt.controller)) + " ones");
       if (info.own_features_only && f != own) {
         if (!opt.features.empty()) say("note: " + l + " reads only its own map (" + own + ") here; skipping features " + f, 0.0);
         continue;
@@ -281,6 +256,19 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
   return combos;
 }
 
+// A bc row in joint torques fits the set's own actions: they must be torques, with the links
+// they were read with (dart and dagger take theirs from their experts).
+void require_torque_episodes(const RunPlan& plan) {
+  for (const auto& [learner, features] : plan.combos) {
+    if (plan.base(learner) != "bc" || feature_map(features).action_kind() != ActionKind::joint_torque) continue;
+    for (const Episode& e : plan.set.episodes)
+      if (e.links.size() != e.states.size() || (!e.actions.empty() && e.actions.front().kind() != ActionKind::joint_torque))
+        throw ConfigError("leaderboard: " + learner + " fits the joint torques of the episodes it is given, and episode \"" +
+                          e.name + "\" of " + plan.request.demos.string() + " holds the cup's actions (record --embodiment "
+                          "arm --controller joint_torque records torques); or leave it out (--learners dart,dagger)");
+  }
+}
+
 // The header line and the settings (meta) every format carries; a progress file is reused only
 // with the same meta.
 void describe_run(RunPlan& plan, const DemoSplit& split) {
@@ -291,7 +279,8 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << opt.demos.string() << " ("
          << plan.set.episodes.size() << " episodes, " << frames << " frames); split " << split.matrices().description
          << "; profile " << opt.profile << "; " << plan.episodes << " rollouts per training seed from " << start_distribution_name(opt.world) << " starts (seed "
-         << opt.seed << "), " << opt.seeds << " training seed(s); rates with 95% Wilson intervals";
+         << opt.seed << "), " << opt.seeds << " training seed(s); rates with 95% Wilson intervals"
+         << (opt.controller == ActionKind::joint_torque ? "; actions in joint torques" : "");
   json learner_options = json::object(), row_features = json::array();
   for (const auto& l : plan.learners) learner_options[l] = plan.options_for(l);
   for (const auto& [l, f] : plan.combos) row_features.push_back(l + " " + f);
@@ -317,6 +306,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
   if (!opt.estimator.empty() && opt.estimator != "none" && senses(plan.perturbation)) plan.meta["estimator"] = opt.estimator;
   if (start_distribution_name(opt.world) != "random") plan.meta["start"] = start_distribution_name(opt.world);
+  if (opt.controller != ActionKind::cup) plan.meta["controller"] = action_kind_name(opt.controller);
 }
 
 // Resume: the rows of <out>.partial.json measured with the same settings, read by the root
@@ -526,10 +516,12 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     rollouts.episodes = plan.episodes;
     rollouts.threads = opt.threads;
     rollouts.perturbation = plan.perturbation;
+    rollouts.actions = opt.controller;
     check_evaluation(opt.world, rollouts);
   }
   plan.combos = row_combos(plan, say);  // a row that cannot train is refused before the demonstrations are read
   plan.set = read_demo_set(opt.demos);
+  require_torque_episodes(plan);
   for (const auto& [learner, features] : plan.combos) check_map_world(feature_map(features), opt.world);
   // The table keeps every row's rollouts of every seed (the pages' per-episode results).
   const double rollouts = static_cast<double>(plan.combos.size()) * opt.seeds * plan.episodes;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include <dicestack/core/error.hpp>
@@ -148,10 +149,16 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   const LearnResult learned =
       LearnerRegistry::global().create(parse_learner_spec(learner).name, s_.learner_options(learner))->learn(c);
   r.fit_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const Score errors = score(*learned.model, *s_.split);
-  r.train_error = errors.train_error;
-  r.has_test = errors.test_error.has_value();
-  r.test_error = errors.test_error.value_or(0.0);
+  // A map of the arm's links or torques has no error on recordings of the cup (as `train`).
+  const FeatureMap& map = learned.model->features();
+  if (!map.reads_links() && map.action_kind() == ActionKind::cup) {
+    const Score errors = score(*learned.model, *s_.split);
+    r.train_error = errors.train_error;
+    r.has_test = errors.test_error.has_value();
+    r.test_error = errors.test_error.value_or(0.0);
+  } else {
+    r.train_error = -1;  // printed "-"
+  }
   const std::string rollouts_text = row_text + ": " + std::to_string(s_.episodes) + " rollouts";
   report_(rollouts_text, at(0.5), true);
   std::shared_ptr<const Model> model = learned.model;
@@ -161,6 +168,7 @@ SeedResult RowRunner::learner_seed(const std::string& learner, const std::string
   request.threads = s_.threads;
   request.perturbation = s_.perturbation;
   request.estimator = estimator_config(estimator_for(s_.estimator, *model));
+  request.actions = model->features().action_kind();
   request.progress = [&](int finished, int of) { report_(rollouts_text, at(0.5 + 0.5 * finished / of), false); };
   std::vector<Episode> episodes;
   keep_rollouts(request, s_.previews, r.results, episodes);
@@ -213,6 +221,36 @@ LeaderboardRow RowRunner::combine(const std::string& learner, const std::string&
     add_outcomes(row, r.stats, s_.seeds);
   }
   return row;
+}
+
+double estimated_row_cost(const std::string& learner, const std::string& regressor, const std::string& features,
+                          const Profile& profile, int rollouts) {
+  // Seconds on one core, from the measured quick and paper leaderboards (docs/learners.md,
+  // docs/notebook/2026-11-27-learners-page-history.md "The paper profile", docs/scaling.md).
+  // Only the ratios matter: they decide which rank gets which row. A profile
+  // other than "paper" is costed as quick.
+  const bool paper = profile.name == "paper";
+  if (learner == "baseline") {
+    const BaselineInfo& b = baseline(regressor);
+    const double budget = static_cast<double>(b.budget(profile)) / b.budget(leaderboard_profile("quick"));
+    return budget * b.quick_seconds + rollouts * 0.01;
+  }
+  auto pick = [](const std::map<std::string, double>& table, const std::string& key, double otherwise) {
+    const auto it = table.find(key);
+    return it == table.end() ? otherwise : it->second;
+  };
+  // One fit on the demonstrations (80 episodes, ~20,000 rows), and the time per policy step.
+  const double fit = pick({{"gbt", 10.0}, {"rbf_svr", 10.0}, {"mlp", 1.0}, {"random_forest", 0.2}, {"knn", 0.01}, {"linear_svr", 0.02}}, regressor, 2.0);
+  double step_us = pick({{"knn", 60.0}, {"rbf_svr", 80.0}, {"gbt", 10.0}}, regressor, 2.0);
+  if (features != "state" && features != "-") step_us *= regressor == "knn" ? 10.0 : 1.5;
+  // What a learner adds: its data relative to the demonstrations (fits grow with it, a kernel
+  // SVR's with its square), its fits, and its own simulation (expert rollouts, corrections).
+  const double rows = pick({{"bc", 1.0}, {"dagger", paper ? 3.0 : 1.5}, {"dart", 3.0}, {"dad", 1.5}}, learner, 2.0);
+  const double fits = pick({{"bc", 1.0}, {"dagger", paper ? 6.0 : 3.0}, {"dart", 1.0}, {"dad", paper ? 31.0 : 3.0}}, learner, 3.0);
+  const double own = pick({{"bc", 0.0}, {"dagger", paper ? 80.0 : 4.0}, {"dart", 2.0}, {"dad", paper ? 400.0 : 20.0}}, learner, 10.0);
+  const double fit_cost = fits * fit * (regressor == "rbf_svr" ? rows * rows : rows);
+  const double rollout_steps = (rollouts + (learner == "dagger" || learner == "dad" ? fits * 16 : 0)) * 300.0;
+  return fit_cost + own + rollout_steps * (step_us + 25.0) * 1e-6;
 }
 
 }  // namespace dicestack

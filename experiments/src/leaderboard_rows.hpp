@@ -1,7 +1,8 @@
 #pragma once
 // One leaderboard job, apart from the dealing and the table: a learner row trained and rolled
 // out for one training seed, or a baseline built and rolled out; how a row adds its seeds up;
-// and the bytes jobs travel in between ranks.
+// and the bytes jobs travel in between ranks. (Each job's estimated cost is declared in
+// leaderboard.hpp.)
 #include <cstdint>
 #include <functional>
 #include <string>

@@ -73,6 +73,7 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
     row.episodes = request.episodes;
     row.threads = request.threads;
     row.perturbation = perturbation(f, level);
+    row.actions = request.actions;
     check_evaluation(world, row);
   }
   std::vector<RobustnessRow> rows;
@@ -85,6 +86,7 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
     r.threads = request.threads;
     r.perturbation = perturbation(f, level);
     r.estimator = request.estimator;
+    r.actions = request.actions;
     rows.push_back({f, level, evaluate(make_policy, world, r, cluster)});
   }
   return rows;

@@ -159,7 +159,7 @@ class Dagger final : public Learner {
   // the learner ("policy").
   static Episode mixture_rollout(DiceEnv& pooled, Expert& expert, const Model* model, double beta, std::uint64_t seed,
                                  const Perturbation& perturbation) {
-    PerturbedEnv episode(pooled, perturbation, seed);
+    PerturbedEnv episode(pooled, perturbation, seed, expert.controller());
     MixturePolicy mixture(expert, episode.env(), model, beta);
     Episode e = rollout(episode, mixture, episode.random_start(seed), seed, StepSource::policy);
     e.origin = "dagger";

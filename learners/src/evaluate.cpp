@@ -191,8 +191,6 @@ void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   if (request.actions == ActionKind::joint_torque) {
     const std::string what = "evaluate: a policy in joint torques";
     if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
-    if (!takes_joint_torques(request.perturbation))
-      throw ConfigError(what + ": the perturbation's action delay, action noise and bias are drawn for the cup's actions");
     if (request.estimator.kind != EstimatorKind::none)
       throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; use --estimator none");
     if (request.push != InitialPush::none) throw ConfigError(what + ": an initial push is a cup velocity change");
@@ -226,7 +224,7 @@ EvalStats evaluate(const PolicyFactory& make_policy, const WorldConfig& world, c
         Timed t;
         TimedPolicy timed(*policies[slot], t.policy_seconds);
         const std::uint64_t episode_seed = evaluation_start_seed(request.seed, i);
-        PerturbedEnv episode(envs.at(w), request.perturbation, episode_seed);
+        PerturbedEnv episode(envs.at(w), request.perturbation, episode_seed, request.actions);
         episode.use_estimator(request.estimator);
         RolloutOptions episode_options = options;
         const State start = episode.random_start(episode_seed);

@@ -221,9 +221,7 @@ void require_learnable_map(const std::string& learner, const Params& params, con
 
 void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
                         const FeatureMap& features, const std::string& learner) {
-  if (features.reads_links() || features.action_kind() != ActionKind::cup)
-    throw ConfigError("leaderboard: feature map \"" + features.name() + "\" is for the arm's links or joint torques, and "
-                      "the rows are scored on recordings of the cup; train such a policy with `dicestack train`");
+  if (features.reads_links() || features.action_kind() != ActionKind::cup) return require_learnable_map(learner, params, features);
   if (std::none_of(schema.begin(), schema.end(), [](const ParamSpec& s) { return s.name == "perturb"; })) return;
   require_labellable(learner_perturbation(params, world, learner), features, learner, learner == "dagger");
 }

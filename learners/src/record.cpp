@@ -58,9 +58,6 @@ void check_record_request(ActionKind controller, const WorldConfig& world, const
   if (controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
     throw ConfigError("record: an expert answering joint torques drives an arm's joints; this world's cup floats (give "
                       "--embodiment arm)");
-  if (controller == ActionKind::joint_torque && !takes_joint_torques(request.perturbation))
-    throw ConfigError("record: an expert answering joint torques runs without an action delay, action noise or bias "
-                      "(they are drawn for the cup's actions)");
   if (request.estimator.kind == EstimatorKind::none) return;
   if (request.feedback != ExpertFeedback::observations)
     throw ConfigError("record: an estimator stands between the sensors and the expert's feedback, which reads the world; "
@@ -92,7 +89,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
         auto& expert = experts[static_cast<std::size_t>(w)];
         if (!expert) expert = make_expert(name, config);
         const std::uint64_t s = training_start_seed(request.seed, request.first + i);
-        PerturbedEnv episode(envs.at(w), request.perturbation, s);
+        PerturbedEnv episode(envs.at(w), request.perturbation, s, config.controller);
         episode.add_executed_noise(noise, derive_seed(s, 2));
         episode.use_estimator(request.estimator);
         ExpertPolicy policy(*expert, episode.env(), request.feedback);

@@ -174,7 +174,8 @@ def _names(values, what):
 
 def leaderboard(regressors=None, learners=None, demos="builtin", *, features=None, options=None, baselines=None,
                 profile="quick", split="episodes", episodes=None, seeds=1, seed=0, world=None, start="random",
-                threads=None, out=None, format=None, perturb=None, estimator=None, progress=None):
+                threads=None, out=None, format=None, perturb=None, estimator=None, embodiment=None, controller="cup",
+                progress=None):
     """The paper's Table I, as `dicestack leaderboard` makes it: every regressor under every
     learner (and feature map), rolled out from random starts. Returns the rows as a list of dicts
     with the keys of `dicestack leaderboard --format json`'s rows (regressor, learner, features,
@@ -192,7 +193,8 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     perturbed worlds, as `leaderboard --perturb` (a level or a perturbation file; training stays
     nominal; docs/robustness.md); estimator: what the rolled-out policies are shown under sensing
     factors and delays, as `leaderboard --estimator` ("none", "kalman" or "particle"; None: each model's
-    own).
+    own). embodiment: "cup" or "arm" (None: the world's); controller: "cup" or "joint_torque", what
+    the rows' policies answer, as `leaderboard --controller` (joint torques need the arm; docs/arm.md).
 
     out: also write the table there, in `format` (md, csv, latex, json or html; None: from the
     file's suffix, .md .csv .tex .json .html, else md; html is a results page with its media in
@@ -210,8 +212,10 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
     for name, value in (("episodes", episodes), ("seeds", seeds)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
             raise ValueError(f"{name} must be a positive int, got {value!r}")
+    if not isinstance(controller, str):
+        raise TypeError(f"controller must be a name (cup, joint_torque), got {type(controller).__name__}")
     table = _dicestack.leaderboard(
-        resolve_world(world, start),
+        resolve_world(world, start, embodiment),
         os.fspath(demos),
         _names(regressors, "regressors"),
         _names(learners, "learners"),
@@ -229,5 +233,6 @@ def leaderboard(regressors=None, learners=None, demos="builtin", *, features=Non
         progress_bar(progress),
         "none" if perturb is None else os.fspath(perturb),
         _estimator_name(estimator),
+        controller,
     )
     return json.loads(table)["rows"]

@@ -61,6 +61,12 @@ py::array_t<double> to_array(const Matrix& m) {
   return out;
 }
 
+ActionKind controller_from(const std::string& name) {
+  for (ActionKind kind : {ActionKind::cup, ActionKind::joint_torque})
+    if (name == action_kind_name(kind)) return kind;
+  throw py::value_error("controller must be \"cup\" or \"joint_torque\", got \"" + name.substr(0, 40) + "\"");
+}
+
 py::array_t<double> actions_to_array(const std::vector<Action>& actions, ActionKind kind) {
   const std::size_t width = action_dim(kind);
   py::array_t<double> out({static_cast<py::ssize_t>(actions.size()), static_cast<py::ssize_t>(width)});

@@ -43,6 +43,8 @@ py::array_t<double> rows_to_array(const std::vector<std::array<double, N>>& rows
   for (const auto& r : rows) p = std::copy(r.begin(), r.end(), p);
   return out;
 }
+/// "cup" or "joint_torque"; ValueError otherwise.
+ActionKind controller_from(const std::string& name);
 /// Actions of one kind as an (N, action_dim(kind)) array.
 py::array_t<double> actions_to_array(const std::vector<Action>& actions, ActionKind kind = ActionKind::cup);
 /// An (N, action_dim(kind)) array as actions of `kind` (N may be 0); ValueError for another shape.

@@ -71,13 +71,6 @@ py::tuple bounds(const Box<N>& box) {
   return py::make_tuple(to_array(box.low), to_array(box.high));
 }
 
-// "cup" or "joint_torque"; ValueError otherwise.
-ActionKind controller_from(const std::string& name) {
-  for (ActionKind kind : {ActionKind::cup, ActionKind::joint_torque})
-    if (name == action_kind_name(kind)) return kind;
-  throw py::value_error("controller must be \"cup\" or \"joint_torque\", got \"" + name.substr(0, 40) + "\"");
-}
-
 py::tuple action_bounds(const EnvCore& core) {
   return core.controller() == ActionKind::cup ? bounds(core.env().action_space()) : bounds(core.env().torque_space());
 }

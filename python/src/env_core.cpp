@@ -38,21 +38,13 @@ EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation, con
   validate(perturbation, world);
   if (controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
     throw ConfigError("controller \"joint_torque\" drives an arm's joints: it needs embodiment \"arm\"");
-  check_controller(perturbation);
   if (controller == ActionKind::joint_torque && estimator.kind != EstimatorKind::none)
     throw ConfigError("an estimator rebuilds worlds from the 24 observed numbers, which do not hold the arm's links; the "
                       "joint_torque controller runs without one");
 }
 
-void EnvCore::check_controller(const Perturbation& perturbation) const {
-  if (controller_ == ActionKind::joint_torque && !takes_joint_torques(perturbation))
-    throw ConfigError("an action delay, action noise and bias are drawn for the cup's actions; the joint_torque controller "
-                      "cannot take them");
-}
-
 void EnvCore::begin(const Perturbation* perturbation) {
-  if (perturbation) check_controller(*perturbation);
-  episode_ = std::make_unique<PerturbedEnv>(*nominal_, perturbation ? *perturbation : perturbation_, episode_seed_);
+  episode_ = std::make_unique<PerturbedEnv>(*nominal_, perturbation ? *perturbation : perturbation_, episode_seed_, controller_);
   episode_->use_estimator(estimator_);
   world_hash_ = episode_->draw().physics ? dicestack::world_hash(episode_->draw().world) : nominal_hash_;
 }

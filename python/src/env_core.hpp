@@ -40,13 +40,11 @@ class EnvCore {
  public:
   /// `estimator`: what the policy is shown under sensing factors (estimator.hpp); `controller`:
   /// what an action is (the cup's velocity change, or an arm's joint torques). Throws
-  /// ConfigError for joint torques without the arm, under an action delay, action noise or
-  /// bias (drawn for the cup's actions), or behind an estimator (its worlds hold no arm links).
+  /// ConfigError for joint torques without the arm, or behind an estimator (its worlds hold no
+  /// arm links).
   explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {}, const EstimatorConfig& estimator = {},
                    ActionKind controller = ActionKind::cup);
   ActionKind controller() const { return controller_; }
-  /// Throws ConfigError if the controller cannot run under `perturbation` (takes_joint_torques).
-  void check_controller(const Perturbation& perturbation) const;
 
   /// Starts an episode from random_start_state(world, seed), `seed` per EpisodeSeeds, under
   /// `perturbation` if given (this episode only), else the environment's own.

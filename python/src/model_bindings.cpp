@@ -249,9 +249,11 @@ std::string leaderboard(const WorldConfig& world, const std::string& demos, cons
                         const std::vector<std::string>& baselines, const std::vector<std::string>& features,
                         const std::string& profile, const std::string& split, int episodes, int seeds,
                         const py::handle& seed, const py::handle& threads, const std::string& out,
-                        const std::string& format, py::object bar, const std::string& perturb, const std::string& estimator) {
+                        const std::string& format, py::object bar, const std::string& perturb, const std::string& estimator,
+                        const std::string& controller) {
   if (!estimator.empty()) estimator_config(estimator);  // a bad name is refused before any work
   LeaderboardRequest request;
+  request.controller = controller_from(controller);
   request.world = world;
   request.regressors = regressors;
   request.learners = learners;
@@ -368,7 +370,7 @@ void bind_models(py::module_& m) {
   m.def("leaderboard", &leaderboard, py::arg("world"), py::arg("demos"), py::arg("regressors"), py::arg("learners"),
         py::arg("options"), py::arg("baselines"), py::arg("features"), py::arg("profile"), py::arg("split"),
         py::arg("episodes"), py::arg("seeds"), py::arg("seed"), py::arg("threads"), py::arg("out"), py::arg("format"),
-        py::arg("bar"), py::arg("perturb") = "none", py::arg("estimator") = "");
+        py::arg("bar"), py::arg("perturb") = "none", py::arg("estimator") = "", py::arg("controller") = "cup");
 }
 
 }  // namespace dicestack::python

@@ -784,10 +784,15 @@ TEST(CliLearning, RecordInJointTorquesKeepsThemAsTheActionsAndNeedsTheArm) {
   Process bad = run("record --expert scripted --episodes 1 --controller joint_torque --out " + dir.string());
   EXPECT_EQ(bad.status, 1);
   EXPECT_THAT(bad.output, HasSubstr("give --embodiment arm"));
-  bad = run("record --expert scripted --episodes 1 --embodiment arm --controller joint_torque --perturb medium --out " + dir.string());
-  EXPECT_EQ(bad.status, 1);
-  EXPECT_THAT(bad.output, HasSubstr("without an action delay, action noise or bias"));
   EXPECT_FALSE(std::filesystem::exists(dir));
+  // Perturbed, its actuation factors are drawn in the torques, and the set says so (version 5).
+  const Process perturbed = run("record --expert scripted --episodes 1 --embodiment arm --controller joint_torque "
+                                "--perturb medium --out " + dir.string(), false);
+  ASSERT_EQ(perturbed.status, 0) << perturbed.output;
+  const auto meta = nlohmann::json::parse(file_text(dir / "meta.json"));
+  EXPECT_EQ(meta["version"], 5);
+  EXPECT_EQ(meta["episodes"][0]["perturbation"]["joint_torque_noise_std"].size(), 4u);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(CliLearning, RecordThroughTheTrackerNamesItsExpertAndItsRecordings) {
@@ -870,17 +875,36 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
   p = run("dataset info " + (dir / "set").string(), false);
   EXPECT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(p.output, HasSubstr("joint3_action"));
+  // Its actuation rows: the delay, noise and bias in its own torques.
+  p = run("robustness --model " + model + arm + " --factors action_noise,action_delay --episodes 2 --format csv", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(std::count(p.output.begin(), p.output.end(), '\n'), 1 + 6) << p.output;
   const std::vector<std::pair<std::string, std::string>> refused{
       {"evaluate --model " + model + " --episodes 1", "--embodiment arm"},
       {"evaluate --model " + model + arm + " --episodes 1 --demos " + kTinyDemos, "--demos scores a policy on recordings"},
       {"evaluate --model " + model + arm + " --episodes 1 --initial-push left", "an initial push is a cup velocity change"},
-      {"robustness --model " + model + arm + " --factors action_noise", "without action_delay, action_noise and all"},
-      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "record --embodiment arm"}};
+      {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "record --embodiment arm"},
+      {"leaderboard --demos " + kTinyDemos + " --controller joint_torque --regressors knn --learners dart --episodes 1", "--embodiment arm"},
+      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners bc --episodes 1",
+       "--learners dart,dagger"},
+      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners dart --features state "
+       "--episodes 1", "answers cup actions, not the --controller joint_torque ones"}};
   for (const auto& [args, message] : refused) {
     p = run(args);
     EXPECT_EQ(p.status, 1) << args;
     EXPECT_THAT(p.output, HasSubstr(message)) << args;
   }
+  // The leaderboard's rows in torques: each learner's map in them, without an error on recordings of the cup.
+  p = run("leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners "
+          "dart:expert=tracker:episodes=2:successes_only=false:tracker_probes=1:tracker_robust=1:tracker_variants=false "
+          "--episodes 2 --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  const auto board = nlohmann::json::parse(p.output);
+  EXPECT_EQ(board["controller"], "joint_torque");
+  ASSERT_GE(board["rows"].size(), 1u);
+  EXPECT_EQ(board["rows"][0]["features"], "state+links+clock+start_state@dice+retry/osc");
+  EXPECT_EQ(board["rows"][0]["train_error"], -1);
+  EXPECT_EQ(board["rows"][0]["episodes"], 2);
   std::filesystem::remove_all(dir);
 }
 
@@ -1256,19 +1280,14 @@ TEST(CliPerturb, RobustnessWritesEveryRowInEachFormatAndOnlyReplacesItsOwnTable)
   p = run(cmd + "--expert-feedback observations");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("--expert-feedback is for --expert"));
-  // An expert in joint torques: the arm's, and without the action noise drawn in the cup's units.
+  // An expert in joint torques: the arm's, its actuation factors drawn in torques.
   p = run(expert + "--factors none --controller joint_torque");
   EXPECT_EQ(p.status, 1);
   EXPECT_THAT(p.output, HasSubstr("give --embodiment arm"));
-  p = run(expert + "--embodiment arm --factors action_noise --controller joint_torque");
-  EXPECT_EQ(p.status, 1);
-  EXPECT_THAT(p.output, HasSubstr("without action_delay, action_noise and all"));
-  p = run(expert + "--embodiment arm --factors none,all --controller joint_torque");
-  EXPECT_EQ(p.status, 1);
-  EXPECT_THAT(p.output, HasSubstr("without action_delay, action_noise and all"));
-  p = run(expert + "--embodiment arm --factors none --controller joint_torque", false);
+  p = run(expert + "--embodiment arm --factors none,action_noise --controller joint_torque", false);
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_THAT(p.output, HasSubstr("\nnone,none,"));
+  EXPECT_THAT(p.output, HasSubstr("\naction_noise,hard,"));
   std::filesystem::remove(out);
   std::filesystem::remove(world);
   std::filesystem::remove(model);

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -206,6 +207,55 @@ TEST(Perturbation, DrawnDelaysCoverTheirRangeAndLeaveTheOtherDrawsAlone) {
   for (int n : action_seen) EXPECT_GT(n, 20) << "every action delay from 0 to 3 drawn";
   EXPECT_EQ(observation_seen[3], 0);
   for (std::size_t k = 0; k < 3; ++k) EXPECT_GT(observation_seen[k], 30) << k;
+}
+
+TEST(Perturbation, JointTorquesGetTheirOwnDrawsAfterTheCupsFromTheTorqueLimits) {
+  WorldConfig arm;
+  arm.embodiment = Embodiment::arm;
+  const Perturbation p = perturbation_factor("action_noise", "medium");
+  const PerturbationDraw d = draw_perturbation(p, arm, 7), cup = draw_perturbation(p, WorldConfig{}, 7);
+  // The cup's draws are the floating cup's, number for number: the torques' come after them.
+  EXPECT_EQ(d.action_bias, cup.action_bias);
+  EXPECT_EQ(d.noise_seed, cup.noise_seed);
+  for (std::size_t k = 0; k < kJointCount; ++k) {
+    EXPECT_DOUBLE_EQ(d.torque_noise[k], 0.05 * arm.arm.torque_limit[k]);
+    EXPECT_NE(d.torque_bias[k], 0.0);
+    EXPECT_LT(std::abs(d.torque_bias[k]), 5 * 0.015 * arm.arm.torque_limit[k]);
+  }
+  // Only an arm's record names them, and they read back.
+  EXPECT_EQ(draw_to_json(cup).find("joint_torque"), std::string::npos);
+  const PerturbationDraw back = channel_draw_from_json(draw_to_json(d), "e");
+  EXPECT_EQ(back.torque_bias, d.torque_bias);
+  EXPECT_EQ(back.torque_noise, d.torque_noise);
+  EXPECT_THAT(test::error_of([] { channel_draw_from_json(R"({"joint_torque_noise_std": [1, 2, -3, 4]})", "e"); }),
+              HasSubstr("e: its perturbation's \"joint_torque_noise_std\" must be 4 standard deviations >= 0"));
+}
+
+TEST(Perturbation, AChannelDelaysJointTorquesBehindZeroTorquesAndNoisesThemInNewtonMetres) {
+  PerturbationDraw d;
+  d.action_delay = 2;
+  d.torque_bias = Action::torques({10.0, 0.0, 0.0, 0.0});
+  d.torque_noise = Action::torques({0.0, 0.0, 0.0, 5.0});
+  d.noise_seed = 3;
+  PerturbedChannel channel(d, ActionKind::joint_torque);
+  ASSERT_EQ(channel.pending().size(), 2u);
+  EXPECT_EQ(channel.pending().front(), Action::zeros(ActionKind::joint_torque));
+  const Action chosen = Action::torques({100.0, 200.0, 300.0, 400.0});
+  for (int step = 0; step < 2; ++step) {
+    const Action idle = channel.execute(chosen);
+    EXPECT_EQ(idle.kind(), ActionKind::joint_torque) << "nothing runs: zero torques, plus the bias";
+    EXPECT_EQ(idle[0], 10.0);
+    EXPECT_EQ(idle[1], 0.0);
+    EXPECT_NE(idle[3], 0.0) << "the wrist's noise";
+  }
+  const Action late = channel.execute(chosen);
+  EXPECT_EQ(late[0], 110.0);
+  EXPECT_EQ(late[2], 300.0);
+  EXPECT_NEAR(late[3], 400.0, 5 * 5.0);
+  ASSERT_EQ(channel.pending().size(), 2u);
+  EXPECT_EQ(channel.pending().front(), chosen);
+  EXPECT_THAT(test::error_of([&] { channel.execute(Action{0.0, 0.0, 0.0}); }),
+              HasSubstr("a choice for the cup controller, where the policy answers joint_torque actions"));
 }
 
 }  // namespace

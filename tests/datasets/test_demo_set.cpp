@@ -263,7 +263,7 @@ TEST(DemoSetBadInput, MetaAndFiles) {
   EXPECT_THAT(read_error("missing_file"), HasSubstr("meta.json: lists episode_0009.csv, which does not exist"));
   EXPECT_THAT(read_error("extra_file"), HasSubstr("episode_0002.csv: not listed in meta.json"));
   EXPECT_THAT(read_error("newer_version"),
-              HasSubstr("meta.json: format version 99 is newer than this dicestack reads (4); upgrade dicestack"));
+              HasSubstr("meta.json: format version 99 is newer than this dicestack reads (5); upgrade dicestack"));
   EXPECT_THAT(read_error("wrong_format"), HasSubstr("format \"robomimic\" is not dicestack-demos"));
   EXPECT_THAT(read_error("steps_mismatch"), HasSubstr("says episode_0000.csv has 7 steps; the file has 4"));
   EXPECT_THAT(read_error("no_meta"), HasSubstr("meta.json: missing; not a dicestack demonstration folder"));

@@ -47,13 +47,16 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
   r = torque_request();
   r.world.embodiment = Embodiment::cup;
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("--embodiment arm"));
-  // The leaderboard scores its rows on recordings of the cup: no row of the arm's links.
+  // A leaderboard's row of the arm's links: learned as `train` learns it (DART, not DaD).
   const LearnerInfo& dart = LearnerRegistry::global().info("dart");
+  EXPECT_NO_THROW(require_labellable(dart.params, Params(dart.params, {}, "dart"), r.world,
+                                     feature_map("state+links+clock/torque"), "dart"));
+  const LearnerInfo& dad = LearnerRegistry::global().info("dad");
   EXPECT_THAT(test::error_of([&] {
-                require_labellable(dart.params, Params(dart.params, {}, "dart"), r.world,
-                                   feature_map("state+links+clock/torque"), "dart");
+                require_labellable(dad.params, Params(dad.params, {}, "dad"), r.world,
+                                   feature_map("state+links+clock/torque"), "dad");
               }),
-              HasSubstr("leaderboard: feature map"));
+              HasSubstr("learned by bc from episodes recorded on the arm, or by dart and dagger"));
   r = torque_request();
   r.controller = "wrist";
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("is not one of cup, joint_torque"));

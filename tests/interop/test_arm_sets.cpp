@@ -1,4 +1,5 @@
-// An arm's demonstrations: its links and joint torques kept by the folder format (version 4),
+// An arm's demonstrations: its links and joint torques kept by the folder format (version 4,
+// version 5 with the torques' perturbation),
 // robomimic and Minari; a cup set's bytes unchanged; bad arm files refused naming the place.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dicestack/core/perturbation.hpp>
 #include <dicestack/datasets/demo_set.hpp>
 #include <dicestack/interop/interop.hpp>
 #include <dicestack/learners/demonstrator.hpp>
@@ -79,6 +81,33 @@ TEST(ArmSets, TheFolderKeepsThemAsVersionFourAndACupSetStaysVersionTwo) {
   write_demo_set(cup, cup_dir);
   EXPECT_EQ(nlohmann::json::parse(text_of(cup_dir / "meta.json"))["version"], 2);
   EXPECT_FALSE(nlohmann::json::parse(text_of(cup_dir / "meta.json"))["units"].contains("joint_torques"));
+}
+
+TEST(ArmSets, AnArmsTorqueDrawsAreVersionFiveAndAVersionFourSetCannotHoldThem) {
+  DemoSet set;
+  set.world.embodiment = Embodiment::arm;
+  set.world.episode.max_steps = 20;
+  RecordRequest request = test::record_request(2, 5, 1);
+  request.perturbation = perturbation_factor("action_noise", "medium");
+  request.perturbation.action_delay = 2;
+  ExpertConfig torques;
+  torques.controller = ActionKind::joint_torque;
+  set.episodes = record_expert("scripted", torques, set.world, request);
+  for (std::size_t i = 0; i < set.episodes.size(); ++i) set.episodes[i].name = "episode_000" + std::to_string(i);
+  const fs::path dir = scratch("arm_torque_draws");
+  write_demo_set(set, dir);
+  auto meta = nlohmann::json::parse(text_of(dir / "meta.json"));
+  EXPECT_EQ(meta["version"], 5);
+  const auto& drawn = meta["episodes"][0]["perturbation"];
+  EXPECT_EQ(drawn["joint_torque_noise_std"][0], 0.05 * set.world.arm.torque_limit[0]);
+  EXPECT_EQ(drawn["action_delay"], 2);
+  expect_same(set, read_demo_set(dir));
+  EXPECT_EQ(set.episodes[0].actions[0].kind(), ActionKind::joint_torque) << "the torques as chosen";
+
+  meta["version"] = 4;
+  write_text(dir / "meta.json", meta.dump());
+  EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }),
+              HasSubstr("has the joint torques' bias or noise, which format version 4 does not have (version 5 added them)"));
 }
 
 TEST(ArmSets, RobomimicAndMinariCarryTheLinksAndJointTorques) {

@@ -219,11 +219,16 @@ def test_the_joint_torque_controller_takes_the_arms_four_torques():
         dicestack.DiceStackEnv(controller="joint_torque")
     with pytest.raises(ValueError, match="controller must be"):
         dicestack.DiceStackEnv(embodiment="arm", controller="torque")
-    # Factors drawn in the cup's units, and estimators, are refused (at the reset that asks for them too).
-    with pytest.raises(ValueError, match="action delay, action noise and bias"):
-        dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"action_delay": 2})
-    with pytest.raises(ValueError, match="action delay, action noise and bias"):
-        env.reset(seed=4, options={"perturb": {"action_noise": 0.1}})
+    # The actuation factors act on the torques: late, and noised as a fraction of each limit.
+    delayed = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"action_delay": 2})
+    delayed.reset(seed=3)
+    assert delayed.pending.shape == (2, 4) and not np.any(delayed.pending)
+    delayed.step(held)
+    assert np.array_equal(delayed.pending[1], held * np.array([1, 1, 1, 0.5]))  # as clipped
+    _, info = env.reset(seed=4, options={"perturb": {"action_noise": 0.1}})
+    drawn = info["perturbation"]
+    assert np.allclose(drawn["joint_torque_noise_std"], 0.1 * env.action_space.high)
+    assert len(drawn["joint_torque_bias"]) == 4
     with pytest.raises(ValueError, match="estimator"):
         dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", estimator="kalman")
     late = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"observation_delay": 2})

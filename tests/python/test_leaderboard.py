@@ -80,3 +80,10 @@ def test_bad_arguments_raise(demos):
         dicestack.leaderboard(["knn"], ["bc", "dart"], demos, options={"episodes": "abc"}, progress=False)
     with pytest.raises(ValueError, match='has an option "iterations"'):
         dicestack.leaderboard(["knn"], ["bc"], demos, options={"iterations": 3}, progress=False)
+    # Rows in joint torques need the arm, and bc a set recorded on it in them.
+    with pytest.raises(ValueError, match="controller must be"):
+        dicestack.leaderboard(["knn"], ["dart"], demos, controller="torque", progress=False)
+    with pytest.raises(ValueError, match="--embodiment arm"):
+        dicestack.leaderboard(["knn"], ["dart"], demos, controller="joint_torque", progress=False)
+    with pytest.raises(ValueError, match="--learners dart,dagger"):
+        dicestack.leaderboard(["knn"], ["bc"], demos, embodiment="arm", controller="joint_torque", progress=False)

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <span>
 #include <sstream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -90,9 +91,9 @@ constexpr Key kKeys[] = {
      "cup segment mass x U(1 - a, 1 + a)"},
     {"gravity", &Perturbation::gravity, nullptr, 2, false, " m/s^2", "", "gravity's y + N(0, sigma), m/s^2"},
     {"action_noise", &Perturbation::action_noise, nullptr, 10, false, "", "",
-     "every executed action + N(0, s) each step, s a fraction of action.scale"},
+     "every executed action + N(0, s) each step, s a fraction of action.scale (of the arm's torque limits for joint torques)"},
     {"action_bias", &Perturbation::action_bias, nullptr, 10, false, "", "",
-     "every executed action + a bias drawn once per episode from N(0, b), b a fraction of action.scale"},
+     "every executed action + a bias drawn once per episode from N(0, b), b a fraction of action.scale (of the torque limits for joint torques)"},
     {"action_delay", nullptr, &Perturbation::action_delay, kMaxActionDelay, false, "", "",
      "what the policy chooses runs this many control steps later (nothing runs before)"},
     {"observation_noise", &Perturbation::observation_noise, nullptr, 10, false, "", "",
@@ -294,6 +295,11 @@ PerturbationDraw draw_perturbation(const Perturbation& p, const WorldConfig& wor
     d.action_noise[k] = p.action_noise * world.action.scale[k];
   }
   d.noise_seed = rng.next();
+  const auto torque = action_scale(world, ActionKind::joint_torque);
+  for (std::size_t k = 0; k < kJointCount; ++k) {
+    d.torque_bias[k] = p.action_bias * torque[k] * rng.normal();
+    d.torque_noise[k] = p.action_noise * torque[k];
+  }
   d.action_delay = p.action_delay;
   for (std::size_t k = 0; k < kStateDim; ++k) d.observation_noise[k] = p.observation_noise * observation_spread()[k];
   d.observation_delay = p.observation_delay;
@@ -327,6 +333,11 @@ std::string draw_to_json(const PerturbationDraw& d) {
          {"start_cup_lift", w.randomization.cup_lift},
          {"start_cup_tilt", w.randomization.cup_tilt},
          {"noise_seed", d.noise_seed}};
+  // Only an arm's episode can run joint torques; a cup's record stays as it was.
+  if (w.embodiment == Embodiment::arm) {
+    j["joint_torque_bias"] = d.torque_bias;
+    j["joint_torque_noise_std"] = d.torque_noise;
+  }
   return j.dump();
 }
 
@@ -360,6 +371,8 @@ PerturbationDraw channel_draw_from_json(std::string_view text, const std::string
   reals("action_bias", d.action_bias, false);
   reals("action_noise_std", d.action_noise, true);
   reals("observation_noise_std", d.observation_noise, true);
+  reals("joint_torque_bias", d.torque_bias, false);
+  reals("joint_torque_noise_std", d.torque_noise, true);
   d.action_delay = steps("action_delay");
   d.observation_delay = steps("observation_delay");
   // What the policy saw is replayed from the seed only under observation noise (the action
@@ -375,17 +388,11 @@ PerturbationDraw channel_draw_from_json(std::string_view text, const std::string
   return d;
 }
 
-bool takes_joint_torques(const PerturbationDraw& draw) {
-  if (draw.action_delay > 0) return false;
-  for (std::size_t k = 0; k < kActionDim; ++k)
-    if (draw.action_bias[k] != 0.0 || draw.action_noise[k] > 0.0) return false;
-  return true;
-}
-
-bool takes_joint_torques(const Perturbation& p) { return p.action_delay == 0 && p.action_noise == 0.0 && p.action_bias == 0.0; }
-
-PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw)
-    : draw_(draw), noise_(draw.noise_seed), chosen_(static_cast<std::size_t>(draw.action_delay), Action{0.0, 0.0, 0.0}) {}
+PerturbedChannel::PerturbedChannel(const PerturbationDraw& draw, ActionKind actions)
+    : draw_(draw),
+      noise_(draw.noise_seed),
+      chosen_(static_cast<std::size_t>(draw.action_delay), Action::zeros(actions)),
+      actions_(actions) {}
 
 State PerturbedChannel::observe(const State& state) {
   states_.push_back(state);
@@ -397,17 +404,20 @@ State PerturbedChannel::observe(const State& state) {
 }
 
 Action PerturbedChannel::execute(const Action& chosen) {
-  if (chosen.kind() != ActionKind::cup && !takes_joint_torques(draw_))
-    throw InputError("an action delay, action noise and bias are drawn for the cup's actions; joint torques cannot take them");
+  if (chosen.kind() != actions_)
+    throw InputError("a choice for the " + std::string(action_kind_name(chosen.kind())) + " controller, where the policy answers " +
+                     std::string(action_kind_name(actions_)) + " actions");
   chosen_.push_back(chosen);  // holds action_delay zeros from the start: nothing runs before then
   Action a = chosen_.front();
   chosen_.pop_front();
   ran_.push_back(a);
   if (ran_.size() > static_cast<std::size_t>(draw_.observation_delay)) ran_.pop_front();
-  if (a.kind() != ActionKind::cup) return a;
-  for (std::size_t k = 0; k < kActionDim; ++k) {
-    a[k] += draw_.action_bias[k];
-    if (draw_.action_noise[k] > 0.0) a[k] += draw_.action_noise[k] * noise_.normal();
+  const bool cup = a.kind() == ActionKind::cup;
+  const Action& bias = cup ? draw_.action_bias : draw_.torque_bias;
+  const Action& noise = cup ? draw_.action_noise : draw_.torque_noise;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    a[k] += bias[k];
+    if (noise[k] > 0.0) a[k] += noise[k] * noise_.normal();
   }
   return a;
 }

@@ -8,13 +8,13 @@
 
 namespace dicestack {
 
-PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const Perturbation& perturbation, std::uint64_t episode_seed)
-    : PerturbedEnv(pooled, draw_perturbation(perturbation, pooled.config(), episode_seed)) {}
+PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const Perturbation& perturbation, std::uint64_t episode_seed, ActionKind actions)
+    : PerturbedEnv(pooled, draw_perturbation(perturbation, pooled.config(), episode_seed), actions) {}
 
-PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw)
+PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw, ActionKind actions)
     : draw_(draw), env_(&pooled), model_(&pooled.config()) {
   if (draw_.physics) env_ = &own_.emplace(draw_.world);
-  if (draw_.acts) channel_.emplace(draw_);
+  if (draw_.acts) channel_.emplace(draw_, actions);
 }
 
 PerturbedEnv::PerturbedEnv(DiceEnv& env) : env_(&env), model_(&env.config()) { draw_.world = env.config(); }

@@ -22,8 +22,10 @@ inline constexpr const char* kDemoFormat = "dicestack-demos";
 /// its perturbed world drew), written only by sets that hold one, so that nominal sets stay
 /// byte for byte version 2; version 4 an arm's readings (its links and joint torques at each
 /// step, columns of their own, and its final links), written only by sets that hold an arm's
-/// episode. Older folders stay readable (docs/formats.md).
-inline constexpr int kDemoFormatVersion = 4;
+/// episode; version 5 an arm's perturbation drawn in joint torques too (the bias and noise a
+/// policy in joint torques met), written only by sets that hold such a perturbation. Older
+/// folders stay readable (docs/formats.md).
+inline constexpr int kDemoFormatVersion = 5;
 /// Format marker of the JSON summaries the baselines (optimise, reinforce, rrt) write into a set.
 inline constexpr const char* kBaselineFormat = "dicestack-baseline";
 
@@ -74,7 +76,7 @@ struct DemoMetaEntry {
 
 /// What a set's meta.json says, checked on its own (no episode file is opened).
 struct DemoMeta {
-  int version = kDemoFormatVersion;  ///< the file's format version (1 to 4)
+  int version = kDemoFormatVersion;  ///< the file's format version (1 to 5)
   WorldConfig world;
   std::string description;
   std::string provenance;

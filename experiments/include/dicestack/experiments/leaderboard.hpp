@@ -43,6 +43,11 @@ struct LeaderboardRequest {
   /// observations), an estimator's name (estimator.hpp), or empty: each model's own
   /// (estimator_for; none for a baseline).
   std::string estimator;
+  /// What the rows' policies answer: the cup's actions, or joint torques on an arm world (each
+  /// learner's own map in torques, torque_map_name; learned by dart and dagger from their
+  /// experts, by bc from a set recorded on the arm in torques; no train or test error, as the
+  /// recordings hold another controller's actions or none to score).
+  ActionKind controller = ActionKind::cup;
   /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
   /// before any work (a user's file is refused), and finished rows go to <out>.partial.json as
   /// they come, so that a rerun with the same settings resumes.

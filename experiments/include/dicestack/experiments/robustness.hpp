@@ -34,6 +34,8 @@ struct RobustnessRequest {
   std::vector<std::string> factors;
   /// What the policy is shown under the sensing factors: the observation, or an estimate.
   EstimatorConfig estimator;
+  /// What the policy answers (EvalRequest::actions): its delay, noise and bias are of that kind.
+  ActionKind actions = ActionKind::cup;
   /// Called as each row starts with (row index, rows in all, factor, level).
   std::function<void(int, int, const std::string&, const std::string&)> progress;
 };

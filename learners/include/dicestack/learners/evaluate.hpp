@@ -106,8 +106,8 @@ struct EvalRequest {
   /// What the policy is shown under sensing factors: the observation (none) or an estimate.
   EstimatorConfig estimator;
   std::size_t max_steps = 0;  ///< 0: the world's time limit
-  /// What the policy answers. Joint torques run only on the arm, without an initial push, an
-  /// estimator or a perturbation's action delay, noise or bias (each in the cup's units).
+  /// What the policy answers (a perturbation's action delay, noise and bias are of that kind).
+  /// Joint torques run only on the arm, without an initial push or an estimator.
   ActionKind actions = ActionKind::cup;
   std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
   std::vector<EpisodeResult>* results = nullptr;  ///< if set, receives every rollout's results in index order

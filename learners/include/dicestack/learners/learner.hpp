@@ -188,8 +188,8 @@ void require_labellable(const TrainingPerturbation& p, const FeatureMap& feature
 /// dataset refuses any other by name), or dart and dagger, whose experts run on the arm (human
 /// recordings hold neither links nor torques), without include_demos, in the nominal world.
 void require_learnable_map(const std::string& learner, const Params& params, const FeatureMap& map);
-/// The same for a learner's options: nothing when `schema` has no "perturb" (a leaderboard's row,
-/// which also refuses a map of the arm's links or torques: its rows are scored on recordings).
+/// The same for a learner's options (a leaderboard's row): a map of the arm's links or torques
+/// as require_learnable_map says, else nothing when `schema` has no "perturb".
 void require_labellable(const std::vector<ParamSpec>& schema, const Params& params, const WorldConfig& world,
                         const FeatureMap& features, const std::string& learner);
 /// Names `p` in the model's record: "perturb", and "estimator" when the policy runs behind one.

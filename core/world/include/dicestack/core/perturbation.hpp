@@ -26,7 +26,8 @@ struct Perturbation {
   double cup_mass = 0.0;   ///< a, in [0, 1)
   double gravity = 0.0;    ///< sigma, m/s^2, in [0, 2]
   // Actuation: each executed action gets N(0, noise) per step plus a per-episode bias
-  // N(0, bias), both as fractions of action.scale; it is applied `delay` steps late.
+  // N(0, bias), both as fractions of its scale (action.scale for the cup's actions, the arm's
+  // torque limits for joint torques); it is applied `delay` steps late.
   double action_noise = 0.0;  ///< in [0, 10]
   double action_bias = 0.0;   ///< in [0, 10]
   int action_delay = 0;       ///< steps, in [0, 100]
@@ -87,8 +88,12 @@ std::vector<PerturbationKey> perturbation_keys();
 /// What one episode got.
 struct PerturbationDraw {
   WorldConfig world;        ///< the world it runs in (physics and start ranges changed)
-  Action action_bias{0.0, 0.0, 0.0};  ///< world units, added to every executed action
+  Action action_bias{0.0, 0.0, 0.0};  ///< world units, added to every executed cup action
   Action action_noise{0.0, 0.0, 0.0};  ///< std per step, world units
+  /// The same for joint-torque actions, N m: drawn after everything else (so a cup's draws are
+  /// as before), from the arm's torque limits.
+  Action torque_bias = Action::zeros(ActionKind::joint_torque);
+  Action torque_noise = Action::zeros(ActionKind::joint_torque);
   int action_delay = 0;
   State observation_noise{};  ///< std per state component
   int observation_delay = 0;
@@ -113,23 +118,19 @@ std::string draw_to_json(const PerturbationDraw& draw);
 /// `source` and the field out of range, or when there is observation noise and no noise seed.
 PerturbationDraw channel_draw_from_json(std::string_view text, const std::string& source);
 
-/// Whether joint-torque actions (the arm's joint_torque controller) can run under `draw` or a
-/// perturbation's draws: no action delay (its queue starts with the cup's zeros), no action noise
-/// and no bias (drawn in the cup's units).
-bool takes_joint_torques(const PerturbationDraw& draw);
-bool takes_joint_torques(const Perturbation& perturbation);
-
 /// What a perturbed episode's policy sees and what the world executes (the draw's sensing and
 /// actuation), step by step; rollout() and the Python environment share it, so both give the
 /// same episodes.
 class PerturbedChannel {
  public:
-  explicit PerturbedChannel(const PerturbationDraw& draw);
+  /// `actions`: the kind the policy answers in (what runs while nothing has been chosen).
+  explicit PerturbedChannel(const PerturbationDraw& draw, ActionKind actions = ActionKind::cup);
   /// The observation at the step whose true state is `state` (call once per state, in order,
   /// from the start): the state observation_delay steps ago (the start before then), plus noise.
   State observe(const State& state);
   /// What runs at this step, given what the policy chose now: its choice action_delay steps ago
-  /// (nothing before then), plus the bias and this step's noise.
+  /// (nothing before then), plus the bias and this step's noise of its kind. Throws InputError
+  /// for a choice of another kind than the channel's.
   Action execute(const Action& chosen);
   /// What runs at the next action_delay steps before the next choice does (before bias and
   /// noise), in order: the choices not yet run, zeros before the first. Empty without a delay.
@@ -144,6 +145,7 @@ class PerturbedChannel {
   std::deque<State> states_;
   std::deque<Action> chosen_;
   std::deque<Action> ran_;
+  ActionKind actions_;
 };
 
 /// The typical spread of each state component (positions m, angles rad, velocities), the unit

@@ -28,10 +28,12 @@ struct PerturbedStep {
 class PerturbedEnv {
  public:
   /// The episode of `episode_seed` under `perturbation` (draw_perturbation): it runs in `pooled`
-  /// when the draw leaves the physics nominal, else in a world of its own. `pooled` must outlive it.
-  PerturbedEnv(DiceEnv& pooled, const Perturbation& perturbation, std::uint64_t episode_seed);
+  /// when the draw leaves the physics nominal, else in a world of its own. `pooled` must outlive
+  /// it. `actions`: the kind the policy answers in (its delay, noise and bias are of that kind).
+  PerturbedEnv(DiceEnv& pooled, const Perturbation& perturbation, std::uint64_t episode_seed,
+               ActionKind actions = ActionKind::cup);
   /// The same for a draw already made (a replay, a test's own draw).
-  PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw);
+  PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw, ActionKind actions = ActionKind::cup);
   /// `env` unperturbed.
   explicit PerturbedEnv(DiceEnv& env);
   PerturbedEnv(const PerturbedEnv&) = delete;  // env_ may point into own_
