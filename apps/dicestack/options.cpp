@@ -60,9 +60,10 @@ void TrackerOption::add_to(CLI::App& app) {
 TrackerConfig TrackerOption::config_for(ActionKind controller) const {
   TrackerConfig tracker = config();
   tracker.controller = controller;
-  const bool refine_given =
-      std::any_of(settings.begin(), settings.end(), [](const std::string& s) { return s.rfind("refine=", 0) == 0; });
-  if (controller == ActionKind::joint_torque && !refine_given) tracker.refine = 0;
+  if (controller == ActionKind::joint_torque)
+    settle_for_joint_torques(tracker, [&](std::string_view name) {
+      return std::any_of(settings.begin(), settings.end(), [&](const std::string& s) { return s.rfind(std::string(name) + "=", 0) == 0; });
+    });
   return tracker;
 }
 

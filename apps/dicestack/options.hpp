@@ -37,8 +37,8 @@ struct TrackerOption {
   /// The preset with the settings on top; throws ConfigError naming a bad one.
   TrackerConfig config() const { return tracker_config(preset, settings); }
   /// config() for an expert answering `controller`'s actions: its paths chosen in that
-  /// controller and, in joint torques, not refined unless `refine=` is given (a refinement
-  /// generation in held torques takes about 10 s on 2 cores: 40 min for the distill preset's).
+  /// controller and, in joint torques, settled as a learner's is (settle_for_joint_torques): not
+  /// refined unless `refine=` is given, ranked from at least 32 probe starts unless `probes=` is.
   TrackerConfig config_for(ActionKind controller) const;
   /// " --tracker-preset P --tracker K=V ..." as given, for a set's provenance.
   std::string as_arguments() const;

@@ -66,9 +66,6 @@ std::string number_text(double v) {
 // ("Policies from the human recordings") and docs/notebook/2026-11-27-learners-history.md
 // ("Robust choices and velocity targets").
 constexpr int kServoPaths = 1, kOtherPaths = 3;
-// The probe starts that rank the recordings for a learner in joint torques, whose tracker does
-// not refine the path it ranks first (learner_tracker_config).
-constexpr int kTorqueTrackerProbes = 32;
 
 // The learners' tracker preset: tuned for DART on the tuning seeds (docs/learners.md, "Policies
 // from the human recordings"; the measurements: docs/notebook/2026-11-27-learners-page-history.md,
@@ -174,14 +171,11 @@ TrackerConfig learner_tracker_config(const Learner& learner, const std::string& 
   const int paths = static_cast<int>(params.integer("tracker_paths"));
   if (learner.given("tracker_paths") || preset == kLearnerPreset) tracker.paths = tracker_paths_for(paths, features);
   tracker.controller = feature_map(features).action_kind();  // paths chosen in the controller the labels are for
-  // Refining a path in held torques costs two more simulated steps per step: about 10 s a
-  // generation on 2 cores, 40 min for the preset's refinements. Without a refinement the ranked
-  // path is the one followed, and 16 probe starts ranked a weaker one first for one training
-  // seed in three (199 of 480 probe trials against 606 of 960 with 32), whose run then took 406 s
-  // instead of 285 s: twice the probes cost 30 s.
-  if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_refine")) tracker.refine = 0;
-  if (tracker.controller == ActionKind::joint_torque && !learner.given("tracker_probes"))
-    set_tracker_setting(tracker, "probes", std::to_string(std::max(tracker.probes, kTorqueTrackerProbes)));  // as the option would
+  // Refining a path in held torques costs 40 min for the preset's refinements, and with 16
+  // probe starts a weaker path led for one training seed in three (199 of 480 probe trials
+  // against 606 of 960 with 32; that run took 406 s instead of 285 s).
+  if (tracker.controller == ActionKind::joint_torque)
+    settle_for_joint_torques(tracker, [&](std::string_view s) { return learner.given("tracker_" + std::string(s)); });
   validate(tracker);
   return tracker;
 }

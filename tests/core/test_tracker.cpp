@@ -450,6 +450,21 @@ TEST(TrackerPresets, PlainIsTheBareTrackerAndDistillTheLearnersTuning) {
               HasSubstr("tracker preset \"tuned\": unknown; presets: plain, distill"));
 }
 
+TEST(TrackerPresets, InJointTorquesATrackerIsNotRefinedAndRanksFromMoreStartsUnlessTold) {
+  TrackerConfig settled = tracker_preset("distill");
+  settle_for_joint_torques(settled, [](std::string_view) { return false; });
+  EXPECT_EQ(settled.controller, ActionKind::joint_torque);
+  EXPECT_EQ(settled.refine, 0);
+  EXPECT_EQ(settled.probes, 32);
+  EXPECT_EQ(settled.finalist_probes, 128);
+  TrackerConfig told = tracker_preset("distill");
+  told.probes = 8;
+  told.refine = 3;
+  settle_for_joint_torques(told, [](std::string_view name) { return name == "probes" || name == "refine"; });
+  EXPECT_EQ(told.probes, 8);
+  EXPECT_EQ(told.refine, 3);
+}
+
 TEST(TrackerPresets, SettingsGoOnTopByTheirFieldsNamesAndABadOneIsNamed) {
   const TrackerConfig c = tracker_config("distill", {"smooth=2", "variants=false", "probes=8", "paths=1"});
   EXPECT_EQ(c.smooth, 2.0);

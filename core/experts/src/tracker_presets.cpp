@@ -1,5 +1,6 @@
 // The tracker's named presets and its settings by name (tracker.hpp): one vocabulary, the
 // config's field names, for record, robustness, Python, the bench and the learners.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -66,6 +67,13 @@ std::vector<std::string> tracker_preset_names() { return {"plain", "distill"}; }
 std::vector<std::string> tracker_setting_names() {
   return {"probes", "optimise", "paths", "smooth", "rescue", "robust", "robust_noise", "robust_warp", "keep_extremes",
           "shrink", "variants", "refine", "refine_probes", "refine_restarts", "refine_timing"};
+}
+
+void settle_for_joint_torques(TrackerConfig& c, const std::function<bool(std::string_view)>& given) {
+  constexpr int kProbes = 32;
+  c.controller = ActionKind::joint_torque;
+  if (!given("refine")) c.refine = 0;
+  if (!given("probes")) set_tracker_setting(c, "probes", std::to_string(std::max(c.probes, kProbes)));
 }
 
 void set_tracker_setting(TrackerConfig& c, std::string_view name, std::string_view value) {

@@ -142,6 +142,11 @@ std::vector<std::string> tracker_preset_names();
 std::vector<std::string> tracker_setting_names();
 /// Sets one of them from text. Throws ConfigError naming the setting and what it takes.
 void set_tracker_setting(TrackerConfig& config, std::string_view name, std::string_view value);
+/// A tracker told in joint torques, with the settings not given (`given` says by name) made what
+/// held torques need: no refinement (a generation in held torques takes about 10 s on 2 cores),
+/// and at least 32 probe starts to rank the path it then follows unrefined (16 ranked a weaker
+/// one first for one learner's seed in three). Sets `controller`.
+void settle_for_joint_torques(TrackerConfig& config, const std::function<bool(std::string_view)>& given);
 /// The value of one of them in `config`, as text set_tracker_setting reads back the same.
 std::string tracker_setting_text(const TrackerConfig& config, std::string_view name);
 /// Every setting of `config`, "NAME=VALUE, ...", in tracker_setting_names' order: what a
