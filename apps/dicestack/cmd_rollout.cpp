@@ -2,6 +2,8 @@
 // fingerprint of every state (for determinism checks across processes) and optionally a PNG.
 #include <chrono>
 #include <cstdio>
+#include <span>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,36 +26,43 @@ struct RolloutOptions {
   std::uint64_t seed = 0;
   std::string start = "random";
   std::string actions = "random";
+  std::string controller = "cup";
   int steps = 0;
   std::filesystem::path png;
   bool json = false;
 };
 
-// Uniform random actions in the optimisers' range (action.scale), from their own stream, or none.
+// Uniform random actions of `kind` in their scale (action_scale: the optimisers' range for the
+// cup, the torque limits for joint torques), from their own stream, or zeros.
 class BuiltinController final : public Policy {
  public:
-  BuiltinController(bool random, const std::array<double, kActionDim>& scale, std::uint64_t seed) : random_(random), scale_(scale), rng_(seed) {}
+  BuiltinController(bool random, ActionKind kind, std::span<const double> scale, std::uint64_t seed)
+      : random_(random), kind_(kind), scale_(scale.begin(), scale.end()), rng_(seed) {}
   Action act(const History&) override {
-    Action a{0.0, 0.0, 0.0};
+    Action a = Action::zeros(kind_);
     if (random_)
-      for (std::size_t k = 0; k < kActionDim; ++k) a[k] = rng_.uniform(-1.0, 1.0) * scale_[k];
+      for (std::size_t k = 0; k < a.size(); ++k) a[k] = rng_.uniform(-1.0, 1.0) * scale_[k];
     return a;
   }
   std::string name() const override { return random_ ? "random actions" : "still"; }
 
  private:
   bool random_;
-  std::array<double, kActionDim> scale_;
+  ActionKind kind_;
+  std::vector<double> scale_;
   Rng rng_;
 };
 
 int run_rollout(const RolloutOptions& opt) {
   const WorldConfig config = opt.world.load();
+  const ActionKind kind = opt.controller == "joint_torque" ? ActionKind::joint_torque : ActionKind::cup;
+  if (kind == ActionKind::joint_torque && config.embodiment != Embodiment::arm)
+    throw ConfigError("rollout: --controller joint_torque drives an arm's joints: give --embodiment arm");
   DiceEnv env(config);
   // As DiceEnv::reset(seed) starts: the random start of the seed, the noise from its stream 1.
   const State start = opt.start == "paper" ? paper_start_state(config) : random_start_state(config, opt.seed);
   const std::uint64_t noise_seed = opt.start == "paper" ? opt.seed : derive_seed(opt.seed, 1);
-  BuiltinController controller(opt.actions == "random", config.action.scale, derive_seed(opt.seed, 2));
+  BuiltinController controller(opt.actions == "random", kind, action_scale(config, kind), derive_seed(opt.seed, 2));
   dicestack::RolloutOptions options;
   options.max_steps = static_cast<std::size_t>(opt.steps > 0 ? opt.steps : config.episode.max_steps);
   const auto t0 = std::chrono::steady_clock::now();
@@ -101,8 +110,13 @@ void add_rollout_command(CLI::App& app) {
   cmd->add_option("--start", opt->start, "Start state: random (from the seed) or paper")
       ->check(CLI::IsMember({"random", "paper"}))
       ->capture_default_str();
-  cmd->add_option("--actions", opt->actions, "Actions: random (uniform in the optimisers' scale) or still (zero)")
+  cmd->add_option("--actions", opt->actions, "Actions: random (uniform in the optimisers' scale, or within the torque limits) or still (zero)")
       ->check(CLI::IsMember({"random", "still"}))
+      ->capture_default_str();
+  cmd->add_option("--controller", opt->controller,
+                  "What the actions drive: cup (its velocity changes; on the arm through the cup controller) or joint_torque "
+                  "(the arm's four torques, with --embodiment arm; still: none, and the arm falls)")
+      ->check(CLI::IsMember({"cup", "joint_torque"}))
       ->capture_default_str();
   cmd->add_option("--steps", opt->steps, "Control steps (default and most: the world's episode.max_steps, where the episode is truncated)")
       ->check(CLI::PositiveNumber);

@@ -129,6 +129,20 @@ TEST(Cli, StateHashIsIdenticalAcrossProcessesAndMatchesThisOne) {
   EXPECT_NE(ja["state_hash"], nlohmann::json::parse(run("rollout --seed 10 --steps 300 --json").output)["state_hash"]);
 }
 
+TEST(Cli, RolloutDrivesTheArmsJointsInTorquesAndOnlyTheArms) {
+  const Process limp = run("rollout --embodiment arm --controller joint_torque --actions still --steps 20 --json", false);
+  ASSERT_EQ(limp.status, 0) << limp.output;
+  const Process held = run("rollout --embodiment arm --actions still --steps 20 --json", false);
+  ASSERT_EQ(held.status, 0) << held.output;
+  EXPECT_NE(nlohmann::json::parse(limp.output)["state_hash"], nlohmann::json::parse(held.output)["state_hash"])
+      << "no torque lets the arm fall; the cup controller holds the cup";
+  const Process random = run("rollout --embodiment arm --controller joint_torque --steps 20 --json", false);
+  ASSERT_EQ(random.status, 0) << random.output;
+  const Process cup = run("rollout --controller joint_torque --steps 2");
+  EXPECT_EQ(cup.status, 1);
+  EXPECT_THAT(cup.output, HasSubstr("give --embodiment arm"));
+}
+
 TEST(Cli, BadWorldConfigIsReportedWithTheField) {
   const auto good = test::scratch_path("dicestack_cli_world.json");
   ASSERT_EQ(run("config --out " + good.string()).status, 0);
