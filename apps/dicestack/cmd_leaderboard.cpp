@@ -145,7 +145,7 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   cmd->add_option("--controller", opt->controller,
                   "What the rows' policies answer: cup (the cup's velocity changes) or joint_torque (the arm's four torques, "
                   "with --embodiment arm: each learner's map in torques; dart and dagger learn them from their experts, bc "
-                  "from a set recorded on the arm; docs/arm.md)")
+                  "from a set recorded on the arm; default learners then dart:expert=tracker; docs/arm.md)")
       ->check(CLI::IsMember({"cup", "joint_torque"}))
       ->capture_default_str();
   cmd->add_option("--recordings", opt->recordings,

@@ -59,7 +59,8 @@ std::string record_provenance(const RecordOptions& opt, const Perturbation& pert
                           : "") +
          (opt.controller == "cup" ? "" : "; the expert's cup actions told in the joint torques the cup controller held") +
          (opt.controller == "cup" || opt.expert != "tracker" ? ""
-                                                             : " (in joint torques its paths are refined only with --tracker refine=N)") +
+                                                             : " (in joint torques its paths are ranked from 32 probe starts "
+                                                               "unless --tracker probes=N, and refined only with --tracker refine=N)") +
          (perturbation.nominal() ? "" : "; domain randomisation: each episode in its own world drawn from its seed (" +
                                             perturbation_summary(perturbation) + ")") +
          (sensed ? "; the expert's feedback acted on " +

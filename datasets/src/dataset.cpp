@@ -113,14 +113,19 @@ Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& fea
 
 bool is_test_episode(std::size_t index) { return index % 5 == 4; }
 
+namespace {
+
+std::string episode_split_text(std::size_t test, std::size_t all) {
+  return "episodes: i % 5 == 4 is test (" + std::to_string(test) + " of " + std::to_string(all) + " episodes)";
+}
+
+}  // namespace
+
 Split split_by_episode(const std::vector<Episode>& episodes, const FeatureMap& features) {
   std::vector<const Episode*> train, test;
   for (std::size_t i = 0; i < episodes.size(); ++i) (is_test_episode(i) ? test : train).push_back(&episodes[i]);
   if (train.empty()) throw InputError("episode split: no training episode among " + std::to_string(episodes.size()));
-  Split s{stack(train, features), stack(test, features),
-          "episodes: i % 5 == 4 is test (" + std::to_string(test.size()) + " of " + std::to_string(episodes.size()) +
-              " episodes)"};
-  return s;
+  return {stack(train, features), stack(test, features), episode_split_text(test.size(), episodes.size())};
 }
 
 std::vector<std::size_t> numpy_legacy_permutation(std::size_t n, std::uint32_t seed) {
@@ -188,6 +193,12 @@ DemoSplit::DemoSplit(const std::vector<Episode>& episodes, const std::string& ru
   }
 }
 
+std::string DemoSplit::description() const {
+  if (rule_ == "episodes") return episode_split_text(held_out_.size(), all_.size());
+  if (rule_ == "none") return "none: all " + std::to_string(all_.size()) + " episodes are training";
+  return matrices().description;
+}
+
 const Split& DemoSplit::matrices(const FeatureMap& features) const {
   auto& slot = matrices_[features.name()];
   if (!slot) {
@@ -200,8 +211,7 @@ const Split& DemoSplit::matrices(const FeatureMap& features) const {
     } else if (rule_ == "rows") {
       slot = std::make_unique<Split>(split_by_rows(all_, 0.25, 42, features));
     } else {
-      slot = std::make_unique<Split>(Split{make_dataset(all_, features), make_dataset({}, features),
-                                           "none: all " + std::to_string(all_.size()) + " episodes are training"});
+      slot = std::make_unique<Split>(Split{make_dataset(all_, features), make_dataset({}, features), description()});
     }
   }
   return *slot;

@@ -31,9 +31,12 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// An arm's perturbation drawn in joint torques (draw_to_json): the keys version 5 adds.
-constexpr const char* kTorqueBiasKey = "joint_torque_bias";
-constexpr const char* kTorqueNoiseKey = "joint_torque_noise_std";
+// Whether an episode's entry holds the joint torques' draws (draw_to_json), which version 5 adds.
+bool holds_torque_draws(const json& entry) {
+  if (!entry.contains("perturbation") || !entry["perturbation"].is_object()) return false;
+  const json& p = entry["perturbation"];
+  return p.contains("joint_torque_bias") || p.contains("joint_torque_noise_std");
+}
 
 std::string episode_file_name(std::size_t index) {
   std::string digits = std::to_string(index);
@@ -78,9 +81,7 @@ void check_links_world(const Episode& e, const WorldConfig& world, const std::st
 json meta_with_entries(const DemoSet& set, json episodes) {
   const bool perturbed = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("perturbation"); });
   const bool arm = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("final_links"); });
-  const bool torque_draws = std::any_of(episodes.begin(), episodes.end(), [](const json& e) {
-    return e.contains("perturbation") && e["perturbation"].contains(kTorqueBiasKey);
-  });
+  const bool torque_draws = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return holds_torque_draws(e); });
   // Version 3 only adds the perturbation, version 4 an arm's readings, version 5 an arm's
   // perturbation drawn in joint torques too: a set without them is written as the version
   // before them.
@@ -318,7 +319,7 @@ DemoMeta parse_demo_meta(std::string_view text, const fs::path& meta_path) {
     if (version >= 3 && entry.contains("perturbation")) {
       if (!entry["perturbation"].is_object())
         meta_error(meta_path, "\"perturbation\" of " + e.file + " must be an object (the values its world drew)");
-      if (version < 5 && (entry["perturbation"].contains(kTorqueBiasKey) || entry["perturbation"].contains(kTorqueNoiseKey)))
+      if (version < 5 && holds_torque_draws(entry))
         meta_error(meta_path, "\"perturbation\" of " + e.file + " has the joint torques' bias or noise, which format version " +
                                   std::to_string(version) + " does not have (version 5 added them)");
       e.perturbation = entry["perturbation"].dump();

@@ -122,11 +122,6 @@ LeaderboardRow row_from(const json& j) {
   return r;
 }
 
-}  // namespace
-
-
-namespace {
-
 void check_one_of(const std::string& what, const std::string& value, const std::vector<std::string>& allowed) {
   if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return;
   std::string list;
@@ -218,6 +213,11 @@ void check_request(RunPlan& plan) {
   for (const auto& r : plan.regressors) RegressorRegistry::global().info(r);  // fail fast on typos
   if (opt.baselines.size() == 1 && opt.baselines[0] == "all") opt.baselines = baseline_names();
   for (const auto& b : opt.baselines) baseline(b);  // unknown names fail before any work
+  if (opt.controller == ActionKind::joint_torque && opt.split == "rows")
+    throw ConfigError("leaderboard --controller joint_torque: --split rows shuffles rows of the state map, which answers the "
+                      "cup's actions; use --split episodes");
+  if (opt.controller == ActionKind::joint_torque && !opt.baselines.empty())
+    throw ConfigError("leaderboard --controller joint_torque: the baselines act in the cup's actions; leave --baselines out");
   for (const auto& l : plan.learners)
     if (LearnerRegistry::global().info(plan.base(l)).needs_trajectories && opt.split == "rows")
       throw ConfigError("learner \"" + l + "\" learns from whole demonstrations; --split rows shuffles their rows: use --split episodes");
@@ -265,7 +265,7 @@ void require_torque_episodes(const RunPlan& plan) {
       if (e.links.size() != e.states.size() || (!e.actions.empty() && e.actions.front().kind() != ActionKind::joint_torque))
         throw ConfigError("leaderboard: " + learner + " fits the joint torques of the episodes it is given, and episode \"" +
                           e.name + "\" of " + plan.request.demos.string() + " holds the cup's actions (record --embodiment "
-                          "arm --controller joint_torque records torques); or leave it out (--learners dart,dagger)");
+                          "arm --controller joint_torque records torques); or leave it out (--learners dart:expert=tracker)");
   }
 }
 
@@ -277,7 +277,7 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   for (const auto& e : plan.set.episodes) frames += e.size();
   std::ostringstream header;
   header << "dicestack " DICESTACK_VERSION " leaderboard: demonstrations " << opt.demos.string() << " ("
-         << plan.set.episodes.size() << " episodes, " << frames << " frames); split " << split.matrices().description
+         << plan.set.episodes.size() << " episodes, " << frames << " frames); split " << split.description()
          << "; profile " << opt.profile << "; " << plan.episodes << " rollouts per training seed from " << start_distribution_name(opt.world) << " starts (seed "
          << opt.seed << "), " << opt.seeds << " training seed(s); rates with 95% Wilson intervals"
          << (opt.controller == ActionKind::joint_torque ? "; actions in joint torques" : "");
@@ -300,13 +300,14 @@ void describe_run(RunPlan& plan, const DemoSplit& split) {
   plan.header = header.str();
   plan.meta = {{"learner_options", learner_options}, {"features", row_features}, {"dicestack_version", DICESTACK_VERSION},
                {"demos", opt.demos.string()}, {"episodes_in_demos", plan.set.episodes.size()},
-               {"split", split.matrices().description}, {"profile", opt.profile}, {"rollouts_per_seed", plan.episodes},
+               {"split", split.description()}, {"profile", opt.profile}, {"rollouts_per_seed", plan.episodes},
                {"training_seeds", opt.seeds}, {"seed", opt.seed}};
   // Only a perturbed run names its perturbation: a nominal table and its progress file stay as they were.
   if (!plan.perturbation.nominal()) plan.meta["perturb"] = json::parse(perturbation_to_json(plan.perturbation));
   if (!opt.estimator.empty() && opt.estimator != "none" && senses(plan.perturbation)) plan.meta["estimator"] = opt.estimator;
   if (start_distribution_name(opt.world) != "random") plan.meta["start"] = start_distribution_name(opt.world);
   if (opt.controller != ActionKind::cup) plan.meta["controller"] = action_kind_name(opt.controller);
+  if (opt.world.embodiment == Embodiment::arm) plan.meta["embodiment"] = "arm";  // a cup's progress files stay as they were
 }
 
 // Resume: the rows of <out>.partial.json measured with the same settings, read by the root
@@ -507,7 +508,9 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
   plan.profile = &leaderboard_profile(opt.profile);
   plan.episodes = opt.episodes > 0 ? opt.episodes : plan.profile->rollouts;
   plan.regressors = opt.regressors.empty() ? RegressorRegistry::global().names() : opt.regressors;
-  plan.learners = opt.learners.empty() ? plan.profile->learners : opt.learners;
+  // In joint torques bc and dagger's default (include_demos) would fit the recordings' cup actions.
+  const std::vector<std::string> torque_learners{"dart:expert=tracker"};
+  plan.learners = !opt.learners.empty() ? opt.learners : opt.controller == ActionKind::joint_torque ? torque_learners : plan.profile->learners;
   check_request(plan);
   plan.perturbation = load_perturbation(opt.perturb, opt.world);  // before any work
   if (!opt.estimator.empty()) estimator_config(opt.estimator);  // a bad name, before any work
@@ -517,6 +520,7 @@ Leaderboard run_leaderboard(const LeaderboardRequest& request, const Leaderboard
     rollouts.threads = opt.threads;
     rollouts.perturbation = plan.perturbation;
     rollouts.actions = opt.controller;
+    if (!opt.estimator.empty()) rollouts.estimator = estimator_config(opt.estimator);
     check_evaluation(opt.world, rollouts);
   }
   plan.combos = row_combos(plan, say);  // a row that cannot train is refused before the demonstrations are read

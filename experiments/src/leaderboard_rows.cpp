@@ -213,7 +213,10 @@ LeaderboardRow RowRunner::combine(const std::string& learner, const std::string&
     const SeedResult& r = seeds[k];
     add_rollouts(row, s_.seed + k, r.results, r.success_preview, r.failure_preview);
     row.fit_s += r.fit_s / s_.seeds;
-    row.train_error += r.train_error / s_.seeds;
+    if (r.train_error < 0)
+      row.train_error = -1;  // no error (a map of the arm's links or torques): printed "-"
+    else
+      row.train_error += r.train_error / s_.seeds;
     if (!r.has_test)
       row.test_error = -1;  // no test episode: printed "-"
     else

@@ -73,7 +73,8 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
     if (channelled) seen.push_back(step.shown);
   }
   e.outcome = env.outcome();
-  if (world.perturbed()) e.perturbation = draw_to_json(world.draw());
+  if (world.perturbed())
+    e.perturbation = draw_to_json(world.draw(), e.actions.empty() ? ActionKind::cup : e.actions.front().kind());
   return e;
 }
 

@@ -88,8 +88,8 @@ class DiceStackVectorEnv(_VectorBase):
 
     @property
     def pending(self):
-        """Per environment, the (d, 3) actions that run before its next one under an action delay
-        (DiceStackEnv.pending); (0, 3) arrays without a delay."""
+        """Per environment, the (d, 3) actions ((d, 4) in joint torques) that run before its next
+        one under an action delay (DiceStackEnv.pending); (0, 3) or (0, 4) arrays without a delay."""
         return self._vec.pending
 
     @property

@@ -366,7 +366,7 @@ void bind_env_core(py::module_& m) {
             return py::make_tuple(to_array(obs), with_arm(info_dict(core.info()), core));
           },
           py::arg("seed") = py::none(), py::arg("state") = py::none(), py::arg("perturbation") = py::none())
-      .def_property_readonly("draw", [](const EnvCore& c) { return draw_to_json(c.draw()); })
+      .def_property_readonly("draw", [](const EnvCore& c) { return draw_to_json(c.draw(), c.controller()); })
       .def_property_readonly("perturbed", [](const EnvCore& c) { return c.draw().physics || c.draw().acts; })
       .def(
           "step",

@@ -900,7 +900,11 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
       {"train --demos " + kTinyDemos + arm + " --controller joint_torque --regressor knn --out " + model, "record --embodiment arm"},
       {"leaderboard --demos " + kTinyDemos + " --controller joint_torque --regressors knn --learners dart --episodes 1", "--embodiment arm"},
       {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners bc --episodes 1",
-       "--learners dart,dagger"},
+       "--learners dart:expert=tracker"},
+      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --estimator kalman --episodes 1",
+       "an estimator rebuilds worlds without the arm's links"},
+      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --baselines de --episodes 1",
+       "the baselines act in the cup's actions"},
       {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners dart --features state "
        "--episodes 1", "answers cup actions, not the --controller joint_torque ones"}};
   for (const auto& [args, message] : refused) {
@@ -919,6 +923,11 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
   EXPECT_EQ(board["rows"][0]["features"], "state+links+clock+start_state@dice+retry/osc");
   EXPECT_EQ(board["rows"][0]["train_error"], -1);
   EXPECT_EQ(board["rows"][0]["episodes"], 2);
+  // bc learns its row from a set recorded on the arm in torques: the evaluation's rollouts above.
+  p = run("leaderboard --demos " + (dir / "set").string() + arm + " --controller joint_torque --regressors knn --learners bc "
+          "--episodes 1 --format json", false);
+  ASSERT_EQ(p.status, 0) << p.output;
+  EXPECT_EQ(nlohmann::json::parse(p.output)["rows"][0]["learner"], "bc");
   std::filesystem::remove_all(dir);
 }
 

@@ -222,9 +222,10 @@ TEST(Perturbation, JointTorquesGetTheirOwnDrawsAfterTheCupsFromTheTorqueLimits) 
     EXPECT_NE(d.torque_bias[k], 0.0);
     EXPECT_LT(std::abs(d.torque_bias[k]), 5 * 0.015 * arm.arm.torque_limit[k]);
   }
-  // Only an arm's record names them, and they read back.
+  // Only the record of an episode in joint torques names them, and they read back.
   EXPECT_EQ(draw_to_json(cup).find("joint_torque"), std::string::npos);
-  const PerturbationDraw back = channel_draw_from_json(draw_to_json(d), "e");
+  EXPECT_EQ(draw_to_json(d).find("joint_torque"), std::string::npos) << "the arm's episode in the cup's actions";
+  const PerturbationDraw back = channel_draw_from_json(draw_to_json(d, ActionKind::joint_torque), "e");
   EXPECT_EQ(back.torque_bias, d.torque_bias);
   EXPECT_EQ(back.torque_noise, d.torque_noise);
   EXPECT_THAT(test::error_of([] { channel_draw_from_json(R"({"joint_torque_noise_std": [1, 2, -3, 4]})", "e"); }),

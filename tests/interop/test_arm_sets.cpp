@@ -104,6 +104,14 @@ TEST(ArmSets, AnArmsTorqueDrawsAreVersionFiveAndAVersionFourSetCannotHoldThem) {
   expect_same(set, read_demo_set(dir));
   EXPECT_EQ(set.episodes[0].actions[0].kind(), ActionKind::joint_torque) << "the torques as chosen";
 
+  // Perturbed in the cup's actions, the arm's set stays version 4.
+  DemoSet cup_actions = set;
+  cup_actions.episodes = record_expert("scripted", {}, set.world, request);
+  for (std::size_t i = 0; i < cup_actions.episodes.size(); ++i) cup_actions.episodes[i].name = "episode_000" + std::to_string(i);
+  const fs::path cup_dir = scratch("arm_cup_draws");
+  write_demo_set(cup_actions, cup_dir);
+  EXPECT_EQ(nlohmann::json::parse(text_of(cup_dir / "meta.json"))["version"], 4);
+
   meta["version"] = 4;
   write_text(dir / "meta.json", meta.dump());
   EXPECT_THAT(test::error_of([&] { read_demo_set(dir); }),

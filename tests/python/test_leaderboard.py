@@ -85,5 +85,5 @@ def test_bad_arguments_raise(demos):
         dicestack.leaderboard(["knn"], ["dart"], demos, controller="torque", progress=False)
     with pytest.raises(ValueError, match="--embodiment arm"):
         dicestack.leaderboard(["knn"], ["dart"], demos, controller="joint_torque", progress=False)
-    with pytest.raises(ValueError, match="--learners dart,dagger"):
+    with pytest.raises(ValueError, match="--learners dart:expert=tracker"):
         dicestack.leaderboard(["knn"], ["bc"], demos, embodiment="arm", controller="joint_torque", progress=False)

@@ -316,7 +316,7 @@ PerturbationDraw draw_perturbation(const Perturbation& p, const WorldConfig& wor
   return d;
 }
 
-std::string draw_to_json(const PerturbationDraw& d) {
+std::string draw_to_json(const PerturbationDraw& d, ActionKind actions) {
   const WorldConfig& w = d.world;
   json j{{"dice_friction", w.dice.friction},
          {"cup_friction", w.cup.friction},
@@ -333,8 +333,8 @@ std::string draw_to_json(const PerturbationDraw& d) {
          {"start_cup_lift", w.randomization.cup_lift},
          {"start_cup_tilt", w.randomization.cup_tilt},
          {"noise_seed", d.noise_seed}};
-  // Only an arm's episode can run joint torques; a cup's record stays as it was.
-  if (w.embodiment == Embodiment::arm) {
+  // Only an episode in joint torques met them; any other's record stays as it was.
+  if (actions == ActionKind::joint_torque) {
     j["joint_torque_bias"] = d.torque_bias;
     j["joint_torque_noise_std"] = d.torque_noise;
   }

@@ -72,6 +72,9 @@ class DemoSplit {
   /// The split's matrices through `features`, made once per map (not thread-safe). Under "rows"
   /// only the state map: ConfigError for a map that reads an episode's history.
   const Split& matrices(const FeatureMap& features = state_features()) const;
+  /// What matrices().description says, without making rows (a set whose actions the state map
+  /// does not answer, such as joint torques, has none of its rows).
+  std::string description() const;
 
  private:
   std::vector<Episode> all_, train_, held_out_;

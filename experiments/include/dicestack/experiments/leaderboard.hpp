@@ -46,7 +46,8 @@ struct LeaderboardRequest {
   /// What the rows' policies answer: the cup's actions, or joint torques on an arm world (each
   /// learner's own map in torques, torque_map_name; learned by dart and dagger from their
   /// experts, by bc from a set recorded on the arm in torques; no train or test error, as the
-  /// recordings hold another controller's actions or none to score).
+  /// recordings hold another controller's actions or none to score). Default learners then:
+  /// dart:expert=tracker. No baselines (they act in the cup's actions) and no row split.
   ActionKind controller = ActionKind::cup;
   /// Where the table will be written (empty: nowhere): it and <out>.partial.json are checked
   /// before any work (a user's file is refused), and finished rows go to <out>.partial.json as

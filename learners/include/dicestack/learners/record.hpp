@@ -47,8 +47,7 @@ struct RecordRequest {
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& expert, const WorldConfig& world,
                                    const RecordRequest& request, Cluster& cluster = local_cluster());
 
-/// Throws ConfigError for an expert in joint torques without an arm or under factors drawn for
-/// the cup's actions (an action delay, action noise or bias), and for an estimator nothing reads
+/// Throws ConfigError for an expert in joint torques without an arm, and for an estimator nothing reads
 /// (the expert's feedback on the world) or that cannot run (an expert answering joint torques:
 /// its worlds are rebuilt from the 24 observed numbers, without an arm's links). What
 /// record_expert checks first, for callers that check before other work.

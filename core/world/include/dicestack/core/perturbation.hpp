@@ -109,8 +109,9 @@ PerturbationDraw draw_perturbation(const Perturbation& p, const WorldConfig& wor
 
 /// The values an episode drew, as a JSON object (the per-episode "perturbation" of saved sets
 /// and of the Python environment's info; docs/formats.md): frictions, masses, gravity, the action
-/// bias and noise, the delays, the observation noise and the start ranges.
-std::string draw_to_json(const PerturbationDraw& draw);
+/// bias and noise, the delays, the observation noise and the start ranges; for an episode whose
+/// `actions` are joint torques, their bias and noise too.
+std::string draw_to_json(const PerturbationDraw& draw, ActionKind actions = ActionKind::cup);
 
 /// The actuation and sensing of a draw saved by draw_to_json (what a PerturbedChannel needs to
 /// replay an episode's observations: the noises' std, the bias, the delays and the noise seed);
