@@ -77,6 +77,32 @@ TEST(Perturbed, AnExpertPlansInEachEpisodesOwnWorldOnAnyThreadCount) {
   for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].states, two[i].states) << i;
 }
 
+TEST(Perturbed, AnExpertInJointTorquesMeetsTheirDelayNoiseAndBiasTheSameOnAnyThreadCount) {
+  WorldConfig w = test::short_world(30);
+  w.embodiment = Embodiment::arm;
+  ExpertConfig torques;
+  torques.controller = ActionKind::joint_torque;
+  const PolicyFactory scripted = [torques] { return std::make_unique<OwnedExpertPolicy>(make_expert("scripted", torques)); };
+  std::vector<Episode> one, two, nominal;
+  EvalRequest r = test::eval_request(3, 8, 1, &one);
+  r.actions = ActionKind::joint_torque;
+  r.perturbation = perturbation_factor("action_noise", "medium");
+  r.perturbation.action_delay = 2;
+  evaluate(scripted, w, r);
+  r.threads = 2;
+  r.rollouts = &two;
+  evaluate(scripted, w, r);
+  EvalRequest clean = test::eval_request(3, 8, 2, &nominal);
+  clean.actions = ActionKind::joint_torque;
+  evaluate(scripted, w, clean);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].states, two[i].states) << i;
+    EXPECT_NE(one[i].states, nominal[i].states) << i;
+    EXPECT_NE(one[i].perturbation.find("joint_torque_noise_std"), std::string::npos) << "its record names the torques' draws";
+  }
+}
+
 // A draw with nothing on but what the caller sets next.
 PerturbationDraw bare_draw(const WorldConfig& w) {
   PerturbationDraw d = draw_perturbation(Perturbation{}, w, 1);
