@@ -58,7 +58,7 @@ int run_curve(const LeaderboardOptions& opt, CLI::App& cmd, Cluster& cluster) {
 
 int run_leaderboard(const LeaderboardOptions& opt, Cluster& cluster) {
   LeaderboardRequest request = opt.request;
-  request.controller = opt.controller == "joint_torque" ? ActionKind::joint_torque : ActionKind::cup;
+  request.controller = controller_kind(opt.controller);
   request.world = opt.world.load();
   request.demos = opt.demos.resolve(request.world, cluster);
   request.cluster = &cluster;
@@ -142,12 +142,10 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
                   "training stays nominal")
       ->capture_default_str();
   add_estimator_option(*cmd, r.estimator);
-  cmd->add_option("--controller", opt->controller,
-                  "What the rows' policies answer: cup (the cup's velocity changes) or joint_torque (the arm's four torques, "
-                  "with --embodiment arm: each learner's map in torques; dart and dagger learn them from their experts, bc "
-                  "from a set recorded on the arm; default learners then dart:expert=tracker; docs/arm.md)")
-      ->check(CLI::IsMember({"cup", "joint_torque"}))
-      ->capture_default_str();
+  add_controller_option(*cmd, opt->controller,
+                        "What the rows' policies answer: cup (the cup's velocity changes) or joint_torque (the arm's four "
+                        "torques, with --embodiment arm: each learner's map in torques; dart and dagger learn them from their "
+                        "experts, bc from a set recorded on the arm; default learners then dart:expert=tracker; docs/arm.md)");
   cmd->add_option("--recordings", opt->recordings,
                   "Instead of the table, a learning curve: realistic success against the number of recordings each "
                   "policy learns from (comma-separated numbers, e.g. 1,3,10,68; default learners dart:expert=tracker "

@@ -99,7 +99,7 @@ int run_record(const RecordOptions& opt, Cluster& cluster) {
   ExpertConfig expert;
   expert.replan = !opt.no_replan;
   expert.retry = opt.retry;
-  if (opt.controller == "joint_torque") expert.controller = ActionKind::joint_torque;
+  expert.controller = controller_kind(opt.controller);
   check_record_request(expert.controller, world, request);
   std::string recordings;  // for the provenance
   std::string followed;    // the tracker's paths, best-ranked first

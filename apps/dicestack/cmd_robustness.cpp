@@ -97,7 +97,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     run.record = model->record;
   } else {
     ExpertConfig config;
-    if (opt.controller == "joint_torque") config.controller = ActionKind::joint_torque;
+    config.controller = controller_kind(opt.controller);
     if (opt.expert == "tracker") {
       if (opt.demos.empty()) throw ConfigError("robustness: --expert tracker follows recordings: give them with --demos");
       const TrackerConfig tracker = opt.tracker.config_for(config.controller);  // simulating what it will answer

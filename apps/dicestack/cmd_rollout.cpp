@@ -55,7 +55,7 @@ class BuiltinController final : public Policy {
 
 int run_rollout(const RolloutOptions& opt) {
   const WorldConfig config = opt.world.load();
-  const ActionKind kind = opt.controller == "joint_torque" ? ActionKind::joint_torque : ActionKind::cup;
+  const ActionKind kind = controller_kind(opt.controller);
   if (kind == ActionKind::joint_torque && config.embodiment != Embodiment::arm)
     throw ConfigError("rollout: --controller joint_torque drives an arm's joints: give --embodiment arm");
   DiceEnv env(config);
@@ -113,11 +113,9 @@ void add_rollout_command(CLI::App& app) {
   cmd->add_option("--actions", opt->actions, "Actions: random (uniform in the optimisers' scale, or within the torque limits) or still (zero)")
       ->check(CLI::IsMember({"random", "still"}))
       ->capture_default_str();
-  cmd->add_option("--controller", opt->controller,
-                  "What the actions drive: cup (its velocity changes; on the arm through the cup controller) or joint_torque "
-                  "(the arm's four torques, with --embodiment arm; still: none, and the arm falls)")
-      ->check(CLI::IsMember({"cup", "joint_torque"}))
-      ->capture_default_str();
+  add_controller_option(*cmd, opt->controller,
+                        "What the actions drive: cup (its velocity changes; on the arm through the cup controller) or "
+                        "joint_torque (the arm's four torques, with --embodiment arm; still: none, and the arm falls)");
   cmd->add_option("--steps", opt->steps, "Control steps (default and most: the world's episode.max_steps, where the episode is truncated)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--png", opt->png, "Render the last frame to this PNG");

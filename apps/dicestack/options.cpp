@@ -152,13 +152,18 @@ CLI::Validator threads_check() {
       "THREADS");
 }
 
+CLI::Option* add_controller_option(CLI::App& cmd, std::string& name, const std::string& help) {
+  return cmd.add_option("--controller", name, help)->check(CLI::IsMember({"cup", "joint_torque"}))->capture_default_str();
+}
+
+ActionKind controller_kind(const std::string& name) {
+  return name == "joint_torque" ? ActionKind::joint_torque : ActionKind::cup;
+}
+
 CLI::Option* add_expert_controller_option(CLI::App& cmd, std::string& name) {
-  return cmd
-      .add_option("--controller", name,
-                  "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup actions "
-                  "told in the joint torques the cup controller held)")
-      ->check(CLI::IsMember({"cup", "joint_torque"}))
-      ->capture_default_str();
+  return add_controller_option(cmd, name,
+                               "What the expert answers on the arm: cup (the cup's velocity change) or joint_torque (its cup "
+                               "actions told in the joint torques the cup controller held)");
 }
 
 CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name) {

@@ -58,6 +58,10 @@ CLI::Option* add_estimator_option(CLI::App& cmd, std::string& name);
 /// `--controller cup|joint_torque` for a command that runs an expert: what it answers on the arm
 /// (default cup). Returns the option, so a command can say more in its description.
 CLI::Option* add_expert_controller_option(CLI::App& cmd, std::string& name);
+/// `--controller cup|joint_torque` with `help` (default: what `name` holds), and the kind a name
+/// checked by it stands for.
+CLI::Option* add_controller_option(CLI::App& cmd, std::string& name, const std::string& help);
+ActionKind controller_kind(const std::string& name);
 
 /// The median of `v` (the benchmarks' figure over repeated runs); 0 for none.
 double median(std::vector<double> v);
