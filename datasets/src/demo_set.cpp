@@ -82,9 +82,8 @@ json meta_with_entries(const DemoSet& set, json episodes) {
   const bool perturbed = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("perturbation"); });
   const bool arm = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return e.contains("final_links"); });
   const bool torque_draws = std::any_of(episodes.begin(), episodes.end(), [](const json& e) { return holds_torque_draws(e); });
-  // Version 3 only adds the perturbation, version 4 an arm's readings, version 5 an arm's
-  // perturbation drawn in joint torques too: a set without them is written as the version
-  // before them.
+  // Version 3 only adds the perturbation, version 4 an arm's readings, version 5 the draws of a
+  // perturbed episode in joint torques: a set without them is written as the version before.
   json units{{"length", "m"},
              {"angle", "rad"},
              {"time", "s"},
