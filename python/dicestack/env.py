@@ -163,8 +163,9 @@ class DiceStackEnv(_EnvBase):
     @property
     def pending(self):
         """Under an action delay of d steps, the (d, 3) actions that run before the next one chosen
-        ((d, 4) in joint torques), in order (zeros before the first choice lands); none without a delay. A policy on an
-        "/ahead" feature map takes it: policy.act(obs, pending=env.pending, unseen=env.unseen)."""
+        ((d, 4) in joint torques), in order (zeros before the first choice lands); none without a
+        delay. A policy on an "/ahead" feature map takes it: policy.act(obs, pending=env.pending,
+        unseen=env.unseen)."""
         return self._env.pending
 
     @property
