@@ -37,8 +37,8 @@ std::optional<PerturbedChannel> replayed_channel(const Episode& e, const Feature
   return PerturbedChannel(d, features.action_kind());
 }
 
-// Throws InputError naming the episode if `features` cannot make its rows: a map of the arm's
-// links on an episode without them, or labels of another controller's actions.
+}  // namespace
+
 void check_rows_of(const Episode& e, const FeatureMap& features) {
   if (features.reads_links() && e.links.size() != e.states.size())
     throw InputError("episode \"" + e.name + "\": feature map \"" + features.name() +
@@ -53,6 +53,8 @@ void check_rows_of(const Episode& e, const FeatureMap& features) {
                             ? " (record --embodiment arm --controller joint_torque records torques)"
                             : ""));
 }
+
+namespace {
 
 Dataset stack(const std::vector<const Episode*>& episodes, const FeatureMap& features, const RowFilter& rows = {}) {
   std::size_t n = 0;

@@ -257,15 +257,16 @@ std::vector<std::pair<std::string, std::string>> row_combos(const RunPlan& plan,
 }
 
 // A bc row in joint torques fits the set's own actions: they must be torques, with the links
-// they were read with (dart and dagger take theirs from their experts).
+// they were read with (dart and dagger take theirs from their experts). Checked before any row.
 void require_torque_episodes(const RunPlan& plan) {
   for (const auto& [learner, features] : plan.combos) {
     if (plan.base(learner) != "bc" || feature_map(features).action_kind() != ActionKind::joint_torque) continue;
-    for (const Episode& e : plan.set.episodes)
-      if (e.links.size() != e.states.size() || (!e.actions.empty() && e.actions.front().kind() != ActionKind::joint_torque))
-        throw ConfigError("leaderboard: " + learner + " fits the joint torques of the episodes it is given, and episode \"" +
-                          e.name + "\" of " + plan.request.demos.string() + " holds the cup's actions (record --embodiment "
-                          "arm --controller joint_torque records torques); or leave it out (--learners dart:expert=tracker)");
+    try {
+      for (const Episode& e : plan.set.episodes) check_rows_of(e, feature_map(features));
+    } catch (const InputError& e) {
+      throw ConfigError("leaderboard: " + learner + " fits the joint torques of the episodes of " + plan.request.demos.string() +
+                        ": " + e.what() + "; or leave it out (--learners dart:expert=tracker)");
+    }
   }
 }
 

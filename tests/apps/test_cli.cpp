@@ -793,6 +793,7 @@ TEST(CliLearning, RecordInJointTorquesKeepsThemAsTheActionsAndNeedsTheArm) {
   EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("refined only with --tracker refine=N"));
   // Which path it plays is said before the episodes, and kept with the set.
   EXPECT_THAT(tracked.output, HasSubstr("the tracker follows episode_"));
+  EXPECT_THAT(tracked.output, HasSubstr(" of 2 probe trials)")) << "--tracker probes=1 as given, not raised to 32";
   EXPECT_THAT(file_text(dir / "meta.json"), HasSubstr("), ranked episode_"));
   std::filesystem::remove_all(dir);
   Process bad = run("record --expert scripted --episodes 1 --controller joint_torque --out " + dir.string());
@@ -919,15 +920,17 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
   ASSERT_EQ(p.status, 0) << p.output;
   const auto board = nlohmann::json::parse(p.output);
   EXPECT_EQ(board["controller"], "joint_torque");
+  EXPECT_EQ(board["embodiment"], "arm");
   ASSERT_GE(board["rows"].size(), 1u);
   EXPECT_EQ(board["rows"][0]["features"], "state+links+clock+start_state@dice+retry/osc");
   EXPECT_EQ(board["rows"][0]["train_error"], -1);
   EXPECT_EQ(board["rows"][0]["episodes"], 2);
   // bc learns its row from a set recorded on the arm in torques: the evaluation's rollouts above.
   p = run("leaderboard --demos " + (dir / "set").string() + arm + " --controller joint_torque --regressors knn --learners bc "
-          "--episodes 1 --format json", false);
+          "--episodes 1 --seeds 6 --format json", false);
   ASSERT_EQ(p.status, 0) << p.output;
   EXPECT_EQ(nlohmann::json::parse(p.output)["rows"][0]["learner"], "bc");
+  EXPECT_EQ(nlohmann::json::parse(p.output)["rows"][0]["train_error"], -1) << "no error over any number of seeds";
   std::filesystem::remove_all(dir);
 }
 

@@ -29,6 +29,11 @@ struct Dataset {
 /// corrections carry the rollout before them so that a map reads their whole episode).
 using RowFilter = std::function<bool(const Episode& episode, std::size_t step)>;
 
+/// Throws InputError naming the episode if `features` cannot make its rows: a map of the arm's
+/// links on an episode without them, or labels of another controller's actions (make_dataset's
+/// check, for callers that check before other work).
+void check_rows_of(const Episode& episode, const FeatureMap& features);
+
 /// Stacks the episodes in the given order; row t of an episode is `features` of its history up
 /// to step t, for every t `rows` keeps. Throws InputError if an episode is malformed.
 Dataset make_dataset(const std::vector<Episode>& episodes, const FeatureMap& features = state_features(),
