@@ -144,8 +144,8 @@ void add_leaderboard_command(CLI::App& app, Cluster& cluster) {
   add_estimator_option(*cmd, r.estimator);
   add_controller_option(*cmd, opt->controller,
                         "What the rows' policies answer: cup (the cup's velocity changes) or joint_torque (the arm's four "
-                        "torques, with --embodiment arm: each learner's map in torques; dart and dagger learn them from their "
-                        "experts, bc from a set recorded on the arm; default learners then dart:expert=tracker; docs/arm.md)");
+                        "torques, with --embodiment arm: each learner's map in torques; dart, dagger and dad (starts=training, "
+                        "corrector=track) learn them from their experts, bc from a set recorded on the arm; default learners then dart:expert=tracker; docs/arm.md)");
   cmd->add_option("--recordings", opt->recordings,
                   "Instead of the table, a learning curve: realistic success against the number of recordings each "
                   "policy learns from (comma-separated numbers, e.g. 1,3,10,68; default learners dart:expert=tracker "

@@ -102,7 +102,7 @@ void add_train_command(CLI::App& app, Cluster& cluster) {
                   "learners`, docs/reference/learners.md)");
   cmd->add_option("--controller", opt->controller,
                   "What the policy's actions drive: cup (velocity changes; on the arm through its operational-space "
-                  "controller) or joint_torque (the arm's four torques: dart or dagger, or bc on a set recorded on the arm in them, with --embodiment arm; the default "
+                  "controller) or joint_torque (the arm's four torques: dart, dagger, dad with starts=training and corrector=track, or bc on a set recorded on the arm in them, with --embodiment arm; the default "
                   "map then reads the arm's links and answers the cup pose and the posture's acceleration that operational-space control turns into the torques: /osc). Default: what the feature map answers")
       ->check(CLI::IsMember({"cup", "joint_torque"}));
   cmd->add_option("--split", opt->split,

@@ -11,13 +11,16 @@
 namespace dicestack {
 
 double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
-                   std::vector<State>* states) {
+                   std::vector<State>* states, std::vector<ArmLinks>* links) {
   env.restore(problem.start);
   if (states) states->clear();
+  if (links) links->clear();
+  const bool arm = env.config().embodiment == Embodiment::arm;
   double cost = 0.0;
   const CostConfig& c = env.config().cost;
   for (std::size_t j = 0; j < problem.target.size(); ++j) {
     if (states) states->push_back(env.get_state());
+    if (links && arm) links->push_back(env.world().arm_links());
     env.step(actions[j]);
     const State now = env.get_state();
     switch (problem.aim) {
@@ -45,6 +48,8 @@ class SequenceCorrector final : public Corrector {
   SequenceCorrector(std::string method, const CorrectorOptions& o) : method_(std::move(method)), options_(o) {}
 
   Correction correct(DiceEnv& env, const CorrectionProblem& p, std::uint64_t seed) const override {
+    if (p.actions != ActionKind::cup)
+      throw InputError("corrector " + method_ + ": a window in joint torques is corrected by track alone");
     const ActionSequenceProblem window(env.config(), static_cast<int>(p.target.size()), ActionBox::limits,
                                        [&p](DiceEnv& e, const std::vector<Action>& actions) { return window_cost(e, p, actions); });
     const Eigen::VectorXd warm = window.point(p.warm);
@@ -67,7 +72,7 @@ class SequenceCorrector final : public Corrector {
     SequenceEvaluator evaluator(env);
     const MinimiseResult found = minimise(window, evaluator, o);
     if (options_.random_start || found.best_cost < c.warm_cost) c.actions = window.actions(found.best.data());
-    c.cost = window_cost(env, p, c.actions, &c.states);  // deterministic: the cost found
+    c.cost = window_cost(env, p, c.actions, &c.states, &c.links);  // deterministic: the cost found
     c.evaluations = found.evaluations + 2;               // with the warm start's and this one
     return c;
   }
@@ -79,7 +84,8 @@ class SequenceCorrector final : public Corrector {
 
 // The tracker's feedback law (core/tracker.hpp) along the demonstration's own path: from the
 // drifted world the cup is steered back onto the recorded cup path; nothing is searched. The
-// warm start (the policy's own actions) stays the answer if it follows the path better.
+// warm start (the policy's own actions) stays the answer if it follows the path better. In
+// joint torques each cup action is told in torques, as the tracker told in them acts.
 class TrackCorrector final : public Corrector {
  public:
   explicit TrackCorrector(double gain) : gain_(gain) {}
@@ -94,11 +100,12 @@ class TrackCorrector final : public Corrector {
     const PathFollower follower(path, {}, p.reference.front(), env.t(), gain_);
     std::vector<Action> actions;
     for (std::size_t j = 0; j < p.target.size(); ++j) {
-      actions.push_back(env.step(follower.act(env.get_state(), env.t())).applied);
+      const Action cup = follower.act(env.get_state(), env.t());
+      actions.push_back(env.step(p.actions == ActionKind::cup ? cup : told_in_torques(env, cup)).applied);
     }
     const double cost = window_cost(env, p, actions);
     c.actions = cost < c.warm_cost ? actions : p.warm;
-    c.cost = window_cost(env, p, c.actions, &c.states);
+    c.cost = window_cost(env, p, c.actions, &c.states, &c.links);
     c.evaluations = 3;
     return c;
   }

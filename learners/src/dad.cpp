@@ -36,6 +36,7 @@ struct DadPlan {
   std::size_t demos = 0;       // demonstrations as targets (0: all)
   int episodes = 0;            // training starts the tracker runs from
   bool retry = false;          // the tracker tries again (from training starts)
+  ActionKind actions = ActionKind::cup;  // what the map answers, and so the corrections' labels
 
   std::string summary() const {
     static const char* aims[] = {"state", "cup", "dice"};
@@ -56,6 +57,16 @@ struct Task {
   std::size_t t = 0;
   CorrectionProblem problem;
 };
+
+// The cup action that takes a floating cup from `before` to `after`'s velocity (its velocity
+// change before gravity's pull over the step). A target recorded in joint torques holds no cup
+// actions, and the tracker's feedback law follows the velocity during each recorded step.
+Action cup_action_between(const State& before, const State& after, const WorldConfig& world) {
+  namespace si = state_index;
+  const double dt = world.physics.control_dt;
+  return {after[si::kCupVx] - before[si::kCupVx] - world.physics.gravity.x * dt,
+          after[si::kCupVy] - before[si::kCupVy] - world.physics.gravity.y * dt, after[si::kCupW] - before[si::kCupW]};
+}
 
 // A correction carries the rollout before its window as history (the policy's steps): those are
 // not rows. A demonstration's steps all are, whoever chose them.
@@ -195,7 +206,8 @@ class Dad final : public Learner {
     std::vector<ParamSpec> out{{"windows", ParamType::integer, "10", 1, 1000, "window sizes: k/windows of each demonstration, k = 1..windows", {}},
             {"iterations", ParamType::integer, "3", 1, 1000, "iterations per window", {}},
             {"corrector", ParamType::choice, "cmaes", 0, 0,
-             "how each window's actions are found: an optimiser, or track (the tracker's feedback law, no search)",
+             "how each window's actions are found: an optimiser, or track (the tracker's feedback law, no search; a map in "
+             "joint torques takes track alone)",
              corrector_names()},
             {"target", ParamType::choice, "cup", 0, 0,
              "what corrections steer back to: cup (the recording's cup path) or state (all its recorded states, eq. 11 "
@@ -354,6 +366,7 @@ class Dad final : public Learner {
     p.demos = static_cast<std::size_t>(params().integer("demos"));
     p.episodes = static_cast<int>(params().integer("episodes"));
     p.retry = expert_retries(params().choice("retry"), features);
+    p.actions = feature_map(features).action_kind();
     return p;
   }
 
@@ -446,11 +459,14 @@ class Dad final : public Learner {
       options.max_steps = steps;
       options.before_step = [&](const DiceEnv& at, std::size_t t) {
         if (t % width != 0 || t >= steps) return;
-        Task task{d, t, {at.snapshot(), {}, {}, plan.aim, {}, {}}};
+        Task task{d, t, {at.snapshot(), {}, {}, plan.aim, {}, {}, plan.actions}};
         for (std::size_t j = t + 1; j < len && j <= t + width; ++j) {
           task.problem.target.push_back(demo.states[j]);
           task.problem.reference.push_back(demo.states[j - 1]);
-          task.problem.reference_actions.push_back(demo.actions[j - 1]);
+          const Action& recorded = demo.actions[j - 1];
+          task.problem.reference_actions.push_back(recorded.kind() == ActionKind::cup
+                                                       ? recorded
+                                                       : cup_action_between(demo.states[j - 1], demo.states[j], at.config()));
         }
         per_demo[d].push_back(std::move(task));
       };
@@ -463,7 +479,9 @@ class Dad final : public Learner {
       const std::vector<Action>& actions = rollouts[d].actions;
       for (auto& task : per_demo[d])  // the policy's own actions, held at zero past its episode's end
         for (std::size_t j = 0; j < task.problem.target.size(); ++j)
-          task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j] : Action{0.0, 0.0, 0.0});
+          task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j]
+                                      : plan.actions == ActionKind::cup ? Action{0.0, 0.0, 0.0}
+                                                                        : Action::torques({0.0, 0.0, 0.0, 0.0}));
     });
     std::vector<Task> tasks;
     for (auto& v : per_demo)
@@ -497,7 +515,7 @@ class Dad final : public Learner {
 
   static std::string pack_correction(const Correction& fix) {
     Packer p;
-    p.put_vector(fix.states).put_vector(fix.actions).put(fix.cost).put(fix.warm_cost).put(fix.evaluations);
+    p.put_vector(fix.states).put_vector(fix.actions).put_vector(fix.links).put(fix.cost).put(fix.warm_cost).put(fix.evaluations);
     return p.take();
   }
 
@@ -506,6 +524,7 @@ class Dad final : public Learner {
     Correction fix;
     fix.states = u.get_vector<State>();
     fix.actions = u.get_vector<Action>();
+    fix.links = u.get_vector<ArmLinks>();
     fix.cost = u.get<double>();
     fix.warm_cost = u.get<double>();
     fix.evaluations = u.get<int>();
@@ -518,11 +537,14 @@ class Dad final : public Learner {
     e.name = "dad_" + std::to_string(iteration) + "_" + demo.name + "_" + std::to_string(t);
     e.seed = demo.seed;
     e.origin = std::string(kMadeAt) + std::to_string(iteration) + ": correction of " + demo.name + " from step " + std::to_string(t);
+    const auto cut = static_cast<std::ptrdiff_t>(t);
     if (before) {
-      e.states.assign(before->states.begin(), before->states.begin() + static_cast<std::ptrdiff_t>(t));
-      e.actions.assign(before->actions.begin(), before->actions.begin() + static_cast<std::ptrdiff_t>(t));
+      e.states.assign(before->states.begin(), before->states.begin() + cut);
+      e.actions.assign(before->actions.begin(), before->actions.begin() + cut);
       e.sources.assign(t, StepSource::policy);
+      if (!fix.links.empty()) e.links.assign(before->links.begin(), before->links.begin() + cut);
     }
+    e.links.insert(e.links.end(), fix.links.begin(), fix.links.end());
     e.states.insert(e.states.end(), fix.states.begin(), fix.states.end());
     e.actions.insert(e.actions.end(), fix.actions.begin(), fix.actions.end());
     e.sources.resize(e.states.size(), StepSource::correction);

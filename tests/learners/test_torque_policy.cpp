@@ -3,7 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -125,6 +127,43 @@ TEST(TorquePolicy, DaggerLearnsTheTrackersTorquesAndResumesFromItsCheckpoint) {
   std::filesystem::remove_all(c.checkpoint_dir);
 }
 
+// DaD on the arm: the tracker's targets in torques from training starts, each window of the
+// policy's own rollout steered back by the feedback law told in torques. Its corrections keep the
+// links they were made at, in its checkpoint too, and a resumed run ends where a whole one does.
+TEST(TorquePolicy, DadCorrectsItsOwnRolloutsInTorquesAndResumesFromItsCheckpoint) {
+  LearnContext c = arm_context();
+  c.world = WorldConfig{};
+  c.world.embodiment = Embodiment::arm;
+  c.demos = test::human_six();
+  c.demos.resize(3);
+  c.features = "state+links+clock+start_state@dice+retry/osc";
+  const std::vector<std::string> options{"starts=training", "episodes=2",      "windows=1",        "iterations=2",
+                                         "corrector=track", "keep_best=false", "tracker_probes=1", "tracker_robust=1",
+                                         "tracker_variants=false"};
+  const LearnResult whole = LearnerRegistry::global().create("dad", options)->learn(c);
+  EXPECT_EQ(whole.model->features().action_kind(), ActionKind::joint_torque);
+  EXPECT_GT(std::stoi(whole.model->record.at("dad_corrections_kept")), 0);
+
+  // Killed when iteration 2 starts, then resumed.
+  c.checkpoint_dir = test::scratch_path("dicestack_dad_torques");
+  std::filesystem::remove_all(c.checkpoint_dir);
+  c.progress = [](const Progress& p) {
+    if (p.iteration == 2) throw std::runtime_error("killed");
+  };
+  EXPECT_THROW(LearnerRegistry::global().create("dad", options)->learn(c), std::runtime_error);
+  c.progress = nullptr;
+  const DemoSet data = read_demo_set(c.checkpoint_dir / "data-1");
+  const auto correction = std::find_if(data.episodes.begin(), data.episodes.end(),
+                                       [](const Episode& e) { return e.origin.starts_with("dad iteration 1"); });
+  ASSERT_NE(correction, data.episodes.end());
+  EXPECT_EQ(correction->actions.back().kind(), ActionKind::joint_torque);
+  EXPECT_EQ(correction->links.size(), correction->size());
+  c.resume = true;
+  const LearnResult resumed = LearnerRegistry::global().create("dad", options)->learn(c);
+  EXPECT_EQ(resumed.model->regressor().save_payload(), whole.model->regressor().save_payload());
+  std::filesystem::remove_all(c.checkpoint_dir);
+}
+
 TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   LearnContext c = arm_context();
   const auto refused = [&](const std::string& learner, const std::vector<std::string>& options) {
@@ -134,10 +173,18 @@ TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   EXPECT_THAT(refused("dart", quick_dart({"include_demos=true"})), HasSubstr("include_demos adds recordings without"));
   EXPECT_THAT(refused("dart", quick_dart({"perturb=easy"})), HasSubstr("perturb= is not built for a policy of the arm's links"));
   EXPECT_THAT(refused("dagger", {"expert=tracker", "iterations=1", "rollouts=1"}), HasSubstr("include_demos adds recordings without"));
+  const auto dad_refusal = [](const std::vector<std::string>& options) {
+    return test::error_of([&] {
+      require_learnable_map("dad", LearnerRegistry::global().create("dad", options)->params(), feature_map(kTorqueMap));
+    });
+  };
+  EXPECT_THAT(dad_refusal({}), HasSubstr("give --option starts=training"));
+  EXPECT_THAT(dad_refusal({"starts=training"}), HasSubstr("give --option corrector=track"));
+  EXPECT_THAT(dad_refusal({"starts=training", "corrector=track", "faithful=units"}), HasSubstr("faithful= runs the paper's code"));
   EXPECT_THAT(test::error_of([] {
-                require_learnable_map("dad", LearnerRegistry::global().create("dad", {})->params(), feature_map(kTorqueMap));
+                require_learnable_map("my_plugin", Params{}, feature_map(kTorqueMap));  // a plugin learner
               }),
-              HasSubstr("learned by bc from episodes recorded on the arm, or by dart and dagger"));
+              HasSubstr("or by dart, dagger and dad (starts=training)"));
   // Where torques cannot run, an evaluation refuses before any rollout.
   EvalRequest request;
   request.actions = ActionKind::joint_torque;

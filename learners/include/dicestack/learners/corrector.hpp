@@ -33,12 +33,16 @@ struct CorrectionProblem {
   /// action was taken in), which the feedback law follows.
   std::vector<State> reference;
   std::vector<Action> reference_actions;
+  /// What the window's actions are: the cup's velocity changes, or the arm's joint torques
+  /// ("track" alone: it tells each of its cup actions in torques, core/tracker.hpp's told_in_torques).
+  ActionKind actions = ActionKind::cup;
 };
 
 /// The best actions found and the trajectory they produce.
 struct Correction {
   std::vector<State> states;    ///< the state before each corrected action (states[0] is start's)
   std::vector<Action> actions;  ///< in the world's units, within its limits: labels as they are applied
+  std::vector<ArmLinks> links;  ///< on the arm, its links before each corrected action (empty for the floating cup)
   double cost = 0.0;            ///< eq. 11: sum over the window of the squared scaled distance
   double warm_cost = 0.0;       ///< the same for the policy's own actions
   int evaluations = 0;          ///< window simulations spent
@@ -46,9 +50,9 @@ struct Correction {
 
 /// Squared scaled distance (all 24 dimensions, the cup's 3 or state_distance's 21, by aim) summed
 /// over the window when `actions` are applied from `problem.start`; fills `states` (may be null)
-/// with the states before each action.
+/// with the states before each action, and on the arm `links` (may be null) with its links then.
 double window_cost(DiceEnv& env, const CorrectionProblem& problem, const std::vector<Action>& actions,
-                   std::vector<State>* states = nullptr);
+                   std::vector<State>* states = nullptr, std::vector<ArmLinks>* links = nullptr);
 
 /// Searches in the optimisers' scaled action space (x = action / ActionConfig::scale), clipped
 /// to the world's limits.
@@ -56,7 +60,8 @@ class Corrector {
  public:
   virtual ~Corrector() = default;
   /// `env` is scratch: its episode is overwritten. Never returns worse than the warm start
-  /// (unless CorrectorOptions::random_start).
+  /// (unless CorrectorOptions::random_start). Throws InputError for a problem in joint torques
+  /// unless it is "track" (a search over torque sequences is not built).
   virtual Correction correct(DiceEnv& env, const CorrectionProblem& problem, std::uint64_t seed) const = 0;
 };
 
