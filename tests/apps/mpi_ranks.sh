@@ -122,6 +122,16 @@ case "$mode" in
     same "$work/$mode-1.dsm.curve.csv" "$work/$mode-2.dsm.curve.csv"
     same "$work/$mode-1.dsm.curve.csv" "$work/$mode-3.dsm.curve.csv"
     [ "$(ls "$work/$mode-2.dsm.checkpoint" | wc -l)" -ge 2 ] || fail "no checkpoint written under mpirun"
+    if [ "$mode" = dad ]; then  # on the arm in joint torques: the corrections travel with their links
+      arm=(--learner dad --option starts=training --option corrector=track --option episodes=3 --option windows=1
+        --option iterations=1 --option tracker_probes=1 --option tracker_robust=1 --option tracker_variants=false
+        --embodiment arm --controller joint_torque)
+      for n in 1 3; do
+        ranks "$n" train --regressor knn --demos "$work/demos" --seed 4 --threads 1 --out "$work/arm-$n.dsm" "${arm[@]}" > /dev/null
+      done
+      same "$work/arm-1.dsm" "$work/arm-3.dsm"
+      same "$work/arm-1.dsm.curve.csv" "$work/arm-3.dsm.curve.csv"
+    fi
     if [ "$mode" = dagger ]; then  # one more round resumed on 3 ranks = three rounds alone
       three=("${opts[@]/iterations=2/iterations=3}")
       "$exe" train --regressor knn --demos "$work/demos" --seed 4 --out "$work/three.dsm" "${three[@]}" "${world[@]}" > /dev/null

@@ -129,7 +129,8 @@ TEST(TorquePolicy, DaggerLearnsTheTrackersTorquesAndResumesFromItsCheckpoint) {
 
 // DaD on the arm: the tracker's targets in torques from training starts, each window of the
 // policy's own rollout steered back by the feedback law told in torques. Its corrections keep the
-// links they were made at, in its checkpoint too, and a resumed run ends where a whole one does.
+// links they were made at, in its checkpoint too, and a resumed run on two threads ends where a
+// whole one on one thread does.
 TEST(TorquePolicy, DadCorrectsItsOwnRolloutsInTorquesAndResumesFromItsCheckpoint) {
   LearnContext c = arm_context();
   c.world = WorldConfig{};
@@ -144,7 +145,8 @@ TEST(TorquePolicy, DadCorrectsItsOwnRolloutsInTorquesAndResumesFromItsCheckpoint
   EXPECT_EQ(whole.model->features().action_kind(), ActionKind::joint_torque);
   EXPECT_GT(std::stoi(whole.model->record.at("dad_corrections_kept")), 0);
 
-  // Killed when iteration 2 starts, then resumed.
+  // Killed when iteration 2 starts, then resumed, on another thread count.
+  c.threads = 2;
   c.checkpoint_dir = test::scratch_path("dicestack_dad_torques");
   std::filesystem::remove_all(c.checkpoint_dir);
   c.progress = [](const Progress& p) {
