@@ -40,14 +40,18 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
   r = torque_request();
   r.learner = "dad";
   r.learner_options = {};
-  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("or by dart and dagger"));
+  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("give --option starts=training"));
+  r.learner_options = {"starts=training", "corrector=track"};
+  EXPECT_EQ(check_train_settings(r), "state+links+clock+start_state@dice+retry/osc");
+  r.learner_options = {};
   r.learner = "bc";  // from episodes recorded on the arm, which the dataset checks when it fits
   r.features = "state+links+clock+start_state@dice+retry/osc";
   EXPECT_EQ(check_train_settings(r), r.features);
   r = torque_request();
   r.world.embodiment = Embodiment::cup;
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("--embodiment arm"));
-  // A leaderboard's row of the arm's links: learned as `train` learns it (DART, not DaD).
+  // A leaderboard's row of the arm's links: learned as `train` learns it (DART; DaD only from
+  // training starts).
   const LearnerInfo& dart = LearnerRegistry::global().info("dart");
   EXPECT_NO_THROW(require_labellable(dart.params, Params(dart.params, {}, "dart"), r.world,
                                      feature_map("state+links+clock/torque"), "dart"));
@@ -56,7 +60,7 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
                 require_labellable(dad.params, Params(dad.params, {}, "dad"), r.world,
                                    feature_map("state+links+clock/torque"), "dad");
               }),
-              HasSubstr("learned by bc from episodes recorded on the arm, or by dart and dagger"));
+              HasSubstr("give --option starts=training"));
   r = torque_request();
   r.controller = "wrist";
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("is not one of cup, joint_torque"));
