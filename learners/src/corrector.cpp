@@ -48,7 +48,7 @@ class SequenceCorrector final : public Corrector {
   SequenceCorrector(std::string method, const CorrectorOptions& o) : method_(std::move(method)), options_(o) {}
 
   Correction correct(DiceEnv& env, const CorrectionProblem& p, std::uint64_t seed) const override {
-    if (p.actions != ActionKind::cup)
+    if (p.action_kind != ActionKind::cup)
       throw InputError("corrector " + method_ + ": a window in joint torques is corrected by track alone");
     const ActionSequenceProblem window(env.config(), static_cast<int>(p.target.size()), ActionBox::limits,
                                        [&p](DiceEnv& e, const std::vector<Action>& actions) { return window_cost(e, p, actions); });
@@ -101,7 +101,7 @@ class TrackCorrector final : public Corrector {
     std::vector<Action> actions;
     for (std::size_t j = 0; j < p.target.size(); ++j) {
       const Action cup = follower.act(env.get_state(), env.t());
-      actions.push_back(env.step(p.actions == ActionKind::cup ? cup : told_in_torques(env, cup)).applied);
+      actions.push_back(env.step(p.action_kind == ActionKind::cup ? cup : told_in_torques(env, cup)).applied);
     }
     const double cost = window_cost(env, p, actions);
     c.actions = cost < c.warm_cost ? actions : p.warm;

@@ -36,7 +36,7 @@ struct DadPlan {
   std::size_t demos = 0;       // demonstrations as targets (0: all)
   int episodes = 0;            // training starts the tracker runs from
   bool retry = false;          // the tracker tries again (from training starts)
-  ActionKind actions = ActionKind::cup;  // what the map answers, and so the corrections' labels
+  ActionKind action_kind = ActionKind::cup;  // what the map answers, and so the corrections' labels
 
   std::string summary() const {
     static const char* aims[] = {"state", "cup", "dice"};
@@ -59,8 +59,9 @@ struct Task {
 };
 
 // The cup action that takes a floating cup from `before` to `after`'s velocity (its velocity
-// change before gravity's pull over the step). A target recorded in joint torques holds no cup
-// actions, and the tracker's feedback law follows the velocity during each recorded step.
+// change before gravity's pull over the step): exact in free flight; in contact it also holds
+// what the contacts did. A target recorded in joint torques holds no cup actions, and the
+// tracker's feedback law follows the velocity during each recorded step.
 Action cup_action_between(const State& before, const State& after, const WorldConfig& world) {
   namespace si = state_index;
   const double dt = world.physics.control_dt;
@@ -144,6 +145,7 @@ class Dad final : public Learner {
   }
 
   LearnResult learn(const LearnContext& c) const override {
+    require_learnable_map("dad", params(), feature_map(c.features));  // before any work
     const DadPlan plan = make_plan(c.features);
     const bool from_training = plan.from_training;
     std::string followed;  // from training starts: the recordings the tracker followed
@@ -366,7 +368,7 @@ class Dad final : public Learner {
     p.demos = static_cast<std::size_t>(params().integer("demos"));
     p.episodes = static_cast<int>(params().integer("episodes"));
     p.retry = expert_retries(params().choice("retry"), features);
-    p.actions = feature_map(features).action_kind();
+    p.action_kind = feature_map(features).action_kind();
     return p;
   }
 
@@ -459,7 +461,7 @@ class Dad final : public Learner {
       options.max_steps = steps;
       options.before_step = [&](const DiceEnv& at, std::size_t t) {
         if (t % width != 0 || t >= steps) return;
-        Task task{d, t, {at.snapshot(), {}, {}, plan.aim, {}, {}, plan.actions}};
+        Task task{d, t, {at.snapshot(), {}, {}, plan.aim, {}, {}, plan.action_kind}};
         for (std::size_t j = t + 1; j < len && j <= t + width; ++j) {
           task.problem.target.push_back(demo.states[j]);
           task.problem.reference.push_back(demo.states[j - 1]);
@@ -477,11 +479,11 @@ class Dad final : public Learner {
       const State& start = fixed_start ? *fixed_start : demo.states[0];
       rollouts[d] = rollout(env, policy, start, demo.seed, StepSource::policy, options);
       const std::vector<Action>& actions = rollouts[d].actions;
-      for (auto& task : per_demo[d])  // the policy's own actions, held at zero past its episode's end
+      // The policy's own actions, zero past its episode's end (no velocity change; in joint
+      // torques, none: the arm sags, which a correction then beats).
+      for (auto& task : per_demo[d])
         for (std::size_t j = 0; j < task.problem.target.size(); ++j)
-          task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j]
-                                      : plan.actions == ActionKind::cup ? Action{0.0, 0.0, 0.0}
-                                                                        : Action::torques({0.0, 0.0, 0.0, 0.0}));
+          task.problem.warm.push_back(task.t + j < actions.size() ? actions[task.t + j] : Action::zeros(plan.action_kind));
     });
     std::vector<Task> tasks;
     for (auto& v : per_demo)

@@ -211,22 +211,23 @@ void require_learnable_map(const std::string& learner, const Params& params, con
   // and the dataset names any episode that does not.
   if (learner == "bc") return;
   // dad's corrections of the policy's own rollouts on the arm: the tracker's targets from training
-  // starts, each window steered back by its feedback law told in torques.
+  // starts, each window steered back by its feedback law (told in torques for a map in them).
   if (learner == "dad") {
-    if (params.choice("starts") != "training")
-      throw ConfigError(what + ": dad learns it from the tracker's episodes on the arm: give --option starts=training "
-                               "(the recordings themselves hold the cup's actions and no links)");
-    if (params.choice("corrector") != "track")
-      throw ConfigError(what + ": dad corrects a window on the arm by the tracker's feedback law: give --option "
-                               "corrector=track (a search over torque sequences is not built)");
     if (params.choice("faithful") != "false")
-      throw ConfigError(what + ": faithful= runs the paper's code, whose actions are the cup's");
+      throw ConfigError(what + ": faithful= runs the paper's code, which is not built for the arm's links or joint "
+                               "torques; leave it at false");
+    if (params.choice("starts") != "training")
+      throw ConfigError(what + ": dad learns it from the tracker's episodes on the arm: give it starts=training "
+                               "(the recordings themselves hold the cup's actions and no links)");
+    if (map.action_kind() == ActionKind::joint_torque && params.choice("corrector") != "track")
+      throw ConfigError(what + ": dad corrects a window in joint torques by the tracker's feedback law: give it "
+                               "corrector=track (a search over torque sequences is not built)");
     return;
   }
   if (learner != "dart" && learner != "dagger")
     throw ConfigError(what + ": a map of the arm's links or joint torques is learned by bc from episodes recorded on the "
-                             "arm, or by dart, dagger and dad (starts=training), whose experts run on the arm (human "
-                             "recordings hold no links, and the cup's actions)");
+                             "arm, or by dart, dagger and dad (starts=training, corrector=track), whose experts run on "
+                             "the arm (human recordings hold no links, and the cup's actions)");
   if (params.boolean("include_demos")) throw ConfigError(what + ": include_demos adds recordings without the arm's links");
   if (params.choice("perturb") != "none")
     throw ConfigError(what + ": perturb= is not built for a policy of the arm's links yet; leave it at none");

@@ -123,6 +123,7 @@ case "$mode" in
     same "$work/$mode-1.dsm.curve.csv" "$work/$mode-3.dsm.curve.csv"
     [ "$(ls "$work/$mode-2.dsm.checkpoint" | wc -l)" -ge 2 ] || fail "no checkpoint written under mpirun"
     if [ "$mode" = dad ]; then  # on the arm in joint torques: the corrections travel with their links
+      # (the default world: the tracker's targets must stack, which 4 s episodes are too short for)
       arm=(--learner dad --option starts=training --option corrector=track --option episodes=3 --option windows=1
         --option iterations=1 --option tracker_probes=1 --option tracker_robust=1 --option tracker_variants=false
         --embodiment arm --controller joint_torque)

@@ -40,7 +40,7 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
   r = torque_request();
   r.learner = "dad";
   r.learner_options = {};
-  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("give --option starts=training"));
+  EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("give it starts=training"));
   r.learner_options = {"starts=training", "corrector=track"};
   EXPECT_EQ(check_train_settings(r), "state+links+clock+start_state@dice+retry/osc");
   r.learner_options = {};
@@ -60,7 +60,7 @@ TEST(TrainController, AMapOrLearnerOrWorldThatCannotIsRefused) {
                 require_labellable(dad.params, Params(dad.params, {}, "dad"), r.world,
                                    feature_map("state+links+clock/torque"), "dad");
               }),
-              HasSubstr("give --option starts=training"));
+              HasSubstr("give it starts=training"));
   r = torque_request();
   r.controller = "wrist";
   EXPECT_THAT(test::error_of([&] { check_train_settings(r); }), HasSubstr("is not one of cup, joint_torque"));

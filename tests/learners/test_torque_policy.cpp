@@ -180,13 +180,13 @@ TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
       require_learnable_map("dad", LearnerRegistry::global().create("dad", options)->params(), feature_map(kTorqueMap));
     });
   };
-  EXPECT_THAT(dad_refusal({}), HasSubstr("give --option starts=training"));
-  EXPECT_THAT(dad_refusal({"starts=training"}), HasSubstr("give --option corrector=track"));
-  EXPECT_THAT(dad_refusal({"starts=training", "corrector=track", "faithful=units"}), HasSubstr("faithful= runs the paper's code"));
+  EXPECT_THAT(dad_refusal({}), HasSubstr("give it starts=training"));
+  EXPECT_THAT(dad_refusal({"starts=training"}), HasSubstr("give it corrector=track"));
+  EXPECT_THAT(dad_refusal({"faithful=units"}), HasSubstr("faithful= runs the paper's code"));  // named first: it overrides the rest
   EXPECT_THAT(test::error_of([] {
                 require_learnable_map("my_plugin", Params{}, feature_map(kTorqueMap));  // a plugin learner
               }),
-              HasSubstr("or by dart, dagger and dad (starts=training)"));
+              HasSubstr("or by dart, dagger and dad (starts=training, corrector=track)"));
   // Where torques cannot run, an evaluation refuses before any rollout.
   EvalRequest request;
   request.actions = ActionKind::joint_torque;

@@ -35,7 +35,7 @@ struct CorrectionProblem {
   std::vector<Action> reference_actions;
   /// What the window's actions are: the cup's velocity changes, or the arm's joint torques
   /// ("track" alone: it tells each of its cup actions in torques, core/tracker.hpp's told_in_torques).
-  ActionKind actions = ActionKind::cup;
+  ActionKind action_kind = ActionKind::cup;
 };
 
 /// The best actions found and the trajectory they produce.
