@@ -58,17 +58,6 @@ struct Task {
   CorrectionProblem problem;
 };
 
-// The cup action that takes a floating cup from `before` to `after`'s velocity (its velocity
-// change before gravity's pull over the step): exact in free flight; in contact it also holds
-// what the contacts did. A target recorded in joint torques holds no cup actions, and the
-// tracker's feedback law follows the velocity during each recorded step.
-Action cup_action_between(const State& before, const State& after, const WorldConfig& world) {
-  namespace si = state_index;
-  const double dt = world.physics.control_dt;
-  return {after[si::kCupVx] - before[si::kCupVx] - world.physics.gravity.x * dt,
-          after[si::kCupVy] - before[si::kCupVy] - world.physics.gravity.y * dt, after[si::kCupW] - before[si::kCupW]};
-}
-
 // A correction carries the rollout before its window as history (the policy's steps): those are
 // not rows. A demonstration's steps all are, whoever chose them.
 bool is_row(const Episode& e, std::size_t t) {
@@ -465,6 +454,7 @@ class Dad final : public Learner {
         for (std::size_t j = t + 1; j < len && j <= t + width; ++j) {
           task.problem.target.push_back(demo.states[j]);
           task.problem.reference.push_back(demo.states[j - 1]);
+          // A target recorded in joint torques holds no cup actions for the feedback law.
           const Action& recorded = demo.actions[j - 1];
           task.problem.reference_actions.push_back(recorded.kind() == ActionKind::cup
                                                        ? recorded

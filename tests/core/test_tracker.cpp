@@ -77,6 +77,20 @@ TEST(PathFollower, HoldsTheLastPoseAfterThePathEnds) {
   for (double v : a) EXPECT_NEAR(v, 0.0, 1e-9);
 }
 
+// A step's cup action read back from the states before and after it: exact while the cup
+// touches nothing (here, lifted clear of the table and the dice, gravity pulling it).
+TEST(PathFollower, ACupActionIsReadBackFromTheVelocitiesAroundItsStep) {
+  DiceEnv env(WorldConfig{});
+  State start = random_start_state(env.config(), 5);
+  start[si::kCupY] += 1.0;
+  env.reset_to(start, 0);
+  const Action dv{0.3, -0.2, 0.4};
+  const State before = env.get_state();
+  env.step(dv);
+  const Action read = cup_action_between(before, env.get_state(), env.config());
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(read[k], dv[k], 1e-4) << k;
+}
+
 TEST(TrackerRecordings, RefuseBadRecordingsNamingThem) {
   const WorldConfig w;
   EXPECT_THROW(Recordings({}, w, {}, 0), InputError);

@@ -56,4 +56,11 @@ std::unique_ptr<Expert> in_joint_torques(std::unique_ptr<Expert> cup_expert) {
   return std::make_unique<JointTorqueExpert>(std::move(cup_expert));
 }
 
+Action cup_action_between(const State& before, const State& after, const WorldConfig& world) {
+  namespace si = state_index;
+  const double dt = world.physics.control_dt;
+  return {after[si::kCupVx] - before[si::kCupVx] - world.physics.gravity.x * dt,
+          after[si::kCupVy] - before[si::kCupVy] - world.physics.gravity.y * dt, after[si::kCupW] - before[si::kCupW]};
+}
+
 }  // namespace dicestack

@@ -262,6 +262,12 @@ bool still_succeeds(const PathFollower& follower, const DiceEnv& env, DiceEnv& s
 /// are the answer. `env` is put back exactly where it was. Throws InputError for a floating cup.
 Action told_in_torques(DiceEnv& env, const Action& cup);
 
+/// The cup action that takes a floating cup from `before` to `after`'s velocity one control step
+/// later in `world`: its velocity change before gravity's pull over the step. Exact in free
+/// flight; in contact it also holds what the contacts did. What a step recorded in joint torques
+/// reads as a cup action, for the feedback law that follows the velocity during each step.
+Action cup_action_between(const State& before, const State& after, const WorldConfig& world);
+
 /// A rescue, mid-episode, when the followed path (`current`, moved into the frame of `frame`,
 /// the episode's start) no longer simulates to a success from env's state: its rest, then every
 /// recording joined at its step nearest the state (the cup's pose and velocity, the dice
