@@ -183,6 +183,8 @@ TEST(TorquePolicy, WhatCannotLearnOrRunTorquesIsRefusedByName) {
   EXPECT_THAT(dad_refusal({}), HasSubstr("give it starts=training"));
   EXPECT_THAT(dad_refusal({"starts=training"}), HasSubstr("give it corrector=track"));
   EXPECT_THAT(dad_refusal({"faithful=units"}), HasSubstr("faithful= runs the paper's code"));  // named first: it overrides the rest
+  // DaD checks its map itself, before the tracker or a fit runs.
+  EXPECT_THAT(refused("dad", {"corrector=track"}), HasSubstr("give it starts=training"));
   EXPECT_THAT(test::error_of([] {
                 require_learnable_map("my_plugin", Params{}, feature_map(kTorqueMap));  // a plugin learner
               }),
