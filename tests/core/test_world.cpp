@@ -1,7 +1,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <thread>
+
+#include <box2d/box2d.h>
 
 #include <dicestack/core/error.hpp>
 #include <dicestack/core/hash.hpp>
@@ -153,6 +157,35 @@ TEST(World, SameSeedAndActionsGiveBitIdenticalStates) {
     h = hash_state(other.state(), h);
   }
   EXPECT_NE(h, hashes[0]);
+}
+
+// Box2D times its steps for a profile nothing here reads; core/world/src/box2d_timer.cpp stops
+// that clock for every caller in the process, Box2D's own steps included.
+TEST(World, Box2DsProfileClockIsStopped) {
+  const b2Timer timer;
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(timer.GetMilliseconds(), 0.0f);
+
+  b2World world(b2Vec2(0.0f, -9.8f));
+  b2BodyDef ground_def;
+  b2PolygonShape ground;
+  ground.SetAsBox(5.0f, 0.1f);
+  world.CreateBody(&ground_def)->CreateFixture(&ground, 0.0f);
+  b2PolygonShape box;
+  box.SetAsBox(0.05f, 0.05f);
+  for (int i = 0; i < 400; ++i) {  // a pile whose steps take well over a millisecond in all
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(-4.0f + 0.2f * static_cast<float>(i % 40), 0.2f + 0.11f * static_cast<float>(i / 40));
+    world.CreateBody(&def)->CreateFixture(&box, 1.0f);
+  }
+  float total = 0.0f;
+  for (int i = 0; i < 30; ++i) {
+    world.Step(1.0f / 150.0f, 10, 8);
+    const b2Profile& p = world.GetProfile();
+    total += p.step + p.collide + p.solve + p.solveTOI + p.broadphase;
+  }
+  EXPECT_EQ(total, 0.0f);
 }
 
 TEST(World, PushingIntoSideWallsAndCeilingIsReported) {
