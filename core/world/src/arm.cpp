@@ -106,8 +106,22 @@ struct ChainDynamics {
   Vec4 bias;
 };
 
-ChainDynamics chain_dynamics(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
-  const auto& a = now.angles;
+// The sines and cosines of the chain's absolute angles, taken once per law: each is read by
+// every body after it, the task's Jacobian and the drift (the law runs at every substep).
+struct AngleTrig {
+  std::array<double, 4> sin{}, cos{};
+};
+
+AngleTrig trig_of(const std::array<double, 4>& angles) {
+  AngleTrig t;
+  for (std::size_t j = 0; j < 4; ++j) {
+    t.sin[j] = std::sin(angles[j]);
+    t.cos[j] = std::cos(angles[j]);
+  }
+  return t;
+}
+
+ChainDynamics chain_dynamics(const ArmConfig& arm, const ArmMotion& now, const AngleTrig& trig, Vec2 gravity) {
   const auto& w = now.rates;
   // Each body's centre and its derivative by each angle: a link's centre lies half its length
   // along it from its near joint; the cup's centre is the wrist, at the last link's far end.
@@ -128,9 +142,9 @@ ChainDynamics chain_dynamics(const ArmConfig& arm, const ArmMotion& now, Vec2 gr
     Eigen::Vector2d centripetal = Eigen::Vector2d::Zero();
     for (std::size_t j = 0; j <= i; ++j) {
       const double r = reach(i, j);
-      jv(0, static_cast<Eigen::Index>(j)) = -r * std::sin(a[j]);
-      jv(1, static_cast<Eigen::Index>(j)) = r * std::cos(a[j]);
-      centripetal -= r * w[j] * w[j] * Eigen::Vector2d(std::cos(a[j]), std::sin(a[j]));
+      jv(0, static_cast<Eigen::Index>(j)) = -r * trig.sin[j];
+      jv(1, static_cast<Eigen::Index>(j)) = r * trig.cos[j];
+      centripetal -= r * w[j] * w[j] * Eigen::Vector2d(trig.cos[j], trig.sin[j]);
     }
     m += mass[i] * jv.transpose() * jv;
     m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) += inertia[i];
@@ -174,11 +188,11 @@ double within_limits(const ArmConfig& arm, const Vec4& base, const Vec4& extra) 
 }
 
 // The task's Jacobian: the cup's centre (the wrist) and its angle by the chain's absolute angles.
-Eigen::Matrix<double, 3, 4> task_jacobian(const ArmConfig& arm, const std::array<double, 4>& angles) {
+Eigen::Matrix<double, 3, 4> task_jacobian(const ArmConfig& arm, const AngleTrig& trig) {
   Eigen::Matrix<double, 3, 4> task = Eigen::Matrix<double, 3, 4>::Zero();
   for (std::size_t j = 0; j < 3; ++j) {
-    task(0, static_cast<Eigen::Index>(j)) = -arm.link_lengths[j] * std::sin(angles[j]);
-    task(1, static_cast<Eigen::Index>(j)) = arm.link_lengths[j] * std::cos(angles[j]);
+    task(0, static_cast<Eigen::Index>(j)) = -arm.link_lengths[j] * trig.sin[j];
+    task(1, static_cast<Eigen::Index>(j)) = arm.link_lengths[j] * trig.cos[j];
   }
   task(2, 3) = 1.0;
   return task;
@@ -215,13 +229,14 @@ Vec4 posture_axis(const ArmConfig& arm, const std::array<double, 4>& a) {
 OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, Vec2 gravity) {
   const auto& a = now.angles;
   const auto& w = now.rates;
-  OperationalSpace os{chain_dynamics(arm, now, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero(), Vec4::Zero(), posture_axis(arm, a)};
+  const AngleTrig trig = trig_of(a);
+  OperationalSpace os{chain_dynamics(arm, now, trig, gravity), {}, Vec4::Zero(), {}, Eigen::Vector3d::Zero(), Vec4::Zero(), posture_axis(arm, a)};
   // The task: the cup's centre (the wrist) and its angle.
-  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, a);
+  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, trig);
   for (std::size_t j = 0; j < 3; ++j) {
     const double l = arm.link_lengths[j];
-    os.drift(0) -= l * w[j] * w[j] * std::cos(a[j]);
-    os.drift(1) -= l * w[j] * w[j] * std::sin(a[j]);
+    os.drift(0) -= l * w[j] * w[j] * trig.cos[j];
+    os.drift(1) -= l * w[j] * w[j] * trig.sin[j];
   }
   // The cup's own velocity, not the links' rates through the chain: what the joints let drift
   // is corrected too.
@@ -238,18 +253,19 @@ OperationalSpace operational_space(const ArmConfig& arm, const ArmMotion& now, V
 
 std::array<double, 4> arm_joint_space_torques(const ArmConfig& arm, const ArmMotion& now, const std::array<double, 4>& accel,
                                               Vec2 gravity) {
-  const ChainDynamics d = chain_dynamics(arm, now, gravity);
+  const ChainDynamics d = chain_dynamics(arm, now, trig_of(now.angles), gravity);
   return clipped(arm, joint_torques_of(d.m * Vec4(accel[0], accel[1], accel[2], accel[3]) + d.bias));
 }
 
 std::array<double, 4> arm_torque_change(const ArmConfig& arm, const ArmMotion& now, Vec2 velocity_change, double turn_change,
                                         double dt) {
-  const ChainDynamics d = chain_dynamics(arm, now, {0.0, 0.0});
+  const AngleTrig trig = trig_of(now.angles);
+  const ChainDynamics d = chain_dynamics(arm, now, trig, {0.0, 0.0});
   // Joint torques to the forces on the absolute angles (each joint turns its body and the one
   // before it back), then to the cup's velocity and turn through the task's Jacobian.
   Eigen::Matrix4d forces = Eigen::Matrix4d::Identity();
   for (Eigen::Index j = 1; j < 4; ++j) forces(j - 1, j) = -1.0;
-  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, now.angles);
+  const Eigen::Matrix<double, 3, 4> task = task_jacobian(arm, trig);
   const Eigen::Matrix<double, 3, 4> a = dt * task * d.m.inverse() * forces;
   const Eigen::Matrix3d aat = a * a.transpose() + 1e-12 * Eigen::Matrix3d::Identity();
   const Vec4 change = a.transpose() * aat.ldlt().solve(Eigen::Vector3d(velocity_change.x, velocity_change.y, turn_change));
