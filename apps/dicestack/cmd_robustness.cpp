@@ -31,12 +31,17 @@ struct RobustnessOptions {
   TrackerOption tracker;
 };
 
-// Joint torques run on the arm, without an estimator (its worlds hold no arm links). `what`
-// names who answers in them.
-void check_torque_run(const std::string& what, const RobustnessOptions& opt, const WorldConfig& world) {
+// Joint torques run on the arm. `what` names who answers in them.
+void check_arm(const std::string& what, const WorldConfig& world) {
   if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
+}
+
+// An expert in joint torques runs without an estimator: its feedback is told in torques through
+// the world's own links, not an estimate's.
+void check_torque_run(const std::string& what, const RobustnessOptions& opt, const WorldConfig& world) {
+  check_arm(what, world);
   if (!opt.estimator.empty() && opt.estimator != "none")
-    throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; leave --estimator out");
+    throw ConfigError(what + ": an expert in joint torques tells its feedback through the world's own links; leave --estimator out");
 }
 
 // An expert in joint torques (a model answers in its own actions).
@@ -89,7 +94,7 @@ void run_robustness(const RobustnessOptions& opt, Cluster& cluster) {
     auto model = std::make_shared<const Model>(load_model(opt.model));
     check_map_world(model->features(), world);
     if (model->features().action_kind() == ActionKind::joint_torque)
-      check_torque_run("robustness: " + opt.model.string() + " (a policy in joint torques)", opt, world);
+      check_arm("robustness: " + opt.model.string() + " (a policy in joint torques)", world);
     run.estimator = estimator_for(opt.estimator, *model);
     request.actions = model->features().action_kind();
     factory = [model] { return std::make_unique<ModelPolicy>(model); };

@@ -30,16 +30,21 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
   e.origin = policy.name();
   DiceEnv& env = world.env();
   const bool channelled = world.channelled();
-  std::vector<State> seen;  // what the policy was shown, when that is not the true states
+  std::vector<State> seen;         // what the policy was shown, when that is not the true states
+  std::vector<ArmLinks> seen_links;  // and the links shown with it (an estimator's are its own)
   std::vector<Action> applied, pending, unseen;
   policy.attach(env);
   const State shown = world.reset_to(start, seed);
   // An arm's joint encoders read its links exactly and at once: only the scene's sensing is
-  // perturbed.
+  // perturbed. Behind an estimator the policy is shown the links of the state it estimates.
   const bool arm = env.config().embodiment == Embodiment::arm;
   e.states.push_back(env.get_state());
   if (arm) e.links.push_back(env.world().arm_links());
-  if (channelled) seen.push_back(shown);
+  const auto show = [&](const State& s) {
+    seen.push_back(s);
+    if (arm) seen_links.push_back(world.shown_links());
+  };
+  if (channelled) show(shown);
   policy.reset(seed);
   while (true) {
     if (options.before_step) options.before_step(env, applied.size());
@@ -47,7 +52,7 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
       pending.assign(world.pending().begin(), world.pending().end());
       unseen.assign(world.unseen().begin(), world.unseen().end());
     }
-    Action a = policy.act(History{channelled ? seen : e.states, applied, pending, unseen, e.links});
+    Action a = policy.act(History{channelled ? seen : e.states, applied, pending, unseen, channelled ? seen_links : e.links});
     if (applied.empty() && options.push != InitialPush::none) {
       if (a.kind() != ActionKind::cup) throw InputError("an initial push is a cup velocity change; this policy answers joint torques");
       a[0] += options.push == InitialPush::left ? -1.0 : 1.0;
@@ -70,7 +75,7 @@ Episode rollout(PerturbedEnv& world, Policy& policy, const State& start, std::ui
     }
     e.states.push_back(r.observation);
     if (arm) e.links.push_back(env.world().arm_links());
-    if (channelled) seen.push_back(step.shown);
+    if (channelled) show(step.shown);
   }
   e.outcome = env.outcome();
   if (world.perturbed())
@@ -192,8 +197,8 @@ void check_evaluation(const WorldConfig& world, const EvalRequest& request) {
   if (request.actions == ActionKind::joint_torque) {
     const std::string what = "evaluate: a policy in joint torques";
     if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
-    if (request.estimator.kind != EstimatorKind::none)
-      throw ConfigError(what + ": an estimator rebuilds worlds without the arm's links; use --estimator none");
+    if (request.estimator.kind == EstimatorKind::particle)
+      throw ConfigError(what + ": the particle filter rebuilds its worlds without the arm's links; use --estimator kalman");
     if (request.push != InitialPush::none) throw ConfigError(what + ": an initial push is a cup velocity change");
   }
   require_memory("evaluate", static_cast<std::uint64_t>(std::max(0, request.episodes)),

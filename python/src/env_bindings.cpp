@@ -75,12 +75,14 @@ py::tuple action_bounds(const EnvCore& core) {
   return core.controller() == ActionKind::cup ? bounds(core.env().action_space()) : bounds(core.env().torque_space());
 }
 
-// An arm's links and joints beside the 24 observed numbers, which a joint-torque policy needs.
+// An arm's links and joints beside the 24 observed numbers, which a joint-torque policy needs
+// (behind an estimator, the links of the state it shows).
 py::dict with_arm(py::dict info, const EnvCore& core) {
   const World& w = core.env().world();
   if (w.config().embodiment != Embodiment::arm) return info;
-  info["link_angles"] = to_array(w.arm_link_angles());
-  info["link_rates"] = to_array(w.arm_link_rates());
+  const ArmLinks links = core.shown_links();
+  info["link_angles"] = to_array(links.angles);
+  info["link_rates"] = to_array(links.rates);
   info["joint_torques"] = to_array(w.arm_step_torques());  // as demonstration sets keep them
   return info;
 }

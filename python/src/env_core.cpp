@@ -38,9 +38,9 @@ EnvCore::EnvCore(const WorldConfig& world, const Perturbation& perturbation, con
   validate(perturbation, world);
   if (controller == ActionKind::joint_torque && world.embodiment != Embodiment::arm)
     throw ConfigError("controller \"joint_torque\" drives an arm's joints: it needs embodiment \"arm\"");
-  if (controller == ActionKind::joint_torque && estimator.kind != EstimatorKind::none)
-    throw ConfigError("an estimator rebuilds worlds from the 24 observed numbers, which do not hold the arm's links; the "
-                      "joint_torque controller runs without one");
+  if (controller == ActionKind::joint_torque && estimator.kind == EstimatorKind::particle)
+    throw ConfigError("the particle filter rebuilds its worlds without the arm's links; the joint_torque controller runs "
+                      "behind estimator \"kalman\" or none");
 }
 
 void EnvCore::begin(const Perturbation* perturbation) {

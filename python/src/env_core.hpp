@@ -72,6 +72,9 @@ class EnvCore {
   /// The info of the episode's latest state (what reset reports; step's own is in StepResult).
   StepInfo info() const;
 
+  /// The arm's links the policy is shown: the estimator's (of the state it estimates) when one
+  /// runs, else the encoders'.
+  ArmLinks shown_links() const { return episode_ ? episode_->shown_links() : nominal_->world().arm_links(); }
   DiceEnv& env() { return episode_ ? episode_->env() : *nominal_; }
   const DiceEnv& env() const { return episode_ ? episode_->env() : *nominal_; }
   std::uint64_t world_hash() const { return world_hash_; }

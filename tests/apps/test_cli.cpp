@@ -902,8 +902,8 @@ TEST(CliLearning, APolicyInJointTorquesTrainsOnTheArmAndWhatItCannotRunIsRefused
       {"leaderboard --demos " + kTinyDemos + " --controller joint_torque --regressors knn --learners dart --episodes 1", "--embodiment arm"},
       {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners bc --episodes 1",
        "--learners dart:expert=tracker"},
-      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --estimator kalman --episodes 1",
-       "an estimator rebuilds worlds without the arm's links"},
+      {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --estimator particle --episodes 1",
+       "the particle filter rebuilds its worlds without the arm's links"},
       {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --baselines de --episodes 1",
        "the baselines act in the cup's actions"},
       {"leaderboard --demos " + kTinyDemos + arm + " --controller joint_torque --regressors knn --learners dart --features state "

@@ -229,8 +229,15 @@ def test_the_joint_torque_controller_takes_the_arms_four_torques():
     drawn = info["perturbation"]
     assert np.allclose(drawn["joint_torque_noise_std"], 0.1 * env.action_space.high)
     assert len(drawn["joint_torque_bias"]) == 4
-    with pytest.raises(ValueError, match="estimator"):
-        dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", estimator="kalman")
+    with pytest.raises(ValueError, match="particle filter"):
+        dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", estimator="particle")
+    # Behind the Kalman filter the policy is shown the state its torques land in, and its links.
+    behind = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"action_delay": 2},
+                                    estimator="kalman")
+    _, shown = behind.reset(seed=3)
+    _, now = delayed.reset(seed=3)
+    assert behind.pending.shape == (0, 4)
+    assert not np.array_equal(shown["link_angles"], now["link_angles"])
     late = dicestack.DiceStackEnv(embodiment="arm", controller="joint_torque", perturb={"observation_delay": 2})
     late.reset(seed=3)
     late.step(held)

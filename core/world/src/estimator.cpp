@@ -111,7 +111,7 @@ EstimatorConfig estimator_config(std::string_view name) {
 
 void CommandTimeline::start() {
   steps_ = lagged_step_ = 0;
-  queue_.assign(static_cast<std::size_t>(action_delay_), Action{0.0, 0.0, 0.0});
+  queue_.assign(static_cast<std::size_t>(action_delay_), Action::zeros(actions_));
   since_.clear();
 }
 
@@ -136,8 +136,9 @@ void CommandTimeline::run_on(World& world) const {
   for (const Action& a : queue_) world.step(a);
 }
 
-KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config)
-    : dt_(model.physics.control_dt), timeline_(draw.action_delay, draw.observation_delay) {
+KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config,
+                                 ActionKind actions)
+    : dt_(model.physics.control_dt), timeline_(draw.action_delay, draw.observation_delay, actions) {
   for (std::size_t k = 0; k < kStateDim; ++k) {
     sensor_variance_[k] = draw.observation_noise[k] * draw.observation_noise[k];
     const double q = config.model_error * model_error_of(k);
@@ -145,7 +146,8 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
   }
   const bool exact = std::all_of(sensor_variance_.begin(), sensor_variance_.end(), [](double v) { return v == 0.0; });
   std::vector<WorldConfig> worlds{model};
-  if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0))
+  if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0) &&
+      model.embodiment == Embodiment::cup)
     for (const WorldConfig& w : other_frictions(model)) worlds.push_back(w);
   models_.reserve(worlds.size());
   for (const WorldConfig& w : worlds) models_.emplace_back(w);
@@ -153,12 +155,28 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
   misfit_.assign(models_.size(), 0.0);
 }
 
+State Estimator::rebuild(World& world, const State& state, int step) const {
+  if (encoders_.empty() || world.config().embodiment != Embodiment::arm) {
+    world.set_state(state);
+    return state;
+  }
+  world.set_state(state, encoders_.at(static_cast<std::size_t>(step)));
+  return world.state();
+}
+
+bool Estimator::agrees(const State& model, const State& sensed) const {
+  if (encoders_.empty()) return model == sensed;
+  for (std::size_t k = 0; k < kStateDim; ++k)
+    if (std::abs(model[k] - sensed[k]) > kArmAgreement * (1.0 + std::abs(sensed[k]))) return false;
+  return true;
+}
+
 State KalmanEstimator::start(const State& observed) {
-  for (World& w : models_) w.set_state(observed);
   predicted_.assign(models_.size(), observed);
+  for (std::size_t m = 0; m < models_.size(); ++m) predicted_[m] = rebuild(models_[m], observed, 0);
   misfit_.assign(models_.size(), 0.0);
   chosen_ = 0;
-  lagged_ = observed;
+  lagged_ = predicted_[0];
   const auto& all = kPairs;
   for (std::size_t i = 0; i < all.size(); ++i)
     covariance_[i] = {sensor_variance_[all[i].pose], 0.0, sensor_variance_[all[i].velocity]};
@@ -227,11 +245,10 @@ void KalmanEstimator::correct(const State& observed) {
   // warm-starting, which a rebuild loses (the cup's velocity follows the dice it carries).
   // Moving the bodies of a running model instead, contacts kept, measured no better under noise.
   // Each model's prediction stays the state it stands at until the next step.
+  // On an arm the rebuilt model holds the links its encoders read, and the cup where they hold it.
   for (std::size_t m = 0; m < predicted_.size(); ++m)
-    if (predicted_[m] != lagged_) {
-      models_[m].set_state(lagged_);
-      predicted_[m] = lagged_;
-    }
+    if (!agrees(predicted_[m], lagged_)) predicted_[m] = rebuild(models_[m], lagged_, timeline_.lagged_step());
+  lagged_ = predicted_[chosen_];
 }
 
 State KalmanEstimator::update(const Action& chosen, const State& observed) {
@@ -242,25 +259,29 @@ State KalmanEstimator::update(const Action& chosen, const State& observed) {
 }
 
 State KalmanEstimator::ahead() {
-  if (timeline_.empty()) return lagged_;
   World& forecast = models_[chosen_];
+  if (timeline_.empty()) {
+    links_ = forecast.arm_links();
+    return lagged_;
+  }
   const WorldSnapshot at_lagged = forecast.snapshot();
   timeline_.run_on(forecast);
   const State landing = forecast.state();
+  links_ = forecast.arm_links();
   forecast.restore(at_lagged);
   return landing;
 }
 
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
-                                          const PerturbationDraw& draw) {
+                                          const PerturbationDraw& draw, ActionKind actions) {
   bool noisy = false;
   for (double sigma : draw.observation_noise) noisy = noisy || sigma > 0.0;
   const bool sensed = noisy || draw.observation_delay > 0 || draw.action_delay > 0;
   if (config.kind == EstimatorKind::none || !sensed) return nullptr;
   // Without sensor noise there is nothing to weigh particles by: the delays alone are made up
   // exactly by the Kalman filter's forward simulation, which a particle filter would repeat.
-  if (config.kind == EstimatorKind::particle && noisy) return std::make_unique<ParticleEstimator>(model, draw, config);
-  return std::make_unique<KalmanEstimator>(model, draw, config);
+  if (config.kind == EstimatorKind::particle && noisy) return std::make_unique<ParticleEstimator>(model, draw, config, actions);
+  return std::make_unique<KalmanEstimator>(model, draw, config, actions);
 }
 
 }  // namespace dicestack

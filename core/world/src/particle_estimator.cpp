@@ -15,8 +15,9 @@ constexpr std::uint64_t kParticleStream = 0x7061727469636c65ULL;  // "particle"
 
 }  // namespace
 
-ParticleEstimator::ParticleEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config)
-    : timeline_(draw.action_delay, draw.observation_delay), seed_(derive_seed(draw.noise_seed, kParticleStream)),
+ParticleEstimator::ParticleEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config,
+                                     ActionKind actions)
+    : timeline_(draw.action_delay, draw.observation_delay, actions), seed_(derive_seed(draw.noise_seed, kParticleStream)),
       scratch_(model) {
   if (config.particles < 1 || config.particles > kMaxParticles)
     throw ConfigError("particle filter: takes 1 to " + std::to_string(kMaxParticles) + " particles, got " +
@@ -130,9 +131,16 @@ State ParticleEstimator::update(const Action& chosen, const State& observed) {
 
 State ParticleEstimator::ahead() {
   const State now = mean();
-  if (timeline_.empty()) return now;
+  if (timeline_.empty()) {
+    if (scratch_.config().embodiment == Embodiment::arm) {
+      scratch_.set_state(now);
+      links_ = scratch_.arm_links();
+    }
+    return now;
+  }
   scratch_.set_state(now);
   timeline_.run_on(scratch_);
+  links_ = scratch_.arm_links();
   return scratch_.state();
 }
 

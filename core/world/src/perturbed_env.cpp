@@ -12,7 +12,7 @@ PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const Perturbation& perturbation, st
     : PerturbedEnv(pooled, draw_perturbation(perturbation, pooled.config(), episode_seed), actions) {}
 
 PerturbedEnv::PerturbedEnv(DiceEnv& pooled, const PerturbationDraw& draw, ActionKind actions)
-    : draw_(draw), env_(&pooled), model_(&pooled.config()) {
+    : draw_(draw), env_(&pooled), model_(&pooled.config()), actions_(actions) {
   if (draw_.physics) env_ = &own_.emplace(draw_.world);
   if (draw_.acts) channel_.emplace(draw_, actions);
 }
@@ -23,8 +23,10 @@ void PerturbedEnv::use_estimator(const EstimatorConfig& config) { estimator_conf
 
 State PerturbedEnv::first_shown(const State& start) {
   const State observed = channel_ ? channel_->observe(start) : start;
-  estimator_ = make_estimator(estimator_config_, *model_, draw_);
-  return estimator_ ? estimator_->start(observed) : observed;
+  estimator_ = make_estimator(estimator_config_, *model_, draw_, actions_);
+  if (!estimator_) return observed;
+  read_encoders();
+  return estimator_->start(observed);
 }
 
 void PerturbedEnv::add_executed_noise(const Action& sigma, std::uint64_t seed) {
@@ -54,8 +56,15 @@ PerturbedStep PerturbedEnv::step(const Action& chosen) {
   }
   PerturbedStep s{env_->step(executed), {}};
   s.shown = channel_ ? channel_->observe(s.result.observation) : s.result.observation;
-  if (estimator_) s.shown = estimator_->update(clipped, s.shown);
+  if (estimator_) {
+    read_encoders();
+    s.shown = estimator_->update(clipped, s.shown);
+  }
   return s;
+}
+
+void PerturbedEnv::read_encoders() {
+  if (env_->config().embodiment == Embodiment::arm) estimator_->read_encoders(env_->world().arm_links());
 }
 
 const std::deque<Action>& PerturbedEnv::pending() const {

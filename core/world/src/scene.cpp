@@ -164,7 +164,7 @@ b2Vec2 box2d_point(Vec2 p, double u) { return {box2d_length(p.x, u), box2d_lengt
 
 // The arm holding the cup: link bodies in the rest posture for the cup's pose, moving so that
 // the wrist follows the cup's velocity, and the four joints with their limits.
-void add_arm(Scene& scene, const WorldConfig& c, const Pose& cup) {
+void add_arm(Scene& scene, const WorldConfig& c, const Pose& cup, const ArmLinks* links) {
   const double u = scene.u;
   const ArmConfig& arm = c.arm;
   for (b2Fixture* f : scene.fixtures)
@@ -173,8 +173,8 @@ void add_arm(Scene& scene, const WorldConfig& c, const Pose& cup) {
       filter.categoryBits = kSceneCategory;
       f->SetFilterData(filter);
     }
-  const ArmPosture posture = arm_posture(arm, {cup.x, cup.y});
-  const auto rates = arm_link_rates(arm, posture.link_angles, {cup.vx, cup.vy});
+  const ArmPosture posture = links ? arm_posture_of(arm, links->angles) : arm_posture(arm, {cup.x, cup.y});
+  const auto rates = links ? links->rates : arm_link_rates(arm, posture.link_angles, {cup.vx, cup.vy});
   b2Vec2 joint_velocity(0.0f, 0.0f);  // of the link's near joint, Box2D units
   for (std::size_t i = 0; i < kArmLinks; ++i) {
     const double a = posture.link_angles[i], len = arm.link_lengths[i];
@@ -284,8 +284,19 @@ std::array<Pose, kBodies> poses_of(const State& s) {
 
 WorldStorage make_world_storage() { return WorldStorage(new std::byte[sizeof(b2World)]); }
 
-Scene::Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::byte* storage)
+Scene::Scene(const WorldConfig& c, const std::array<Pose, kBodies>& given, std::byte* storage, const ArmLinks* encoders)
     : u(c.physics.units_per_metre) {
+  std::array<Pose, kBodies> poses = given;
+  if (encoders) {  // the cup at the wrist the links reach, moving as they move it
+    const ArmPosture p = arm_posture_of(c.arm, encoders->angles);
+    poses[0].x = p.joints[3].x;
+    poses[0].y = p.joints[3].y;
+    poses[0].vx = poses[0].vy = 0.0;
+    for (std::size_t i = 0; i < kArmLinks; ++i) {
+      poses[0].vx -= c.arm.link_lengths[i] * std::sin(encoders->angles[i]) * encoders->rates[i];
+      poses[0].vy += c.arm.link_lengths[i] * std::cos(encoders->angles[i]) * encoders->rates[i];
+    }
+  }
   initialise_box2d_once();
   world = new (storage) b2World(b2Vec2(box2d_length(c.physics.gravity.x, u), box2d_length(c.physics.gravity.y, u)));
   world->SetAllowSleeping(c.physics.allow_sleep);
@@ -293,7 +304,7 @@ Scene::Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::
   add_wall_fixtures(*this, c, next_id);
   bodies[0] = add_cup_body(*this, c, poses[0], next_id);
   add_dice_bodies(*this, c, poses, next_id);
-  if (c.embodiment == Embodiment::arm) add_arm(*this, c, poses[0]);
+  if (c.embodiment == Embodiment::arm) add_arm(*this, c, poses[0], encoders);
 }
 
 }  // namespace dicestack::detail

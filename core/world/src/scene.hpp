@@ -62,7 +62,10 @@ struct Scene {
   Scene& operator=(const Scene&) = delete;
   ~Scene() { world->~b2World(); }
 
-  Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::byte* storage);
+  /// The scene at `poses`; an arm in the rest posture for the cup's pose, or, given `links`, in
+  /// the links its encoders read, with the cup where they hold it (its angle and turn rate from
+  /// `poses`).
+  Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::byte* storage, const ArmLinks* encoders = nullptr);
 
   b2ContactManager& contacts() const { return const_cast<b2ContactManager&>(world->GetContactManager()); }
   /// Every fixture by id: walls, cup, dice, then the arm's links.

@@ -1,6 +1,7 @@
 #include <dicestack/core/world.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -35,6 +36,14 @@ State World::state() const { return impl_->state(); }
 void World::set_state(const State& state) {
   require_finite(state, "world state");
   impl_->rebuild(poses_of(state));
+}
+
+void World::set_state(const State& state, const ArmLinks& links) {
+  if (impl_->config.embodiment != Embodiment::arm) throw InputError("world state: arm links given to a floating cup");
+  require_finite(state, "world state");
+  for (std::size_t i = 0; i < 3; ++i)
+    if (!std::isfinite(links.angles[i]) || !std::isfinite(links.rates[i])) throw InputError("world state: an arm link is not finite");
+  impl_->rebuild(poses_of(state), &links);
 }
 
 bool World::step(const Action& dv) {

@@ -17,9 +17,9 @@ struct World::Impl {
   std::optional<detail::Scene> scene;  // lives in `storage`
 
   // Replaces the scene; the old one is destroyed first so that both use the same storage.
-  detail::Scene& rebuild(const std::array<detail::Pose, detail::kBodies>& poses) {
+  detail::Scene& rebuild(const std::array<detail::Pose, detail::kBodies>& poses, const ArmLinks* links = nullptr) {
     scene.reset();
-    return scene.emplace(config, poses, storage.get());
+    return scene.emplace(config, poses, storage.get(), links);
   }
 
   explicit Impl(const WorldConfig& c) : config(c) {

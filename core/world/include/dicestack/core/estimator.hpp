@@ -42,6 +42,10 @@ struct EstimatorConfig {
   bool identify_friction = true;
 };
 
+/// How near an arm's model must stand to what the sensor gave to keep running, relative to each
+/// number (plus 1): a few times the float rounding Box2D keeps its bodies in.
+inline constexpr double kArmAgreement = 1e-6;
+
 /// The most particles `particle:N` takes: each is a world of its own (kEstimatorWorldBytes)
 /// stepped at every control step (about 30 us), so 4096 hold about 650 MB and take about 40 s
 /// per episode.
@@ -84,6 +88,30 @@ class Estimator {
   /// trained without the delay acts on the state its action meets. A policy's clock stays the
   /// count of its own choices: the choice lands after as many of them as it would without.
   virtual State update(const Action& chosen, const State& observed) = 0;
+  /// The arm's links in the world of the last estimate (zeros for the floating cup): a policy
+  /// whose law reads the links acts on these with the estimate. A world rebuilt from 24 numbers
+  /// takes the arm's rest posture, so the links are exact only where nothing was corrected (the
+  /// delays made up in the nominal world), not under sensor noise.
+  const ArmLinks& links() const { return links_; }
+  /// On an arm, the links its joint encoders read now (exact and at once), given before start()
+  /// and before each update(): a model rebuilt at an estimate then holds the links read at the
+  /// step it stands for, and the cup where they hold it, instead of the rest posture.
+  void read_encoders(const ArmLinks& now) { encoders_.push_back(now); }
+
+ protected:
+  /// Rebuilds `world` at `state` (with the links read at `step`, when the encoders were read);
+  /// returns the state it then stands at: `state` itself, or on an arm with encoders its cup
+  /// where the links hold it.
+  State rebuild(World& world, const State& state, int step) const;
+  /// True when a model's state and what the sensor gave agree, so the model keeps running (its
+  /// contacts warm). Exactly, for the floating cup. On an arm, to within kArmAgreement of each
+  /// number: a world rebuilt at a sensed state stands within the simulator's float rounding of
+  /// it, since the rest posture an arm is built in is solved from the rounded numbers, and a
+  /// rebuild at every step would lose the contacts' warm-starting for nothing.
+  bool agrees(const State& model, const State& sensed) const;
+
+  ArmLinks links_{};
+  std::vector<ArmLinks> encoders_;  // the links read at each step from the start, on an arm
 };
 
 /// What a robot's own command queue knows under delays, for an estimator: the commands chosen
@@ -91,9 +119,10 @@ class Estimator {
 /// shows (an observation delay), which the estimate of that step must be moved through.
 class CommandTimeline {
  public:
-  CommandTimeline(int action_delay, int observation_delay)
-      : action_delay_(action_delay), observation_delay_(observation_delay) {}
-  /// A new episode: action_delay zero commands queued, nothing run.
+  /// `actions`: the kind the policy answers in, whose zeros run before its first choice lands.
+  CommandTimeline(int action_delay, int observation_delay, ActionKind actions = ActionKind::cup)
+      : action_delay_(action_delay), observation_delay_(observation_delay), actions_(actions) {}
+  /// A new episode: action_delay zero commands queued (no torque on an arm's joints), nothing run.
   void start();
   /// Records the choice of the step just taken; true when the newest observation now shows a
   /// step later than the estimate stands at (move it through take_ran() first).
@@ -103,9 +132,12 @@ class CommandTimeline {
   /// Steps `world` on through what ran since the estimate's step, then what is queued.
   void run_on(World& world) const;
   bool empty() const { return since_.empty() && queue_.empty(); }
+  /// The step the estimate stands at (the newest observation's).
+  int lagged_step() const { return lagged_step_; }
 
  private:
   int action_delay_, observation_delay_;
+  ActionKind actions_;
   int steps_ = 0;         // control steps taken
   int lagged_step_ = 0;   // the step the estimate stands at
   std::deque<Action> queue_;  // chosen, not run yet
@@ -127,14 +159,16 @@ class CommandTimeline {
 /// moves it most (a die sliding in the cup or on the table). With exact observations and a delay
 /// it keeps the world at kFrictionScales of the nominal friction for the dice, the cup and the
 /// walls apart (27 worlds), each stepped as the model is, and forecasts with the one whose
-/// one-step predictions have matched the observations best. Under sensor noise the bank is not
+/// one-step predictions have matched the observations best (not on the arm, where the bank was
+/// not measured). Under sensor noise the bank is not
 /// kept: the noise outweighs what tells the frictions apart, and choosing among them measured
 /// worse (docs/robustness.md, "The estimator").
 class KalmanEstimator final : public Estimator {
  public:
   /// `model`: the nominal world; `draw`: the episode's sensing and command delays and its
-  /// sensor's noise (nothing else of it is read).
-  KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config);
+  /// sensor's noise (nothing else of it is read); `actions`: the kind the policy answers in.
+  KalmanEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config,
+                  ActionKind actions = ActionKind::cup);
   State start(const State& observed) override;
   State update(const Action& chosen, const State& observed) override;
 
@@ -171,7 +205,8 @@ class KalmanEstimator final : public Estimator {
 /// episode's noise stream, so the same on any number of threads or ranks.
 class ParticleEstimator final : public Estimator {
  public:
-  ParticleEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config);
+  ParticleEstimator(const WorldConfig& model, const PerturbationDraw& draw, const EstimatorConfig& config,
+                    ActionKind actions = ActionKind::cup);
   State start(const State& observed) override;
   State update(const Action& chosen, const State& observed) override;
 
@@ -197,8 +232,8 @@ class ParticleEstimator final : public Estimator {
 /// The estimator of `config` for one episode (nullptr for none, and when the draw's sensing and
 /// command timing are nominal: the policy then sees the state itself; particle without sensor
 /// noise is the Kalman filter, which makes up the delays exactly). Each episode needs its own:
-/// start() first.
+/// start() first. `actions`: the kind the policy answers in (an arm's joint torques, or the cup's).
 std::unique_ptr<Estimator> make_estimator(const EstimatorConfig& config, const WorldConfig& model,
-                                          const PerturbationDraw& draw);
+                                          const PerturbationDraw& draw, ActionKind actions = ActionKind::cup);
 
 }  // namespace dicestack

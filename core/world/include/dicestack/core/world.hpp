@@ -82,6 +82,10 @@ class World {
   /// takes its rest posture (arm_posture) and the link rates that move the cup as the state says.
   /// Throws InputError if a value is not finite.
   void set_state(const State& state);
+  /// The same with the arm's links as its encoders read them: the links take those angles and
+  /// rates, and the cup is where they hold it (its angle, turn rate and the dice from `state`).
+  /// Throws InputError for a floating cup or a value that is not finite.
+  void set_state(const State& state, const ArmLinks& links);
 
   /// An exact snapshot of the current state; see WorldSnapshot.
   WorldSnapshot snapshot() const;
