@@ -91,6 +91,36 @@ TEST(Arm, InFreeSpaceTheCupMovesAsTheFloatingCupDoes) {
   for (double torque : held.arm_joint_torques()) EXPECT_TRUE(std::isfinite(torque));
 }
 
+// A world rebuilt with the links its encoders read holds them, and the cup where they hold it;
+// the 24 numbers alone rebuild the arm in its rest posture. A floating cup or a link that is not
+// finite is refused.
+TEST(Arm, AStateRebuiltWithItsLinksHoldsThemAndTheCupWhereTheyHoldIt) {
+  const WorldConfig c = arm_world();
+  World run(c, paper_start_state(c));
+  for (int t = 0; t < 10; ++t) run.step(Action{0.1, 0.05, 0.2});
+  const State s = run.state();
+  const ArmLinks links = run.arm_links();
+  World rebuilt(c);
+  rebuilt.set_state(s, links);
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_NEAR(rebuilt.arm_links().angles[j], links.angles[j], 1e-6);
+    EXPECT_NEAR(rebuilt.arm_links().rates[j], links.rates[j], 1e-5);
+  }
+  // The cup within the joints' slack of where it was (its velocity the links' own), the dice
+  // exactly where they were.
+  for (std::size_t k = 0; k < kStateDim; ++k) EXPECT_NEAR(rebuilt.state()[k], s[k], k < 3 || k > 20 ? 1e-2 : 1e-6) << k;
+  World rest(c);
+  rest.set_state(s);
+  double moved = 0.0;
+  for (std::size_t j = 0; j < 3; ++j) moved += std::abs(rest.arm_links().angles[j] - links.angles[j]);
+  EXPECT_GT(moved, 1e-3) << "the swing moved the arm out of its rest posture";
+  World floating{WorldConfig{}};
+  EXPECT_THAT(test::error_of([&] { floating.set_state(s, links); }), HasSubstr("floating cup"));
+  ArmLinks bad = links;
+  bad.rates[1] = std::nan("");
+  EXPECT_THAT(test::error_of([&] { rebuilt.set_state(s, bad); }), HasSubstr("not finite"));
+}
+
 TEST(Arm, RestoringASnapshotContinuesBitForBit) {
   const WorldConfig c = arm_world();
   const auto actions = test::random_actions(c, 5, 80);
