@@ -19,8 +19,8 @@ namespace {
 
 using json = nlohmann::json;
 
-constexpr const char* kFormat = "dicestack-perturbation";
-constexpr int kVersion = 2;  // 2: "delays_drawn"
+constexpr const char* kPerturbationFormat = "dicestack-perturbation";
+constexpr int kPerturbationVersion = 2;  // 2: "delays_drawn"
 constexpr std::uint64_t kPerturbStream = 0x70657274ULL;  // "pert": a stream of its own per episode
 constexpr std::uint64_t kDelayStream = 0x64656c61ULL;    // "dela": drawn delays, apart so the rest stays as in version 1
 constexpr const char* kDelaysDrawn = "delays_drawn";
@@ -195,8 +195,8 @@ std::vector<PerturbationKey> perturbation_keys() {
 
 std::string perturbation_to_json(const Perturbation& p) {
   json j = json::object();
-  j["format"] = kFormat;
-  j["version"] = kVersion;
+  j["format"] = kPerturbationFormat;
+  j["version"] = kPerturbationVersion;
   for (const auto& k : kKeys) j[k.name] = k.real ? json(p.*k.real) : json(p.*k.whole);
   j[kDelaysDrawn] = p.delays_drawn;
   return j.dump(2) + "\n";
@@ -219,14 +219,14 @@ Perturbation perturbation_from_json(std::string_view text, const std::string& so
   } catch (const json::exception& e) {
     throw InputError(source + ": not JSON (" + e.what() + ")");
   }
-  if (!j.is_object() || j.value("format", json()) != kFormat)
-    throw InputError(source + ": not a perturbation file (no \"format\": \"" + std::string(kFormat) + "\")");
+  if (!j.is_object() || j.value("format", json()) != kPerturbationFormat)
+    throw InputError(source + ": not a perturbation file (no \"format\": \"" + std::string(kPerturbationFormat) + "\")");
   const json& v = j.value("version", json());
   if (!v.is_number_integer() || v.get<long long>() < 1)
     throw InputError(source + ": field \"version\" must be a positive integer");
-  if (v.get<long long>() > kVersion)
+  if (v.get<long long>() > kPerturbationVersion)
     throw InputError(source + ": format version " + std::to_string(v.get<long long>()) +
-                     " is newer than this dicestack reads (" + std::to_string(kVersion) + "); upgrade dicestack");
+                     " is newer than this dicestack reads (" + std::to_string(kPerturbationVersion) + "); upgrade dicestack");
   Perturbation p;
   for (const auto& [key, value] : j.items()) {
     if (key == "format" || key == "version") continue;
