@@ -36,12 +36,12 @@ void check_arm(const std::string& what, const WorldConfig& world) {
   if (world.embodiment != Embodiment::arm) throw ConfigError(what + " drives an arm's joints: give --embodiment arm");
 }
 
-// An expert in joint torques runs without an estimator: its feedback is told in torques through
-// the world's own links, not an estimate's.
+// An expert in joint torques runs without an estimator: its feedback is turned into torques
+// through the world's own links, not an estimate's.
 void check_torque_run(const std::string& what, const RobustnessOptions& opt, const WorldConfig& world) {
   check_arm(what, world);
   if (!opt.estimator.empty() && opt.estimator != "none")
-    throw ConfigError(what + ": an expert in joint torques tells its feedback through the world's own links; leave --estimator out");
+    throw ConfigError(what + ": an expert in joint torques turns its feedback into torques through the world's own links; leave --estimator out");
 }
 
 // An expert in joint torques (a model answers in its own actions).

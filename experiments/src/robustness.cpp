@@ -74,6 +74,7 @@ std::vector<RobustnessRow> robustness(const PolicyFactory& make_policy, const Wo
     row.threads = request.threads;
     row.perturbation = perturbation(f, level);
     row.actions = request.actions;
+    row.estimator = request.estimator;
     check_evaluation(world, row);
   }
   std::vector<RobustnessRow> rows;

@@ -63,8 +63,8 @@ void check_record_request(ActionKind controller, const WorldConfig& world, const
     throw ConfigError("record: an estimator stands between the sensors and the expert's feedback, which reads the world; "
                       "give --expert-feedback observations");
   if (controller == ActionKind::joint_torque)
-    throw ConfigError("record: an expert answering joint torques runs without an estimator (its feedback is told in "
-                      "torques through the world's own links, not an estimate's)");
+    throw ConfigError("record: an expert answering joint torques runs without an estimator (its feedback is turned "
+                      "into torques through the world's own links, not an estimate's)");
 }
 
 std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& config, const WorldConfig& world,

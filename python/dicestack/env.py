@@ -93,8 +93,8 @@ class DiceStackEnv(_EnvBase):
     controller: "cup" (the action is the cup's velocity change, on either embodiment) or
     "joint_torque" (the arm only: the action is the four joint torques in N m, shoulder first,
     held through the step and clipped to the arm's limits, which `action_space` gives). On the
-    arm, info also holds link_angles and link_rates (each link's absolute direction and rate)
-    and joint_torques (what the joints held on average over the last step, N m).
+    arm, info also holds link_angles and link_rates (each link's absolute direction and rate;
+    under joint_torque behind the Kalman filter, those of the state it estimates) and joint_torques (what the joints held on average over the last step, N m).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}

@@ -40,8 +40,8 @@ class EnvCore {
  public:
   /// `estimator`: what the policy is shown under sensing factors (estimator.hpp); `controller`:
   /// what an action is (the cup's velocity change, or an arm's joint torques). Throws
-  /// ConfigError for joint torques without the arm, or behind an estimator (its worlds hold no
-  /// arm links).
+  /// ConfigError for joint torques without the arm, or behind the particle filter (its worlds
+  /// hold no arm links).
   explicit EnvCore(const WorldConfig& world, const Perturbation& perturbation = {}, const EstimatorConfig& estimator = {},
                    ActionKind controller = ActionKind::cup);
   ActionKind controller() const { return controller_; }

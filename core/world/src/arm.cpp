@@ -39,6 +39,15 @@ ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& lin
   return p;
 }
 
+Vec2 arm_wrist_velocity(const ArmConfig& arm, const std::array<double, 3>& link_angles, const std::array<double, 3>& link_rates) {
+  Vec2 v{0.0, 0.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    v.x -= arm.link_lengths[i] * std::sin(link_angles[i]) * link_rates[i];
+    v.y += arm.link_lengths[i] * std::cos(link_angles[i]) * link_rates[i];
+  }
+  return v;
+}
+
 ArmPosture arm_posture(const ArmConfig& arm, Vec2 wrist) {
   const auto& l = arm.link_lengths;
   const double dx = arm.base.x - wrist.x, dy = arm.base.y - wrist.y, reach = std::hypot(dx, dy);

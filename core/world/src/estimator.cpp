@@ -147,7 +147,7 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
   const bool exact = std::all_of(sensor_variance_.begin(), sensor_variance_.end(), [](double v) { return v == 0.0; });
   std::vector<WorldConfig> worlds{model};
   if (config.identify_friction && exact && (draw.action_delay > 0 || draw.observation_delay > 0) &&
-      model.embodiment == Embodiment::cup)
+      actions == ActionKind::cup)
     for (const WorldConfig& w : other_frictions(model)) worlds.push_back(w);
   models_.reserve(worlds.size());
   for (const WorldConfig& w : worlds) models_.emplace_back(w);
@@ -172,7 +172,7 @@ bool Estimator::agrees(const State& model, const State& sensed) const {
 }
 
 State KalmanEstimator::start(const State& observed) {
-  predicted_.assign(models_.size(), observed);
+  predicted_.resize(models_.size());
   for (std::size_t m = 0; m < models_.size(); ++m) predicted_[m] = rebuild(models_[m], observed, 0);
   misfit_.assign(models_.size(), 0.0);
   chosen_ = 0;
@@ -248,7 +248,7 @@ void KalmanEstimator::correct(const State& observed) {
   // On an arm the rebuilt model holds the links its encoders read, and the cup where they hold it.
   for (std::size_t m = 0; m < predicted_.size(); ++m)
     if (!agrees(predicted_[m], lagged_)) predicted_[m] = rebuild(models_[m], lagged_, timeline_.lagged_step());
-  lagged_ = predicted_[chosen_];
+  if (!encoders_.empty()) lagged_ = predicted_[chosen_];  // the cup where the encoders' links hold it
 }
 
 State KalmanEstimator::update(const Action& chosen, const State& observed) {

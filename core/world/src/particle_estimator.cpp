@@ -131,16 +131,9 @@ State ParticleEstimator::update(const Action& chosen, const State& observed) {
 
 State ParticleEstimator::ahead() {
   const State now = mean();
-  if (timeline_.empty()) {
-    if (scratch_.config().embodiment == Embodiment::arm) {
-      scratch_.set_state(now);
-      links_ = scratch_.arm_links();
-    }
-    return now;
-  }
+  if (timeline_.empty()) return now;
   scratch_.set_state(now);
   timeline_.run_on(scratch_);
-  links_ = scratch_.arm_links();
   return scratch_.state();
 }
 

@@ -64,7 +64,7 @@ PerturbedStep PerturbedEnv::step(const Action& chosen) {
 }
 
 void PerturbedEnv::read_encoders() {
-  if (env_->config().embodiment == Embodiment::arm) estimator_->read_encoders(env_->world().arm_links());
+  if (actions_ == ActionKind::joint_torque) estimator_->read_encoders(env_->world().arm_links());
 }
 
 const std::deque<Action>& PerturbedEnv::pending() const {

@@ -291,11 +291,9 @@ Scene::Scene(const WorldConfig& c, const std::array<Pose, kBodies>& given, std::
     const ArmPosture p = arm_posture_of(c.arm, encoders->angles);
     poses[0].x = p.joints[3].x;
     poses[0].y = p.joints[3].y;
-    poses[0].vx = poses[0].vy = 0.0;
-    for (std::size_t i = 0; i < kArmLinks; ++i) {
-      poses[0].vx -= c.arm.link_lengths[i] * std::sin(encoders->angles[i]) * encoders->rates[i];
-      poses[0].vy += c.arm.link_lengths[i] * std::cos(encoders->angles[i]) * encoders->rates[i];
-    }
+    const Vec2 v = arm_wrist_velocity(c.arm, encoders->angles, encoders->rates);
+    poses[0].vx = v.x;
+    poses[0].vy = v.y;
   }
   initialise_box2d_once();
   world = new (storage) b2World(b2Vec2(box2d_length(c.physics.gravity.x, u), box2d_length(c.physics.gravity.y, u)));

@@ -62,7 +62,7 @@ struct Scene {
   Scene& operator=(const Scene&) = delete;
   ~Scene() { world->~b2World(); }
 
-  /// The scene at `poses`; an arm in the rest posture for the cup's pose, or, given `links`, in
+  /// The scene at `poses`; an arm in the rest posture for the cup's pose, or, given `encoders`, in
   /// the links its encoders read, with the cup where they hold it (its angle and turn rate from
   /// `poses`).
   Scene(const WorldConfig& c, const std::array<Pose, kBodies>& poses, std::byte* storage, const ArmLinks* encoders = nullptr);

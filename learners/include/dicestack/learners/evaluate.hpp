@@ -107,7 +107,7 @@ struct EvalRequest {
   EstimatorConfig estimator;
   std::size_t max_steps = 0;  ///< 0: the world's time limit
   /// What the policy answers (a perturbation's action delay, noise and bias are of that kind).
-  /// Joint torques run only on the arm, without an initial push or an estimator.
+  /// Joint torques run only on the arm, without an initial push, and not behind the particle filter.
   ActionKind actions = ActionKind::cup;
   std::vector<Episode>* rollouts = nullptr;  ///< if set, receives every rollout in index order
   std::vector<EpisodeResult>* results = nullptr;  ///< if set, receives every rollout's results in index order

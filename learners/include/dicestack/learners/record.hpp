@@ -49,7 +49,7 @@ std::vector<Episode> record_expert(const std::string& name, const ExpertConfig& 
 
 /// Throws ConfigError for an expert in joint torques without an arm, and for an estimator nothing reads
 /// (the expert's feedback on the world) or that cannot run (an expert answering joint torques:
-/// its worlds are rebuilt from the 24 observed numbers, without an arm's links). What
+/// its feedback is turned into torques through the world's own links, not an estimate's). What
 /// record_expert checks first, for callers that check before other work.
 void check_record_request(ActionKind controller, const WorldConfig& world, const RecordRequest& request);
 

@@ -33,6 +33,9 @@ inline std::array<double, 4> arm_joint_angles_of(const std::array<double, 3>& li
 
 /// The posture of `link_angles` (joints by forward kinematics from the shoulder).
 ArmPosture arm_posture_of(const ArmConfig& arm, const std::array<double, 3>& link_angles);
+/// The wrist's (the cup's centre's) velocity, m/s, when the links at `link_angles` turn at
+/// `link_rates` (absolute, rad/s).
+Vec2 arm_wrist_velocity(const ArmConfig& arm, const std::array<double, 3>& link_angles, const std::array<double, 3>& link_rates);
 
 /// The links' absolute rates (rad/s) that move the wrist at `velocity` (m/s): the least-norm
 /// rates (damped near a stretched arm), plus a motion the wrist does not feel that returns the

@@ -43,7 +43,7 @@ struct EstimatorConfig {
 };
 
 /// How near an arm's model must stand to what the sensor gave to keep running, relative to each
-/// number (plus 1): a few times the float rounding Box2D keeps its bodies in.
+/// number (plus 1): a few times the float rounding Box2D keeps its bodies in (Estimator::agrees).
 inline constexpr double kArmAgreement = 1e-6;
 
 /// The most particles `particle:N` takes: each is a world of its own (kEstimatorWorldBytes)
@@ -88,14 +88,14 @@ class Estimator {
   /// trained without the delay acts on the state its action meets. A policy's clock stays the
   /// count of its own choices: the choice lands after as many of them as it would without.
   virtual State update(const Action& chosen, const State& observed) = 0;
-  /// The arm's links in the world of the last estimate (zeros for the floating cup): a policy
-  /// whose law reads the links acts on these with the estimate. A world rebuilt from 24 numbers
-  /// takes the arm's rest posture, so the links are exact only where nothing was corrected (the
-  /// delays made up in the nominal world), not under sensor noise.
+  /// The arm's links in the Kalman filter's world of the last estimate (zeros for the floating
+  /// cup, and from the particle filter): a policy in joint torques, whose law reads the links,
+  /// acts on these with the estimate.
   const ArmLinks& links() const { return links_; }
-  /// On an arm, the links its joint encoders read now (exact and at once), given before start()
-  /// and before each update(): a model rebuilt at an estimate then holds the links read at the
-  /// step it stands for, and the cup where they hold it, instead of the rest posture.
+  /// For a policy in joint torques on an arm, the links its joint encoders read now (exact and at
+  /// once), given before start() and before each update(): the Kalman filter's model, rebuilt at
+  /// an estimate, then holds the links read at the step it stands for, and the cup where they
+  /// hold it; from the 24 numbers alone it would take the arm's rest posture.
   void read_encoders(const ArmLinks& now) { encoders_.push_back(now); }
 
  protected:
@@ -104,14 +104,14 @@ class Estimator {
   /// where the links hold it.
   State rebuild(World& world, const State& state, int step) const;
   /// True when a model's state and what the sensor gave agree, so the model keeps running (its
-  /// contacts warm). Exactly, for the floating cup. On an arm, to within kArmAgreement of each
-  /// number: a world rebuilt at a sensed state stands within the simulator's float rounding of
-  /// it, since the rest posture an arm is built in is solved from the rounded numbers, and a
-  /// rebuild at every step would lose the contacts' warm-starting for nothing.
+  /// contacts warm). Exactly, without encoders. With them, to within kArmAgreement of each
+  /// number: a model rebuilt from the encoders stands within float rounding and the joints'
+  /// slack of the world, never exactly on it, and a rebuild at every step would lose the
+  /// contacts' warm-starting for nothing.
   bool agrees(const State& model, const State& sensed) const;
 
   ArmLinks links_{};
-  std::vector<ArmLinks> encoders_;  // the links read at each step from the start, on an arm
+  std::vector<ArmLinks> encoders_;  // the links read at each step from the start (a torque policy on an arm)
 };
 
 /// What a robot's own command queue knows under delays, for an estimator: the commands chosen
@@ -151,18 +151,19 @@ class CommandTimeline {
 /// moved as a pose integrating its velocity, plus the model's error, against the sensor's
 /// noise). The current state is that estimate simulated forward through the actions that ran
 /// since, and through the commands queued but not run yet (a command delay: the state the next
-/// action lands in). Contacts are the simulator's: a die riding in the cup is predicted as such. The model
-/// is rebuilt only where corrected, so without sensor noise, in the nominal world, it runs as
-/// the world does and makes up a delay exactly.
+/// action lands in). Contacts are the simulator's: a die riding in the cup is predicted as
+/// such. The model is rebuilt only where corrected, so without sensor noise, in the nominal
+/// world, it runs as the world does and makes up a delay exactly (for a policy in joint
+/// torques on an arm, to within kArmAgreement: Estimator::agrees).
 ///
 /// Under a delay its forecast runs several steps in a physics it does not know, and the friction
 /// moves it most (a die sliding in the cup or on the table). With exact observations and a delay
 /// it keeps the world at kFrictionScales of the nominal friction for the dice, the cup and the
 /// walls apart (27 worlds), each stepped as the model is, and forecasts with the one whose
-/// one-step predictions have matched the observations best (not on the arm, where the bank was
-/// not measured). Under sensor noise the bank is not
-/// kept: the noise outweighs what tells the frictions apart, and choosing among them measured
-/// worse (docs/robustness.md, "The estimator").
+/// one-step predictions have matched the observations best (not for a policy in joint torques,
+/// where the bank was not measured). Under sensor noise the bank is not kept: the noise
+/// outweighs what tells the frictions apart, and choosing among them measured worse
+/// (docs/robustness.md, "The estimator").
 class KalmanEstimator final : public Estimator {
  public:
   /// `model`: the nominal world; `draw`: the episode's sensing and command delays and its

@@ -69,9 +69,12 @@ class PerturbedEnv {
   bool perturbed() const { return draw_.physics || draw_.acts; }
   /// True when the actuation or sensing is perturbed: what the policy is shown is not the state.
   bool channelled() const { return channel_.has_value(); }
-  /// The arm's links the policy is shown with what it is shown: the estimator's, when one runs
-  /// (those of the state its estimate stands for), else the encoders' (exact and at once).
-  ArmLinks shown_links() const { return estimator_ ? estimator_->links() : env_->world().arm_links(); }
+  /// The arm's links the policy is shown with what it is shown: for a policy in joint torques
+  /// behind an estimator, the estimator's (those of the state its estimate stands for), else the
+  /// encoders' (exact and at once).
+  ArmLinks shown_links() const {
+    return estimator_ && actions_ == ActionKind::joint_torque ? estimator_->links() : env_->world().arm_links();
+  }
   /// What runs before the next choice under an action delay (History::pending). Empty without,
   /// and with an estimator: its estimate is of the state the next choice lands in.
   const std::deque<Action>& pending() const;
@@ -80,7 +83,7 @@ class PerturbedEnv {
   const std::deque<Action>& unseen() const;
 
  private:
-  void read_encoders();  // an arm's links, exact and at once, to the estimator
+  void read_encoders();  // an arm's links, exact and at once, to a torque policy's estimator
 
   PerturbationDraw draw_;
   std::optional<DiceEnv> own_;  // the world of a draw whose physics differs
