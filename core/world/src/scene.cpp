@@ -163,7 +163,8 @@ constexpr uint16 kWallCategory = 0x0001, kLinkCategory = 0x0002, kSceneCategory 
 b2Vec2 box2d_point(Vec2 p, double u) { return {box2d_length(p.x, u), box2d_length(p.y, u)}; }
 
 // The arm holding the cup: link bodies in the rest posture for the cup's pose, moving so that
-// the wrist follows the cup's velocity, and the four joints with their limits.
+// the wrist follows the cup's velocity (or, given `links`, at the angles and rates its encoders
+// read), and the four joints with their limits.
 void add_arm(Scene& scene, const WorldConfig& c, const Pose& cup, const ArmLinks* links) {
   const double u = scene.u;
   const ArmConfig& arm = c.arm;
