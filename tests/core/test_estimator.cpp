@@ -172,6 +172,14 @@ TEST(Estimator, MakesUpBothDelaysOnTheArmWithTheLinksOfTheStateItShows) {
   EXPECT_LT(state_error[0], 0.2 * state_error[1]) << "kalman " << state_error[0] << ", none " << state_error[1];
   EXPECT_LT(link_error[0], 0.2 * link_error[1]) << "kalman " << link_error[0] << ", none " << link_error[1];
   EXPECT_GT(link_error[1], 0.0);
+  // A policy in the cup's actions on the arm is shown the encoders' links, behind the filter too.
+  PerturbedEnv cup(pooled, late, 1, ActionKind::cup);
+  cup.use_estimator(estimator_config("kalman"));
+  cup.reset(1);
+  for (int t = 0; t < 5; ++t) {
+    cup.step(Action{0.1, 0.1, 0.0});
+    EXPECT_EQ(cup.shown_links(), cup.env().world().arm_links()) << "step " << t;
+  }
 }
 
 TEST(Estimator, FiltersSensorNoiseOnThePoses) {

@@ -156,7 +156,7 @@ KalmanEstimator::KalmanEstimator(const WorldConfig& model, const PerturbationDra
 }
 
 State Estimator::rebuild(World& world, const State& state, int step) const {
-  if (encoders_.empty() || world.config().embodiment != Embodiment::arm) {
+  if (encoders_.empty()) {
     world.set_state(state);
     return state;
   }
